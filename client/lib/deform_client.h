@@ -1,0 +1,109 @@
+// The deformd client library: connect, load a mesh, open deform streams. Hides the gRPC stubs and
+// the streaming reactor; exposes the deform.v1 messages themselves.
+//
+// Thread safety: DeformClient's methods may be called from any thread. A DeformStream's Send*
+// methods may be called from any thread; its callbacks run on gRPC's threads, one at a time per
+// stream, and must not block for long.
+#pragma once
+
+#include <grpcpp/grpcpp.h>
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "deform/v1/deform.grpc.pb.h"
+
+namespace deform::client {
+
+struct ClientOptions {
+  // Largest message accepted (a 133k-vertex mesh's geometry is about 5 MB). Default: 256 MiB.
+  int max_receive_message_bytes = 256 << 20;
+  // Upload chunk size for LoadMesh. Default: 1 MiB.
+  int upload_chunk_bytes = 1 << 20;
+};
+
+using ProgressCallback = std::function<void(const deform::v1::LoadMeshProgress&)>;
+
+class DeformStream;
+
+class DeformClient {
+ public:
+  // Connects lazily to `target` ("host:port"), insecure channel.
+  explicit DeformClient(const std::string& target, ClientOptions options = {});
+  explicit DeformClient(std::shared_ptr<grpc::Channel> channel, ClientOptions options = {});
+
+  // Waits up to `timeout_ms` for the channel to be ready. False on timeout.
+  bool WaitForReady(int timeout_ms);
+
+  // Loads the built-in knee phantom (`vertices` 0 = default). `summary` receives the READY summary.
+  grpc::Status LoadPhantom(int vertices, const deform::v1::MethodOptions& options,
+                           deform::v1::MeshSummary* summary, const ProgressCallback& progress = {},
+                           const std::string& name = "phantom");
+  // Uploads a mesh file and a skeleton file (formats from the extensions: .obj .ply .stl .off;
+  // .tgf or JSON). Reading a file that does not exist gives NOT_FOUND without contacting the server.
+  grpc::Status LoadMeshFiles(const std::string& mesh_path, const std::string& skeleton_path,
+                             const deform::v1::MethodOptions& options,
+                             deform::v1::MeshSummary* summary,
+                             const ProgressCallback& progress = {});
+  // Uploads mesh bytes already in memory.
+  grpc::Status LoadMeshBytes(const std::string& name, deform::v1::MeshFormat format,
+                             const std::string& mesh_bytes, deform::v1::SkeletonFormat skeleton_format,
+                             const std::string& skeleton_bytes,
+                             const deform::v1::MethodOptions& options,
+                             deform::v1::MeshSummary* summary,
+                             const ProgressCallback& progress = {});
+
+  grpc::Status GetMeshInfo(const std::string& mesh_id, bool include_geometry,
+                           deform::v1::MeshInfo* info);
+  grpc::Status ListMeshes(std::vector<deform::v1::MeshSummary>* meshes);
+  grpc::Status UnloadMesh(const std::string& mesh_id);
+
+  struct StreamCallbacks {
+    std::function<void(const deform::v1::DeformFrame&)> on_frame;
+    std::function<void(const deform::v1::Notice&)> on_notice;
+    std::function<void(const grpc::Status&)> on_done;  // once, when the stream ends
+  };
+  // Opens a Deform stream on `mesh_id` (sends `start`). Errors such as NOT_FOUND arrive through
+  // on_done / DeformStream::Wait().
+  std::unique_ptr<DeformStream> OpenStream(const std::string& mesh_id, StreamCallbacks callbacks);
+
+  deform::v1::DeformService::Stub* stub() { return stub_.get(); }
+
+ private:
+  std::shared_ptr<grpc::Channel> channel_;
+  std::unique_ptr<deform::v1::DeformService::Stub> stub_;
+  ClientOptions options_;
+};
+
+// One bidirectional Deform stream. Writes are serialised: while one is in flight, a newer pose
+// replaces any pose still waiting (latest wins), and stiffness updates queue in order.
+class DeformStream {
+ public:
+  virtual ~DeformStream() = default;
+  // False once the stream has ended or Close() was called.
+  virtual bool SendPose(const deform::v1::PoseUpdate& pose) = 0;
+  virtual bool SendStiffness(const deform::v1::StiffnessUpdate& stiffness) = 0;
+  // Half-closes after the pending writes; the server then finishes the stream.
+  virtual void Close() = 0;
+  // Cancels the RPC now.
+  virtual void Cancel() = 0;
+  // Blocks until the stream has ended; returns its final status.
+  virtual grpc::Status Wait() = 0;
+};
+
+// Client-side helpers.
+
+// "JOINT:AXIS:DEGREES[,...]" (deformctl's syntax) into JointAngle terms; INVALID_ARGUMENT status
+// in `error` (and false) for malformed text. Joint and axis names are checked by the server.
+bool ParsePoseAngles(const std::string& spec, deform::v1::PoseUpdate* pose, std::string* error);
+// float32 little-endian xyz bytes into floats (3 per vertex).
+std::vector<float> DecodePositions(const std::string& bytes);
+// Nanoseconds of a monotonic clock (for client_timestamp_ns and latency).
+std::int64_t MonotonicNanos();
+// Format from a file extension; MESH_FORMAT_UNSPECIFIED if unknown.
+deform::v1::MeshFormat MeshFormatFromPath(const std::string& path);
+
+}  // namespace deform::client

@@ -1,0 +1,267 @@
+#include "core/deformation_model.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <chrono>
+#include <limits>
+
+#include "core/mesh_topology.h"
+#include "core/skeleton_geometry.h"
+
+namespace deform {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using ColMajorMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
+
+double SecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// Anchors: rigid-zone vertices far from every joint centre; per component, if none is far enough,
+// the rigid-zone vertices farthest from the joints (within 90% of the farthest).
+std::vector<int> ChooseAnchors(const VertexAdjacency& adjacency, const std::vector<int>& fixed_bone,
+                               const JointRegions& regions, double distance_factor) {
+  std::vector<int> component;
+  const int count = ConnectedComponents(adjacency, &component);
+  const int n = static_cast<int>(fixed_bone.size());
+  std::vector<double> farthest(count, -1.0);
+  std::vector<char> has_far(count, 0);
+  for (int i = 0; i < n; ++i) {
+    if (fixed_bone[i] < 0) continue;
+    const double s = regions.relative_distance[i];
+    farthest[component[i]] = std::max(farthest[component[i]], s);
+    if (s >= distance_factor) has_far[component[i]] = 1;
+  }
+  std::vector<int> anchors;
+  for (int i = 0; i < n; ++i) {
+    if (fixed_bone[i] < 0) continue;
+    const double s = regions.relative_distance[i];
+    const int c = component[i];
+    if (has_far[c] ? s >= distance_factor : s >= 0.9 * farthest[c]) anchors.push_back(i);
+  }
+  return anchors;
+}
+
+}  // namespace
+
+ModelOptions ModelOptions::PlainLaplacian() {
+  ModelOptions options;
+  options.use_joint_nodes = false;
+  options.uniform_material = true;
+  return options;
+}
+
+StatusOr<std::shared_ptr<const DeformationModel>> DeformationModel::Build(
+    TriangleMesh mesh, Skeleton skeleton, const ModelOptions& options) {
+  const auto start = Clock::now();
+  DEFORM_RETURN_IF_ERROR(ValidateMesh(mesh, options.limits));
+  if (!(options.joint_node_weight > 0) || !(options.anchor_weight > 0) ||
+      !std::isfinite(options.joint_node_weight) || !std::isfinite(options.anchor_weight) ||
+      !(options.anchor_distance_factor >= 0)) {
+    return Status::InvalidArgument("joint node and anchor weights must be positive and finite");
+  }
+  std::shared_ptr<DeformationModel> model(new DeformationModel());
+  model->mesh_ = std::move(mesh);
+  model->skeleton_ = std::move(skeleton);
+  model->options_ = options;
+  DEFORM_RETURN_IF_ERROR(model->Precompute());
+  model->precompute_seconds_ = SecondsSince(start);
+  DEFORM_ASSIGN_OR_RETURN(model->default_factorization_, model->FactorizeImpl(Stiffness{}));
+  spdlog::debug("model built: {} vertices, {} joint nodes, {} anchors, factor {} non-zeros",
+                model->mesh_.num_vertices(), model->num_nodes_, model->anchors_.size(),
+                model->default_factorization_->factor().nonzeros());
+  return std::shared_ptr<const DeformationModel>(std::move(model));
+}
+
+Status DeformationModel::Precompute() {
+  const int n = mesh_.num_vertices();
+  diagonal_ = BoundingBoxDiagonal(mesh_.vertices);
+  const VertexAdjacency adjacency = BuildVertexAdjacency(mesh_.triangles, n);
+  const std::vector<NearestBone> nearest = NearestBones(mesh_.vertices, skeleton_);
+  DEFORM_ASSIGN_OR_RETURN(regions_, ComputeJointRegions(mesh_, skeleton_, adjacency, nearest,
+                                                        options_.regions));
+
+  // Rigid zones: outside every joint region, a vertex belongs wholly to its nearest bone.
+  std::vector<int> fixed_bone(n, -1);
+  for (int i = 0; i < n; ++i) {
+    if (regions_.membership_offsets[i] == regions_.membership_offsets[i + 1]) {
+      fixed_bone[i] = nearest[i].bone;
+    }
+  }
+  DEFORM_ASSIGN_OR_RETURN(bone_weights_,
+                          HarmonicBoneWeights(adjacency, fixed_bone, skeleton_.num_bones()));
+
+  // Joint centre nodes.
+  num_nodes_ = options_.use_joint_nodes ? static_cast<int>(regions_.regions.size()) : 0;
+  node_joint_.clear();
+  for (int c = 0; c < num_nodes_; ++c) node_joint_.push_back(regions_.regions[c].joint);
+
+  // L' (n by n + m): uniform weights over the one-ring plus the joint nodes of the vertex.
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(adjacency.neighbors.size() + n * 2);
+  for (int i = 0; i < n; ++i) {
+    const int nodes = options_.use_joint_nodes
+                          ? regions_.membership_offsets[i + 1] - regions_.membership_offsets[i]
+                          : 0;
+    // Weight of the edge to each joint node, in units of one one-ring edge.
+    const double node_edge = options_.joint_node_one_neighbor
+                                 ? 1.0
+                                 : options_.joint_node_balance * adjacency.degree(i);
+    const double share = 1.0 / (adjacency.degree(i) + nodes * node_edge);
+    triplets.emplace_back(i, i, 1.0);
+    for (int p = adjacency.offsets[i]; p < adjacency.offsets[i + 1]; ++p) {
+      triplets.emplace_back(i, adjacency.neighbors[p], -share);
+    }
+    if (nodes > 0) {
+      for (int p = regions_.membership_offsets[i]; p < regions_.membership_offsets[i + 1]; ++p) {
+        triplets.emplace_back(i, n + regions_.membership[p], -share * node_edge);
+      }
+    }
+  }
+  laplacian_.resize(n, n + num_nodes_);
+  laplacian_.setFromTriplets(triplets.begin(), triplets.end());
+  laplacian_.makeCompressed();
+  laplacian_transpose_ = laplacian_.transpose();
+  laplacian_transpose_.makeCompressed();
+
+  Positions rest_with_nodes(n + num_nodes_, 3);
+  rest_with_nodes.topRows(n) = mesh_.vertices;
+  for (int c = 0; c < num_nodes_; ++c) {
+    rest_with_nodes.row(n + c) = regions_.regions[c].centre.transpose();
+  }
+  rest_deltas_ = laplacian_ * rest_with_nodes;
+
+  anchors_ = ChooseAnchors(adjacency, fixed_bone, regions_, options_.anchor_distance_factor);
+  anchor_bone_.resize(anchors_.size());
+  anchor_rest_.resize(static_cast<Eigen::Index>(anchors_.size()), 3);
+  for (size_t a = 0; a < anchors_.size(); ++a) {
+    anchor_bone_[a] = fixed_bone[anchors_[a]];
+    anchor_rest_.row(a) = mesh_.vertices.row(anchors_[a]);
+  }
+
+  // Symbolic analysis on the pattern of the normal equations (weights 1).
+  ColMajorMatrix pattern = laplacian_transpose_ * laplacian_;
+  for (int a : anchors_) pattern.coeffRef(a, a) += 1.0;
+  for (int c = 0; c < num_nodes_; ++c) pattern.coeffRef(n + c, n + c) += 1.0;
+  pattern.makeCompressed();
+  DEFORM_ASSIGN_OR_RETURN(symbolic_, SymbolicCholesky::Analyze(pattern, options_.ordering));
+  return Status::Ok();
+}
+
+StatusOr<std::shared_ptr<const MaterialFactorization>> DeformationModel::Factorize(
+    const Stiffness& stiffness) const {
+  return FactorizeImpl(stiffness);
+}
+
+StatusOr<std::shared_ptr<const MaterialFactorization>> DeformationModel::FactorizeImpl(
+    const Stiffness& stiffness) const {
+  const auto start = Clock::now();
+  const int n = mesh_.num_vertices();
+  auto result = std::make_shared<MaterialFactorization>();
+  result->stiffness_ = stiffness;
+  if (options_.uniform_material) {
+    if (!stiffness.joint_materials.empty() || !stiffness.region_weights.empty() ||
+        !stiffness.vertex_weights.empty()) {
+      return Status::FailedPrecondition("this model has uniform material; stiffness is fixed");
+    }
+    result->row_weights_ = Eigen::VectorXd::Ones(n);
+  } else {
+    DEFORM_ASSIGN_OR_RETURN(result->row_weights_,
+                            MaterialRowWeights(regions_, n, options_.default_material, stiffness));
+  }
+  result->row_weights_squared_ = result->row_weights_.array().square();
+
+  // A^T A = L'^T W^2 L' + anchor_weight^2 sum e_a e_a^T + node_weight^2 sum e_c e_c^T.
+  const auto& w2 = result->row_weights_squared_;
+  Eigen::SparseMatrix<double, Eigen::RowMajor, int> weighted = laplacian_;
+  for (int i = 0; i < n; ++i) {
+    for (Eigen::SparseMatrix<double, Eigen::RowMajor, int>::InnerIterator it(weighted, i); it; ++it) {
+      it.valueRef() *= w2[i];
+    }
+  }
+  ColMajorMatrix normal = laplacian_transpose_ * weighted;
+  const double anchor2 = options_.anchor_weight * options_.anchor_weight;
+  const double node2 = options_.joint_node_weight * options_.joint_node_weight;
+  for (int a : anchors_) normal.coeffRef(a, a) += anchor2;
+  for (int c = 0; c < num_nodes_; ++c) normal.coeffRef(n + c, n + c) += node2;
+  normal.makeCompressed();
+  DEFORM_ASSIGN_OR_RETURN(result->factor_, CholeskyFactor::Factorize(symbolic_, normal));
+  result->factor_seconds_ = SecondsSince(start);
+  return std::shared_ptr<const MaterialFactorization>(std::move(result));
+}
+
+DeformScratch DeformationModel::MakeScratch() const {
+  DeformScratch scratch;
+  scratch.num_vertices = mesh_.num_vertices();
+  scratch.bone_transforms.resize(skeleton_.num_bones());
+  scratch.solution.resize(mesh_.num_vertices() + num_nodes_, 3);
+  scratch.rotated_deltas.resize(mesh_.num_vertices(), 3);
+  scratch.solve_work.resize(3 * static_cast<size_t>(mesh_.num_vertices() + num_nodes_));
+  return scratch;
+}
+
+void DeformationModel::Deform(const MaterialFactorization& factorization, const Pose& pose,
+                              DeformScratch* scratch, DeformTimings* timings) const {
+  const auto start = Clock::now();
+  const int n = mesh_.num_vertices();
+  ForwardKinematics(skeleton_, pose, &scratch->bone_transforms);
+  const auto& bones = scratch->bone_transforms;
+
+  // Rotated, weighted differential coordinates r_i = w_i^2 T_i delta_i, T_i the QLERP blend.
+  const auto& bw = bone_weights_;
+  const auto& w2 = factorization.row_weights_squared_;
+  auto& r = scratch->rotated_deltas;
+  for (int i = 0; i < n; ++i) {
+    const int begin = bw.offsets[i], end = bw.offsets[i + 1];
+    Eigen::Quaterniond q = bones[bw.bones[begin]].rotation;
+    if (end - begin > 1) {
+      const Eigen::Quaterniond first = q;
+      q.coeffs() *= bw.weights[begin];
+      for (int p = begin + 1; p < end; ++p) {
+        const Eigen::Quaterniond& qk = bones[bw.bones[p]].rotation;
+        const double sign = first.dot(qk) < 0 ? -1.0 : 1.0;
+        q.coeffs() += (sign * bw.weights[p]) * qk.coeffs();
+      }
+      q.normalize();
+    }
+    r.row(i) = w2[i] * (q * rest_deltas_.row(i).transpose()).transpose();
+  }
+
+  // A^T b = L'^T r + anchor_weight^2 c + node_weight^2 o.
+  auto& rhs = scratch->solution;
+  for (int row = 0; row < laplacian_transpose_.outerSize(); ++row) {
+    double s0 = 0, s1 = 0, s2 = 0;
+    for (int p = laplacian_transpose_.outerIndexPtr()[row];
+         p < laplacian_transpose_.outerIndexPtr()[row + 1]; ++p) {
+      const int i = laplacian_transpose_.innerIndexPtr()[p];
+      const double v = laplacian_transpose_.valuePtr()[p];
+      s0 += v * r(i, 0);
+      s1 += v * r(i, 1);
+      s2 += v * r(i, 2);
+    }
+    rhs(row, 0) = s0;
+    rhs(row, 1) = s1;
+    rhs(row, 2) = s2;
+  }
+  const double anchor2 = options_.anchor_weight * options_.anchor_weight;
+  for (size_t a = 0; a < anchors_.size(); ++a) {
+    const Eigen::Vector3d target = bones[anchor_bone_[a]].Apply(anchor_rest_.row(a).transpose());
+    rhs.row(anchors_[a]) += anchor2 * target.transpose();
+  }
+  const double node2 = options_.joint_node_weight * options_.joint_node_weight;
+  for (int c = 0; c < num_nodes_; ++c) {
+    const Eigen::Vector3d centre = PosedJointPosition(skeleton_, pose, bones, node_joint_[c]);
+    rhs.row(n + c) += node2 * centre.transpose();
+  }
+  const auto solve_start = Clock::now();
+
+  factorization.factor().Solve3(rhs.data(), scratch->solution.data(), scratch->solve_work.data());
+  if (timings != nullptr) {
+    timings->right_hand_side = std::chrono::duration<double>(solve_start - start).count();
+    timings->solve = SecondsSince(solve_start);
+  }
+}
+
+}  // namespace deform

@@ -1,0 +1,34 @@
+// Reading and writing triangle meshes through OpenMesh.
+//
+// Supported: OBJ, PLY (ASCII and binary), STL (ASCII and binary; duplicate vertices welded),
+// OFF. Polygons are fan-triangulated. Every mesh read is validated with ValidateMesh() before it
+// is returned, so a returned mesh is always usable. No input crashes the reader: unreadable,
+// truncated or malformed content yields INVALID_ARGUMENT naming the problem.
+#pragma once
+
+#include <string>
+#include <string_view>
+
+#include "core/mesh.h"
+#include "core/status.h"
+
+namespace deform {
+
+enum class MeshFormat { kObj, kPly, kStl, kOff };
+
+// "obj" / "ply" / "stl" / "off" (case-insensitive, with or without a leading dot).
+StatusOr<MeshFormat> MeshFormatFromName(std::string_view name);
+// From a file name's extension.
+StatusOr<MeshFormat> MeshFormatFromPath(std::string_view path);
+const char* MeshFormatName(MeshFormat format);
+
+// Parses a whole mesh file held in memory (e.g. received over the network).
+StatusOr<TriangleMesh> ReadMesh(std::string_view bytes, MeshFormat format,
+                                const MeshLimits& limits = {});
+// Reads a file; the format comes from the extension. NOT_FOUND if the file cannot be opened.
+StatusOr<TriangleMesh> ReadMeshFile(const std::string& path, const MeshLimits& limits = {});
+
+// Writes a mesh; the format comes from the extension (.obj .ply .off .stl; PLY and STL binary).
+Status WriteMeshFile(const TriangleMesh& mesh, const std::string& path);
+
+}  // namespace deform

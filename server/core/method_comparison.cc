@@ -1,0 +1,105 @@
+#include "core/method_comparison.h"
+
+#include <algorithm>
+#include <chrono>
+#include <string>
+#include <vector>
+
+#include "core/skinning.h"
+
+namespace deform {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double Median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  return values[values.size() / 2];
+}
+
+}  // namespace
+
+StatusOr<Method> MethodFromName(std::string_view name) {
+  if (name == "paper") return Method::kPaper;
+  if (name == "laplacian") return Method::kLaplacian;
+  if (name == "lbs") return Method::kLbs;
+  if (name == "dqs") return Method::kDqs;
+  return Status::InvalidArgument("unknown method '" + std::string(name) +
+                                 "' (known: paper, laplacian, lbs, dqs)");
+}
+
+const char* MethodName(Method method) {
+  switch (method) {
+    case Method::kPaper: return "paper";
+    case Method::kLaplacian: return "laplacian";
+    case Method::kLbs: return "lbs";
+    case Method::kDqs: return "dqs";
+  }
+  return "unknown";
+}
+
+StatusOr<MethodRun> RunMethod(const TriangleMesh& mesh, const Skeleton& skeleton, Method method,
+                              const Pose& pose, int repeat, const ModelOptions& paper_options) {
+  DEFORM_ASSIGN_OR_RETURN(auto model, DeformationModel::Build(mesh, skeleton, paper_options));
+  return RunMethod(*model, method, pose, repeat);
+}
+
+StatusOr<MethodRun> RunMethod(const DeformationModel& paper_model, Method method, const Pose& pose,
+                              int repeat) {
+  repeat = std::max(1, repeat);
+  MethodRun run;
+  run.precompute_seconds = paper_model.precompute_seconds();
+  std::vector<double> frame_seconds;
+  frame_seconds.reserve(repeat);
+
+  if (method == Method::kPaper || method == Method::kLaplacian) {
+    std::shared_ptr<const DeformationModel> plain;
+    const DeformationModel* model = &paper_model;
+    if (method == Method::kLaplacian) {
+      ModelOptions options = ModelOptions::PlainLaplacian();
+      options.regions = paper_model.options().regions;
+      options.anchor_weight = paper_model.options().anchor_weight;
+      options.anchor_distance_factor = paper_model.options().anchor_distance_factor;
+      options.ordering = paper_model.options().ordering;
+      options.limits = paper_model.options().limits;
+      DEFORM_ASSIGN_OR_RETURN(plain,
+                              DeformationModel::Build(paper_model.mesh(), paper_model.skeleton(), options));
+      model = plain.get();
+      run.precompute_seconds = model->precompute_seconds();
+    }
+    const auto& factorization = *model->default_factorization();
+    run.factor_seconds = factorization.factor_seconds();
+    run.factor_bytes = factorization.factor().bytes();
+    run.joint_nodes = model->num_joint_nodes();
+    run.anchors = static_cast<int>(model->anchor_vertices().size());
+    DeformScratch scratch = model->MakeScratch();
+    for (int r = 0; r < repeat; ++r) {
+      const auto start = Clock::now();
+      model->Deform(factorization, pose, &scratch);
+      frame_seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
+    }
+    run.posed = scratch.positions();
+  } else {
+    std::vector<RigidTransform> bones;
+    for (int r = 0; r < repeat; ++r) {
+      const auto start = Clock::now();
+      ForwardKinematics(paper_model.skeleton(), pose, &bones);
+      if (method == Method::kLbs) {
+        LinearBlendSkinning(paper_model.mesh().vertices, paper_model.bone_weights(), bones, &run.posed);
+      } else {
+        DualQuaternionSkinning(paper_model.mesh().vertices, paper_model.bone_weights(), bones,
+                               &run.posed);
+      }
+      frame_seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
+    }
+  }
+  run.solve_seconds = Median(frame_seconds);
+
+  std::vector<RigidTransform> bones;
+  ForwardKinematics(paper_model.skeleton(), pose, &bones);
+  run.quality = MeasureQuality(paper_model.mesh(), run.posed, paper_model.skeleton(), bones,
+                               paper_model.anchor_vertices(), paper_model.anchor_bones());
+  return run;
+}
+
+}  // namespace deform
