@@ -173,12 +173,20 @@ StatusOr<std::shared_ptr<const MaterialFactorization>> DeformationModel::Factori
   }
   result->row_weights_squared_ = result->row_weights_.array().square();
 
-  // A^T A = L'^T W^2 L' + anchor_weight^2 sum e_a e_a^T + node_weight^2 sum e_c e_c^T.
-  const auto& w2 = result->row_weights_squared_;
+  const ColMajorMatrix normal = BuildNormalMatrix(result->row_weights_squared_);
+  DEFORM_ASSIGN_OR_RETURN(result->factor_, CholeskyFactor::Factorize(symbolic_, normal));
+  result->factor_seconds_ = SecondsSince(start);
+  return std::shared_ptr<const MaterialFactorization>(std::move(result));
+}
+
+// A^T A = L'^T W^2 L' + anchor_weight^2 sum e_a e_a^T + node_weight^2 sum e_c e_c^T.
+Eigen::SparseMatrix<double> DeformationModel::BuildNormalMatrix(
+    const Eigen::VectorXd& row_weights_squared) const {
+  const int n = mesh_.num_vertices();
   Eigen::SparseMatrix<double, Eigen::RowMajor, int> weighted = laplacian_;
   for (int i = 0; i < n; ++i) {
     for (Eigen::SparseMatrix<double, Eigen::RowMajor, int>::InnerIterator it(weighted, i); it; ++it) {
-      it.valueRef() *= w2[i];
+      it.valueRef() *= row_weights_squared[i];
     }
   }
   ColMajorMatrix normal = laplacian_transpose_ * weighted;
@@ -187,9 +195,12 @@ StatusOr<std::shared_ptr<const MaterialFactorization>> DeformationModel::Factori
   for (int a : anchors_) normal.coeffRef(a, a) += anchor2;
   for (int c = 0; c < num_nodes_; ++c) normal.coeffRef(n + c, n + c) += node2;
   normal.makeCompressed();
-  DEFORM_ASSIGN_OR_RETURN(result->factor_, CholeskyFactor::Factorize(symbolic_, normal));
-  result->factor_seconds_ = SecondsSince(start);
-  return std::shared_ptr<const MaterialFactorization>(std::move(result));
+  return normal;
+}
+
+Eigen::SparseMatrix<double> DeformationModel::NormalMatrix(
+    const MaterialFactorization& factorization) const {
+  return BuildNormalMatrix(factorization.row_weights_squared_);
 }
 
 DeformScratch DeformationModel::MakeScratch() const {
@@ -198,13 +209,24 @@ DeformScratch DeformationModel::MakeScratch() const {
   scratch.bone_transforms.resize(skeleton_.num_bones());
   scratch.solution.resize(mesh_.num_vertices() + num_nodes_, 3);
   scratch.rotated_deltas.resize(mesh_.num_vertices(), 3);
-  scratch.solve_work.resize(3 * static_cast<size_t>(mesh_.num_vertices() + num_nodes_));
+  scratch.solve_work.resize(default_factorization_->factor().WorkSize());
   return scratch;
 }
 
 void DeformationModel::Deform(const MaterialFactorization& factorization, const Pose& pose,
                               DeformScratch* scratch, DeformTimings* timings) const {
   const auto start = Clock::now();
+  AssembleRightHandSide(factorization, pose, scratch);
+  const auto solve_start = Clock::now();
+  SolveInPlace(factorization, scratch);
+  if (timings != nullptr) {
+    timings->right_hand_side = std::chrono::duration<double>(solve_start - start).count();
+    timings->solve = SecondsSince(solve_start);
+  }
+}
+
+void DeformationModel::AssembleRightHandSide(const MaterialFactorization& factorization,
+                                             const Pose& pose, DeformScratch* scratch) const {
   const int n = mesh_.num_vertices();
   ForwardKinematics(skeleton_, pose, &scratch->bone_transforms);
   const auto& bones = scratch->bone_transforms;
@@ -255,13 +277,12 @@ void DeformationModel::Deform(const MaterialFactorization& factorization, const 
     const Eigen::Vector3d centre = PosedJointPosition(skeleton_, pose, bones, node_joint_[c]);
     rhs.row(n + c) += node2 * centre.transpose();
   }
-  const auto solve_start = Clock::now();
+}
 
-  factorization.factor().Solve3(rhs.data(), scratch->solution.data(), scratch->solve_work.data());
-  if (timings != nullptr) {
-    timings->right_hand_side = std::chrono::duration<double>(solve_start - start).count();
-    timings->solve = SecondsSince(solve_start);
-  }
+void DeformationModel::SolveInPlace(const MaterialFactorization& factorization,
+                                    DeformScratch* scratch) const {
+  factorization.factor().Solve3(scratch->solution.data(), scratch->solution.data(),
+                                scratch->solve_work.data());
 }
 
 }  // namespace deform

@@ -90,7 +90,7 @@ struct DeformScratch {
   std::vector<RigidTransform> bone_transforms;  // K
   Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> solution;  // (n + m) by 3
   Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> rotated_deltas;  // n by 3
-  std::vector<double> solve_work;  // 3 (n + m)
+  std::vector<double> solve_work;  // CholeskyFactor::WorkSize()
 
   // The deformed vertex positions of the last Deform() (n by 3, a view into `solution`).
   auto positions() const { return solution.topRows(num_vertices); }
@@ -123,6 +123,14 @@ class DeformationModel {
   void Deform(const MaterialFactorization& factorization, const Pose& pose, DeformScratch* scratch,
               DeformTimings* timings = nullptr) const;
 
+  // The two halves of Deform(), for tests and diagnostics. AssembleRightHandSide writes A^T b
+  // ((n + m) by 3) into scratch->solution; SolveInPlace replaces it by the solution.
+  void AssembleRightHandSide(const MaterialFactorization& factorization, const Pose& pose,
+                             DeformScratch* scratch) const;
+  void SolveInPlace(const MaterialFactorization& factorization, DeformScratch* scratch) const;
+  // The normal matrix A^T A ((n + m) square) that `factorization` factorises.
+  Eigen::SparseMatrix<double> NormalMatrix(const MaterialFactorization& factorization) const;
+
   const TriangleMesh& mesh() const { return mesh_; }
   const Skeleton& skeleton() const { return skeleton_; }
   const ModelOptions& options() const { return options_; }
@@ -140,6 +148,7 @@ class DeformationModel {
   DeformationModel() = default;
   Status Precompute();
   StatusOr<std::shared_ptr<const MaterialFactorization>> FactorizeImpl(const Stiffness& stiffness) const;
+  Eigen::SparseMatrix<double> BuildNormalMatrix(const Eigen::VectorXd& row_weights_squared) const;
 
   TriangleMesh mesh_;
   Skeleton skeleton_;

@@ -34,6 +34,7 @@ struct MeshLimits {
 // than two triangles (non-manifold), vertices no triangle uses, and sizes beyond `limits`.
 // Returns INVALID_ARGUMENT (or RESOURCE_EXHAUSTED for limits) with a message that names the
 // offending vertex or triangle index.
+// Zero area means area <= 1e-14 * diagonal^2. Open (boundary) meshes are valid. O(V + F).
 Status ValidateMesh(const TriangleMesh& mesh, const MeshLimits& limits = {});
 
 // Axis-aligned bounding-box diagonal length; 0 for an empty mesh.

@@ -29,6 +29,10 @@ StatusOr<TriangleMesh> ReadMesh(std::string_view bytes, MeshFormat format,
 StatusOr<TriangleMesh> ReadMeshFile(const std::string& path, const MeshLimits& limits = {});
 
 // Writes a mesh; the format comes from the extension (.obj .ply .off .stl; PLY and STL binary).
+// Written directly rather than through OpenMesh's halfedge writers, so any triangle soup can be
+// written; text formats keep doubles exactly, PLY stores doubles, STL floats (and loses unused
+// vertices). INVALID_ARGUMENT for out-of-range indices or non-finite coordinates, NOT_FOUND if the
+// folder does not exist.
 Status WriteMeshFile(const TriangleMesh& mesh, const std::string& path);
 
 }  // namespace deform

@@ -98,18 +98,18 @@ StatusOr<KneePhantom> MakeKneePhantom(int target_vertices) {
   mesh.triangles.resize(2 * segments * rings, 3);
   int f = 0;
   for (int s = 0; s < segments; ++s) {
-    mesh.triangles.row(f++) << 0, ring_vertex(0, s + 1), ring_vertex(0, s);
+    mesh.triangles.row(f++) << 0, ring_vertex(0, s), ring_vertex(0, s + 1);
   }
   for (int ring = 0; ring + 1 < rings; ++ring) {
     for (int s = 0; s < segments; ++s) {
       const int a = ring_vertex(ring, s), b = ring_vertex(ring, s + 1);
       const int c = ring_vertex(ring + 1, s), d = ring_vertex(ring + 1, s + 1);
-      mesh.triangles.row(f++) << a, b, d;
-      mesh.triangles.row(f++) << a, d, c;
+      mesh.triangles.row(f++) << a, d, b;
+      mesh.triangles.row(f++) << a, c, d;
     }
   }
   for (int s = 0; s < segments; ++s) {
-    mesh.triangles.row(f++) << bottom_pole, ring_vertex(rings - 1, s), ring_vertex(rings - 1, s + 1);
+    mesh.triangles.row(f++) << bottom_pole, ring_vertex(rings - 1, s + 1), ring_vertex(rings - 1, s);
   }
   mesh.triangles.conservativeResize(f, 3);
   DEFORM_ASSIGN_OR_RETURN(phantom.skeleton, PhantomSkeleton());

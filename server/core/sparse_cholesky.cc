@@ -3,9 +3,20 @@
 #include <metis.h>
 
 #include <Eigen/OrderingMethods>
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
+#include <type_traits>
 #include <string>
+
+// The solve kernels are compiled twice, for AVX2+FMA and for the baseline, and picked at load
+// time by the CPU (GCC's target_clones), so one binary runs everywhere and fast where it can.
+#if defined(__GNUC__) && defined(__x86_64__) && !defined(__clang__)
+#define DEFORM_SOLVE_KERNEL __attribute__((target_clones("arch=haswell", "default")))
+#else
+#define DEFORM_SOLVE_KERNEL
+#endif
 
 namespace deform {
 namespace {
@@ -98,6 +109,8 @@ StatusOr<std::shared_ptr<const SymbolicCholesky>> SymbolicCholesky::Analyze(cons
 
   // Pattern of C = P A P^T (upper part) and the map from A's entries to C's.
   s->a_nonzeros_ = a.nonZeros();
+  s->a_column_pointers_.assign(a.outerIndexPtr(), a.outerIndexPtr() + n + 1);
+  s->a_row_indices_.assign(a.innerIndexPtr(), a.innerIndexPtr() + a.nonZeros());
   std::vector<int> counts(n + 1, 0);
   std::vector<bool> has_diagonal(n, false);
   for (int j = 0; j < n; ++j) {
@@ -173,6 +186,22 @@ StatusOr<std::shared_ptr<const SymbolicCholesky>> SymbolicCholesky::Analyze(cons
   }
   s->column_pointers_.assign(n + 1, 0);
   std::partial_sum(column_counts.begin(), column_counts.end(), s->column_pointers_.begin() + 1);
+  // Supernodes: column j joins j - 1's supernode when j is j - 1's parent and its pattern is
+  // j - 1's minus j - 1 (equal counts minus one imply equal patterns below).
+  constexpr int kMaxSupernodeWidth = 128;
+  s->supernode_columns_.assign(1, 0);
+  for (int j = 1; j < n; ++j) {
+    const bool continues = s->elimination_tree_[j - 1] == j &&
+                           column_counts[j] == column_counts[j - 1] - 1 &&
+                           j - s->supernode_columns_.back() < kMaxSupernodeWidth;
+    if (!continues) s->supernode_columns_.push_back(j);
+  }
+  s->supernode_columns_.push_back(n);
+  s->max_supernode_width_ = 1;
+  for (size_t k = 0; k + 1 < s->supernode_columns_.size(); ++k) {
+    s->max_supernode_width_ = std::max(s->max_supernode_width_,
+                                       s->supernode_columns_[k + 1] - s->supernode_columns_[k]);
+  }
   if (s->column_pointers_[n] > std::numeric_limits<int>::max()) {
     return Status::ResourceExhausted("Cholesky factor would have " +
                                      std::to_string(s->column_pointers_[n]) + " non-zeros");
@@ -184,7 +213,9 @@ StatusOr<CholeskyFactor> CholeskyFactor::Factorize(std::shared_ptr<const Symboli
                                                    const ColMajorMatrix& a) {
   const SymbolicCholesky& s = *symbolic;
   const int n = s.n_;
-  if (a.rows() != n || a.cols() != n || a.nonZeros() != s.a_nonzeros_ || !a.isCompressed()) {
+  if (a.rows() != n || a.cols() != n || a.nonZeros() != s.a_nonzeros_ || !a.isCompressed() ||
+      !std::equal(s.a_column_pointers_.begin(), s.a_column_pointers_.end(), a.outerIndexPtr()) ||
+      !std::equal(s.a_row_indices_.begin(), s.a_row_indices_.end(), a.innerIndexPtr())) {
     return Status::InvalidArgument("matrix pattern differs from the analysed one");
   }
   // Values of C's upper triangle.
@@ -193,10 +224,9 @@ StatusOr<CholeskyFactor> CholeskyFactor::Factorize(std::shared_ptr<const Symboli
     if (s.a_to_c_[p] >= 0) c_values[s.a_to_c_[p]] = a.valuePtr()[p];
   }
 
-  CholeskyFactor f;
-  f.symbolic_ = std::move(symbolic);
-  f.row_indices_.assign(s.column_pointers_[n], 0);
-  f.values_.assign(s.column_pointers_[n], 0.0);
+  // Column-compressed L first (the diagonal first in each column, rows ascending).
+  std::vector<int> l_rows(s.column_pointers_[n], 0);
+  std::vector<double> l_values(s.column_pointers_[n], 0.0);
   std::vector<std::int64_t> next(s.column_pointers_.begin(), s.column_pointers_.end() - 1);
   std::vector<double> x(n, 0.0);
   std::vector<int> stack(n), mark(n, -1);
@@ -213,35 +243,133 @@ StatusOr<CholeskyFactor> CholeskyFactor::Factorize(std::shared_ptr<const Symboli
     x[k] = 0;
     for (int t = top; t < n; ++t) {
       const int i = stack[t];
-      const double lki = x[i] / f.values_[s.column_pointers_[i]];
+      const double lki = x[i] / l_values[s.column_pointers_[i]];
       x[i] = 0;
       for (std::int64_t p = s.column_pointers_[i] + 1; p < next[i]; ++p) {
-        x[f.row_indices_[p]] -= f.values_[p] * lki;
+        x[l_rows[p]] -= l_values[p] * lki;
       }
       d -= lki * lki;
       const std::int64_t q = next[i]++;
-      f.row_indices_[q] = k;
-      f.values_[q] = lki;
+      l_rows[q] = k;
+      l_values[q] = lki;
     }
     if (!(d > 0) || !std::isfinite(d)) {
       return Status::Internal("matrix is not positive definite (pivot " + std::to_string(k) +
                               " is " + std::to_string(d) + ")");
     }
     const std::int64_t q = next[k]++;
-    f.row_indices_[q] = k;
-    f.values_[q] = std::sqrt(d);
+    l_rows[q] = k;
+    l_values[q] = std::sqrt(d);
   }
+
+  // Pack into supernodal blocks.
+  CholeskyFactor f;
+  const int num_supernodes = static_cast<int>(s.supernode_columns_.size()) - 1;
+  f.row_pointers_.assign(num_supernodes + 1, 0);
+  f.value_pointers_.assign(num_supernodes + 1, 0);
+  for (int sn = 0; sn < num_supernodes; ++sn) {
+    const int first = s.supernode_columns_[sn];
+    const int width = s.supernode_columns_[sn + 1] - first;
+    const std::int64_t rows = s.column_pointers_[first + 1] - s.column_pointers_[first];
+    f.row_pointers_[sn + 1] = f.row_pointers_[sn] + rows;
+    f.value_pointers_[sn + 1] = f.value_pointers_[sn] + rows * width;
+  }
+  f.row_indices_.resize(f.row_pointers_.back());
+  f.values_.assign(f.value_pointers_.back(), 0.0);
+  for (int sn = 0; sn < num_supernodes; ++sn) {
+    const int first = s.supernode_columns_[sn];
+    const int width = s.supernode_columns_[sn + 1] - first;
+    const std::int64_t rows = f.row_pointers_[sn + 1] - f.row_pointers_[sn];
+    std::copy(l_rows.begin() + s.column_pointers_[first],
+              l_rows.begin() + s.column_pointers_[first + 1],
+              f.row_indices_.begin() + f.row_pointers_[sn]);
+    double* block = f.values_.data() + f.value_pointers_[sn];
+    for (int c = 0; c < width; ++c) {
+      // Column first + c holds the block's rows c.. (its pattern is the supernode's minus c rows).
+      const std::int64_t begin = s.column_pointers_[first + c];
+      for (std::int64_t k = c; k < rows; ++k) block[k * width + c] = l_values[begin + (k - c)];
+    }
+  }
+  f.symbolic_ = std::move(symbolic);
   return f;
 }
+
+std::size_t CholeskyFactor::WorkSize() const {
+  return symbolic_ ? 3 * static_cast<std::size_t>(symbolic_->n_ + symbolic_->max_supernode_width_)
+                   : 0;
+}
+
+namespace {
+
+// The supernode kernels. A supernode's own unknowns are kept planar (all x, then y, then z) in a
+// small buffer while its block is applied, so every inner loop is a contiguous dot product or
+// axpy over the block's row; kWidth > 0 fixes the width at compile time (the common narrow
+// supernodes), 0 reads it at run time.
+template <int kWidth>
+DEFORM_SOLVE_KERNEL void ForwardUpdate(const double* __restrict block, const int* __restrict rows,
+                                       std::int64_t first_row, std::int64_t num_rows,
+                                       int dynamic_width, const double* __restrict planar,
+                                       double* __restrict y) {
+  const int width = kWidth > 0 ? kWidth : dynamic_width;
+  const double* px = planar;
+  const double* py = planar + width;
+  const double* pz = planar + 2 * width;
+  for (std::int64_t r = first_row; r < num_rows; ++r) {
+    const double* row = block + r * width;
+    double s0 = 0, s1 = 0, s2 = 0;
+    for (int k = 0; k < width; ++k) {
+      s0 += row[k] * px[k];
+      s1 += row[k] * py[k];
+      s2 += row[k] * pz[k];
+    }
+    double* target = y + 3 * static_cast<std::ptrdiff_t>(rows[r]);
+    target[0] -= s0;
+    target[1] -= s1;
+    target[2] -= s2;
+  }
+}
+
+template <int kWidth>
+DEFORM_SOLVE_KERNEL void BackwardUpdate(const double* __restrict block,
+                                        const int* __restrict rows, std::int64_t first_row,
+                                        std::int64_t num_rows, int dynamic_width,
+                                        double* __restrict planar, const double* __restrict y) {
+  const int width = kWidth > 0 ? kWidth : dynamic_width;
+  double* px = planar;
+  double* py = planar + width;
+  double* pz = planar + 2 * width;
+  for (std::int64_t r = first_row; r < num_rows; ++r) {
+    const double* row = block + r * width;
+    const double* source = y + 3 * static_cast<std::ptrdiff_t>(rows[r]);
+    const double z0 = source[0], z1 = source[1], z2 = source[2];
+    for (int k = 0; k < width; ++k) {
+      px[k] -= row[k] * z0;
+      py[k] -= row[k] * z1;
+      pz[k] -= row[k] * z2;
+    }
+  }
+}
+
+template <typename Kernel>
+void DispatchByWidth(int width, Kernel&& kernel) {
+  switch (width) {
+    case 1: kernel(std::integral_constant<int, 1>()); break;
+    case 2: kernel(std::integral_constant<int, 2>()); break;
+    case 3: kernel(std::integral_constant<int, 3>()); break;
+    case 4: kernel(std::integral_constant<int, 4>()); break;
+    default: kernel(std::integral_constant<int, 0>()); break;
+  }
+}
+
+}  // namespace
 
 void CholeskyFactor::Solve3(const double* b, double* x, double* work) const {
   const SymbolicCholesky& s = *symbolic_;
   const int n = s.n_;
+  const int num_supernodes = static_cast<int>(s.supernode_columns_.size()) - 1;
   const int* perm = s.permutation_.data();
-  const std::int64_t* cp = s.column_pointers_.data();
-  const int* ri = row_indices_.data();
-  const double* lx = values_.data();
-  double* y = work;
+  double* __restrict y = work;
+  double* __restrict planar = work + 3 * static_cast<std::ptrdiff_t>(n);  // 3 * widest supernode
 
   for (int i = 0; i < n; ++i) {
     const double* src = b + 3 * static_cast<std::ptrdiff_t>(perm[i]);
@@ -249,38 +377,64 @@ void CholeskyFactor::Solve3(const double* b, double* x, double* work) const {
     y[3 * i + 1] = src[1];
     y[3 * i + 2] = src[2];
   }
-  // L y = P b, one pass over L.
-  for (int j = 0; j < n; ++j) {
-    const double inv_diagonal = 1.0 / lx[cp[j]];
-    const double y0 = y[3 * j] * inv_diagonal;
-    const double y1 = y[3 * j + 1] * inv_diagonal;
-    const double y2 = y[3 * j + 2] * inv_diagonal;
-    y[3 * j] = y0;
-    y[3 * j + 1] = y1;
-    y[3 * j + 2] = y2;
-    for (std::int64_t p = cp[j] + 1; p < cp[j + 1]; ++p) {
-      double* yi = y + 3 * static_cast<std::ptrdiff_t>(ri[p]);
-      const double v = lx[p];
-      yi[0] -= v * y0;
-      yi[1] -= v * y1;
-      yi[2] -= v * y2;
+
+  // L y = P b, one pass over the factor.
+  for (int sn = 0; sn < num_supernodes; ++sn) {
+    const int first = s.supernode_columns_[sn];
+    const int width = s.supernode_columns_[sn + 1] - first;
+    const int* rows = row_indices_.data() + row_pointers_[sn];
+    const std::int64_t num_rows = row_pointers_[sn + 1] - row_pointers_[sn];
+    const double* block = values_.data() + value_pointers_[sn];
+    double* ys = y + 3 * static_cast<std::ptrdiff_t>(first);  // the supernode's own unknowns
+    for (int c = 0; c < width; ++c) {  // dense forward substitution on the diagonal block
+      const double* row = block + c * width;
+      double s0 = ys[3 * c], s1 = ys[3 * c + 1], s2 = ys[3 * c + 2];
+      for (int k = 0; k < c; ++k) {
+        s0 -= row[k] * planar[k];
+        s1 -= row[k] * planar[width + k];
+        s2 -= row[k] * planar[2 * width + k];
+      }
+      const double inv = 1.0 / row[c];
+      planar[c] = ys[3 * c] = s0 * inv;
+      planar[width + c] = ys[3 * c + 1] = s1 * inv;
+      planar[2 * width + c] = ys[3 * c + 2] = s2 * inv;
+    }
+    DispatchByWidth(width, [&](auto w) {
+      ForwardUpdate<decltype(w)::value>(block, rows, width, num_rows, width, planar, y);
+    });
+  }
+
+  // L^T z = y, one pass over the factor backwards.
+  for (int sn = num_supernodes - 1; sn >= 0; --sn) {
+    const int first = s.supernode_columns_[sn];
+    const int width = s.supernode_columns_[sn + 1] - first;
+    const int* rows = row_indices_.data() + row_pointers_[sn];
+    const std::int64_t num_rows = row_pointers_[sn + 1] - row_pointers_[sn];
+    const double* block = values_.data() + value_pointers_[sn];
+    double* ys = y + 3 * static_cast<std::ptrdiff_t>(first);
+    for (int k = 0; k < width; ++k) {
+      planar[k] = ys[3 * k];
+      planar[width + k] = ys[3 * k + 1];
+      planar[2 * width + k] = ys[3 * k + 2];
+    }
+    DispatchByWidth(width, [&](auto w) {
+      BackwardUpdate<decltype(w)::value>(block, rows, width, num_rows, width, planar, y);
+    });
+    for (int c = width - 1; c >= 0; --c) {  // dense back substitution on the diagonal block
+      double s0 = planar[c], s1 = planar[width + c], s2 = planar[2 * width + c];
+      for (int k = c + 1; k < width; ++k) {
+        const double v = block[k * width + c];
+        s0 -= v * planar[k];
+        s1 -= v * planar[width + k];
+        s2 -= v * planar[2 * width + k];
+      }
+      const double inv = 1.0 / block[c * width + c];
+      planar[c] = ys[3 * c] = s0 * inv;
+      planar[width + c] = ys[3 * c + 1] = s1 * inv;
+      planar[2 * width + c] = ys[3 * c + 2] = s2 * inv;
     }
   }
-  // L^T z = y, one pass over L backwards.
-  for (int j = n - 1; j >= 0; --j) {
-    double s0 = y[3 * j], s1 = y[3 * j + 1], s2 = y[3 * j + 2];
-    for (std::int64_t p = cp[j] + 1; p < cp[j + 1]; ++p) {
-      const double* yi = y + 3 * static_cast<std::ptrdiff_t>(ri[p]);
-      const double v = lx[p];
-      s0 -= v * yi[0];
-      s1 -= v * yi[1];
-      s2 -= v * yi[2];
-    }
-    const double inv_diagonal = 1.0 / lx[cp[j]];
-    y[3 * j] = s0 * inv_diagonal;
-    y[3 * j + 1] = s1 * inv_diagonal;
-    y[3 * j + 2] = s2 * inv_diagonal;
-  }
+
   for (int i = 0; i < n; ++i) {
     double* dst = x + 3 * static_cast<std::ptrdiff_t>(perm[i]);
     dst[0] = y[3 * i];
@@ -292,7 +446,8 @@ void CholeskyFactor::Solve3(const double* b, double* x, double* work) const {
 std::size_t CholeskyFactor::bytes() const {
   if (!symbolic_) return 0;
   return values_.size() * sizeof(double) + row_indices_.size() * sizeof(int) +
-         symbolic_->column_pointers_.size() * sizeof(std::int64_t);
+         (row_pointers_.size() + value_pointers_.size()) * sizeof(std::int64_t) +
+         symbolic_->supernode_columns_.size() * sizeof(int);
 }
 
 }  // namespace deform

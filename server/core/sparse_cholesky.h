@@ -6,8 +6,10 @@
 // called once per mesh and again after each stiffness change.
 //
 // The solve is written for the deformation's three right-hand sides (x, y, z): they are stored
-// interleaved and solved together, so each triangular pass reads the factor exactly once. This is
-// what makes the per-frame solve memory-bound rather than three times that.
+// interleaved and solved together, so each triangular pass reads the factor exactly once. The
+// factor is stored by supernodes (runs of columns sharing one row pattern, kept as dense row-major
+// blocks with one row index per block row), so a pass reads 8 bytes per stored value plus little
+// else, and its inner loops are dense. This makes the per-frame solve memory-bound.
 #pragma once
 
 #include <Eigen/SparseCore>
@@ -50,8 +52,13 @@ class SymbolicCholesky {
   std::vector<int> c_row_indices_;
   std::vector<int> a_to_c_;               // A's value index -> C's value index, or -1 (lower part)
   std::int64_t a_nonzeros_ = 0;
+  std::vector<int> a_column_pointers_;    // A's pattern, to check later matrices against
+  std::vector<int> a_row_indices_;
   std::vector<int> elimination_tree_;     // parent of each column of L, -1 for a root
   std::vector<std::int64_t> column_pointers_;  // of L, n + 1
+  // Supernodes: supernode s holds columns [supernode_columns_[s], supernode_columns_[s + 1]).
+  std::vector<int> supernode_columns_;
+  int max_supernode_width_ = 1;
 };
 
 class CholeskyFactor {
@@ -65,15 +72,25 @@ class CholeskyFactor {
 
   int size() const { return symbolic_ ? symbolic_->size() : 0; }
   // Solves A X = B for three right-hand sides stored interleaved: b[3 i + c] is row i, column c.
-  // `x` may equal `b`. `work` holds 3 * size() doubles. Allocation-free; const and thread-safe.
+  // `x` may equal `b`. `work` holds WorkSize() doubles. Allocation-free; const and thread-safe.
   void Solve3(const double* b, double* x, double* work) const;
+  // Doubles of scratch Solve3 needs: 3 * size() plus room for the widest supernode. The same for
+  // every factor of one symbolic analysis.
+  std::size_t WorkSize() const;
   // Bytes one triangular pass reads: values, row indices and column pointers of L.
   std::size_t bytes() const;
-  std::int64_t nonzeros() const { return static_cast<std::int64_t>(values_.size()); }
+  // Non-zeros of L (the explicit zeros of the supernodes' diagonal blocks not counted).
+  std::int64_t nonzeros() const { return symbolic_ ? symbolic_->factor_nonzeros() : 0; }
+  int num_supernodes() const { return static_cast<int>(row_pointers_.size()) - 1; }
 
  private:
   std::shared_ptr<const SymbolicCholesky> symbolic_;
-  std::vector<int> row_indices_;  // per column: the diagonal first, then rows ascending
+  // Supernode s: its rows are row_indices_[row_pointers_[s] .. row_pointers_[s + 1]) (its own
+  // columns first, then the rows below, ascending); its values are a dense row-major block of
+  // (#rows) by (width) starting at values_[value_pointers_[s]], zero above the diagonal.
+  std::vector<std::int64_t> row_pointers_;
+  std::vector<std::int64_t> value_pointers_;
+  std::vector<int> row_indices_;
   std::vector<double> values_;
 };
 

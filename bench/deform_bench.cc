@@ -1,0 +1,215 @@
+// Per-frame solve, factorisation and precomputation of the deformation model on the shared meshes
+// (1.6k and 26k leg, 133k arm; skipped where ../shared/data is absent) and the built-in phantom.
+//
+// Every solve benchmark reports, besides Google Benchmark's mean time:
+//   median_ms      the median wall time of one frame (these machines are noisy; compare medians)
+//   factor_MB      bytes of the stored factor (values, row indices, column pointers)
+//   bound_ms       the memory-read bound: two passes over the factor at the DRAM read bandwidth
+//                  measured at start-up in the same run (a buffer far larger than the caches)
+//   x_bound        median_ms / bound_ms
+//   cache_bound_ms the same two passes at the bandwidth of a factor-sized buffer (cache-resident
+//                  where the factor fits the last-level cache), and x_cache_bound
+// The Eigen baseline solves the same normal equations with Eigen's SimplicialLLT, whose
+// multi-column solve walks the factor once per coordinate.
+#include <benchmark/benchmark.h>
+
+#include <Eigen/SparseCholesky>
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "bench/memory_bandwidth.h"
+#include "core/deformation_model.h"
+#include "core/model_input.h"
+#include "core/phantom.h"
+
+namespace deform::bench {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+struct BenchMesh {
+  std::string name;
+  std::string mesh_path;      // empty: the phantom
+  std::string skeleton_path;
+  std::string pose_spec;
+};
+
+double g_dram_bandwidth = 0;  // bytes per second, measured once in main()
+std::map<std::string, std::shared_ptr<const DeformationModel>> g_models;
+
+std::shared_ptr<const DeformationModel> ModelFor(const BenchMesh& mesh) {
+  auto it = g_models.find(mesh.name);
+  if (it != g_models.end()) return it->second;
+  auto input = LoadModelInput(mesh.mesh_path, mesh.skeleton_path, kDefaultPhantomVertices);
+  if (!input.ok()) return nullptr;
+  auto model = DeformationModel::Build(input->mesh, input->skeleton, ModelOptions::Paper());
+  if (!model.ok()) return nullptr;
+  return g_models[mesh.name] = *model;
+}
+
+Pose PoseFor(const DeformationModel& model, const BenchMesh& mesh) {
+  Pose pose;
+  auto terms = ParsePoseSpec(mesh.pose_spec, model.skeleton());
+  if (terms.ok()) (void)PoseFromTerms(model.skeleton(), *terms, &pose);
+  return pose;
+}
+
+double Median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0 : v[v.size() / 2];
+}
+
+void ReportAgainstBound(benchmark::State& state, std::size_t factor_bytes,
+                        const std::vector<double>& seconds) {
+  const double median_ms = Median(seconds) * 1e3;
+  const double bound_ms = 2.0 * factor_bytes / g_dram_bandwidth * 1e3;
+  const double cache_bound_ms = 2.0 * factor_bytes / MeasureReadBandwidth(factor_bytes, 3) * 1e3;
+  state.counters["median_ms"] = median_ms;
+  state.counters["factor_MB"] = factor_bytes / 1e6;
+  state.counters["bound_ms"] = bound_ms;
+  state.counters["x_bound"] = median_ms / bound_ms;
+  state.counters["cache_bound_ms"] = cache_bound_ms;
+  state.counters["x_cache_bound"] = median_ms / cache_bound_ms;
+}
+
+// A whole frame: kinematics, rotation blend, right-hand side and both triangular passes.
+void BM_Frame(benchmark::State& state, BenchMesh mesh) {
+  auto model = ModelFor(mesh);
+  if (!model) return state.SkipWithError("mesh could not be loaded");
+  const Pose pose = PoseFor(*model, mesh);
+  DeformScratch scratch = model->MakeScratch();
+  const auto& factorization = *model->default_factorization();
+  std::vector<double> seconds;
+  for (auto _ : state) {
+    const auto start = Clock::now();
+    model->Deform(factorization, pose, &scratch);
+    seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
+  }
+  ReportAgainstBound(state, factorization.factor().bytes(), seconds);
+  state.counters["vertices"] = model->mesh().num_vertices();
+}
+
+// The two triangular passes alone (what the memory-read bound limits).
+void BM_TriangularSolve(benchmark::State& state, BenchMesh mesh) {
+  auto model = ModelFor(mesh);
+  if (!model) return state.SkipWithError("mesh could not be loaded");
+  const Pose pose = PoseFor(*model, mesh);
+  DeformScratch scratch = model->MakeScratch();
+  const auto& factorization = *model->default_factorization();
+  model->AssembleRightHandSide(factorization, pose, &scratch);
+  const auto rhs = scratch.solution;
+  std::vector<double> seconds;
+  for (auto _ : state) {
+    const auto start = Clock::now();
+    factorization.factor().Solve3(rhs.data(), scratch.solution.data(), scratch.solve_work.data());
+    seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
+  }
+  ReportAgainstBound(state, factorization.factor().bytes(), seconds);
+}
+
+// Baseline: Eigen's SimplicialLLT (AMD ordering) on the same system, three columns at once.
+void BM_EigenBaselineSolve(benchmark::State& state, BenchMesh mesh) {
+  auto model = ModelFor(mesh);
+  if (!model) return state.SkipWithError("mesh could not be loaded");
+  const Pose pose = PoseFor(*model, mesh);
+  const auto& factorization = *model->default_factorization();
+  Eigen::SimplicialLLT<Eigen::SparseMatrix<double>> llt(model->NormalMatrix(factorization));
+  DeformScratch scratch = model->MakeScratch();
+  model->AssembleRightHandSide(factorization, pose, &scratch);
+  const Eigen::MatrixXd rhs = scratch.solution;
+  Eigen::MatrixXd x(rhs.rows(), 3);
+  std::vector<double> seconds;
+  for (auto _ : state) {
+    const auto start = Clock::now();
+    x = llt.solve(rhs);
+    benchmark::DoNotOptimize(x.data());
+    seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
+  }
+  const auto& l = llt.matrixL().nestedExpression();
+  ReportAgainstBound(state,
+                     l.nonZeros() * (sizeof(double) + sizeof(int)) + (l.cols() + 1) * sizeof(int),
+                     seconds);
+}
+
+// A numeric refactorisation (as after a stiffness change), reusing the symbolic analysis.
+void BM_Factorize(benchmark::State& state, BenchMesh mesh) {
+  auto model = ModelFor(mesh);
+  if (!model) return state.SkipWithError("mesh could not be loaded");
+  std::vector<double> seconds;
+  Stiffness stiffness;
+  for (auto _ : state) {
+    const auto start = Clock::now();
+    auto f = model->Factorize(stiffness);
+    benchmark::DoNotOptimize(f);
+    seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
+  }
+  state.counters["median_ms"] = Median(seconds) * 1e3;
+  state.counters["factor_MB"] = model->default_factorization()->factor().bytes() / 1e6;
+}
+
+// Everything Build() does: validation, weights, regions, symbolic analysis, first factorisation.
+void BM_Precompute(benchmark::State& state, BenchMesh mesh) {
+  auto input = LoadModelInput(mesh.mesh_path, mesh.skeleton_path, kDefaultPhantomVertices);
+  if (!input.ok()) return state.SkipWithError(input.status().ToString().c_str());
+  std::vector<double> seconds, precompute;
+  for (auto _ : state) {
+    const auto start = Clock::now();
+    auto model = DeformationModel::Build(input->mesh, input->skeleton, ModelOptions::Paper());
+    seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
+    if (model.ok()) precompute.push_back((*model)->precompute_seconds());
+  }
+  state.counters["median_ms"] = Median(seconds) * 1e3;
+  state.counters["precompute_ms"] = Median(precompute) * 1e3;  // before the first factorisation
+}
+
+std::vector<BenchMesh> AvailableMeshes() {
+  const std::string data = std::getenv("DEFORM_SHARED_DATA") ? std::getenv("DEFORM_SHARED_DATA")
+                                                             : DEFORM_SHARED_DATA_DIR;
+  std::vector<BenchMesh> meshes = {{"phantom_2k", "", "", "knee:flexion:60"}};
+  const std::vector<BenchMesh> shared = {
+      {"leg_1633", data + "/leg/leg_1633.obj", data + "/leg/leg.tgf", "1:x:60"},
+      {"leg_25969", data + "/leg/leg_25969.obj", data + "/leg/leg.tgf", "1:x:60"},
+      {"arm_132946", data + "/arm/arm_132946.obj", data + "/arm/arm.tgf", "2:z:-60"},
+  };
+  for (const auto& m : shared) {
+    if (std::filesystem::exists(m.mesh_path)) {
+      meshes.push_back(m);
+    } else {
+      std::fprintf(stderr, "shared mesh %s absent; skipping its benchmarks\n", m.mesh_path.c_str());
+    }
+  }
+  return meshes;
+}
+
+}  // namespace
+}  // namespace deform::bench
+
+int main(int argc, char** argv) {
+  using namespace deform::bench;
+  benchmark::Initialize(&argc, argv);
+  g_dram_bandwidth = MeasureReadBandwidth(std::size_t{1} << 30);
+  benchmark::AddCustomContext("dram_read_GBps", std::to_string(g_dram_bandwidth / 1e9));
+  for (const BenchMesh& mesh : AvailableMeshes()) {
+    const bool large = mesh.name == "arm_132946";
+    benchmark::RegisterBenchmark(("Precompute/" + mesh.name).c_str(), BM_Precompute, mesh)
+        ->Unit(benchmark::kMillisecond)->Iterations(large ? 1 : 3);
+    benchmark::RegisterBenchmark(("Factorize/" + mesh.name).c_str(), BM_Factorize, mesh)
+        ->Unit(benchmark::kMillisecond)->Iterations(large ? 2 : 5);
+    benchmark::RegisterBenchmark(("Frame/" + mesh.name).c_str(), BM_Frame, mesh)
+        ->Unit(benchmark::kMillisecond)->MinTime(1.0);
+    benchmark::RegisterBenchmark(("TriangularSolve/" + mesh.name).c_str(), BM_TriangularSolve, mesh)
+        ->Unit(benchmark::kMillisecond)->MinTime(1.0);
+    benchmark::RegisterBenchmark(("EigenBaselineSolve/" + mesh.name).c_str(), BM_EigenBaselineSolve,
+                                 mesh)
+        ->Unit(benchmark::kMillisecond)->MinTime(1.0);
+  }
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}
