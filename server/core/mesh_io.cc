@@ -969,6 +969,7 @@ StatusOr<PlyHeader> PlyHeaderParser::Run() {
     SplitTokens(line, &tokens_);
     if (tokens_.empty() || tokens_[0] == "comment" || tokens_[0] == "obj_info") continue;
     if (tokens_[0] == "end_header") {
+      if (tokens_.size() != 1) return LineError("'end_header' must stand alone on its line");
       if (!has_format_) return Status::InvalidArgument("the PLY header has no 'format' line");
       header_.body_offset = lines_.position();
       return std::move(header_);
@@ -1495,7 +1496,8 @@ Status AsciiStlChecker::CheckFacet() {
       return Status::InvalidArgument("the STL data ends inside facet " + std::to_string(facet));
     }
   } while (Trim(line).empty());
-  if (!StartsWithIgnoreCase(Trim(line), "endloop")) {
+  // Exactly "endloop": the reader would start another facet at a line containing "outer".
+  if (!EqualsIgnoreCase(Trim(line), "endloop")) {
     return LineError("expected 'endloop' after three vertices (facets must be triangles)");
   }
   return Status::Ok();

@@ -314,7 +314,34 @@ DEFORM_SOLVE_KERNEL void ForwardUpdate(const double* __restrict block, const int
   const double* px = planar;
   const double* py = planar + width;
   const double* pz = planar + 2 * width;
-  for (std::int64_t r = first_row; r < num_rows; ++r) {
+  std::int64_t r = first_row;
+  if (kWidth == 0) {
+    // Four rows at a time share each load of the supernode's unknowns.
+    for (; r + 4 <= num_rows; r += 4) {
+      const double* row0 = block + r * width;
+      const double* row1 = row0 + width;
+      const double* row2 = row1 + width;
+      const double* row3 = row2 + width;
+      double a0 = 0, a1 = 0, a2 = 0, b0 = 0, b1 = 0, b2 = 0;
+      double c0 = 0, c1 = 0, c2 = 0, d0 = 0, d1 = 0, d2 = 0;
+      for (int k = 0; k < width; ++k) {
+        const double x = px[k], yv = py[k], z = pz[k];
+        a0 += row0[k] * x; a1 += row0[k] * yv; a2 += row0[k] * z;
+        b0 += row1[k] * x; b1 += row1[k] * yv; b2 += row1[k] * z;
+        c0 += row2[k] * x; c1 += row2[k] * yv; c2 += row2[k] * z;
+        d0 += row3[k] * x; d1 += row3[k] * yv; d2 += row3[k] * z;
+      }
+      double* t0 = y + 3 * static_cast<std::ptrdiff_t>(rows[r]);
+      double* t1 = y + 3 * static_cast<std::ptrdiff_t>(rows[r + 1]);
+      double* t2 = y + 3 * static_cast<std::ptrdiff_t>(rows[r + 2]);
+      double* t3 = y + 3 * static_cast<std::ptrdiff_t>(rows[r + 3]);
+      t0[0] -= a0; t0[1] -= a1; t0[2] -= a2;
+      t1[0] -= b0; t1[1] -= b1; t1[2] -= b2;
+      t2[0] -= c0; t2[1] -= c1; t2[2] -= c2;
+      t3[0] -= d0; t3[1] -= d1; t3[2] -= d2;
+    }
+  }
+  for (; r < num_rows; ++r) {
     const double* row = block + r * width;
     double s0 = 0, s1 = 0, s2 = 0;
     for (int k = 0; k < width; ++k) {
@@ -338,7 +365,28 @@ DEFORM_SOLVE_KERNEL void BackwardUpdate(const double* __restrict block,
   double* px = planar;
   double* py = planar + width;
   double* pz = planar + 2 * width;
-  for (std::int64_t r = first_row; r < num_rows; ++r) {
+  std::int64_t r = first_row;
+  if (kWidth == 0) {
+    // Four rows at a time share each load and store of the accumulators.
+    for (; r + 4 <= num_rows; r += 4) {
+      const double* row0 = block + r * width;
+      const double* row1 = row0 + width;
+      const double* row2 = row1 + width;
+      const double* row3 = row2 + width;
+      const double* s0 = y + 3 * static_cast<std::ptrdiff_t>(rows[r]);
+      const double* s1 = y + 3 * static_cast<std::ptrdiff_t>(rows[r + 1]);
+      const double* s2 = y + 3 * static_cast<std::ptrdiff_t>(rows[r + 2]);
+      const double* s3 = y + 3 * static_cast<std::ptrdiff_t>(rows[r + 3]);
+      const double a0 = s0[0], a1 = s0[1], a2 = s0[2], b0 = s1[0], b1 = s1[1], b2 = s1[2];
+      const double c0 = s2[0], c1 = s2[1], c2 = s2[2], d0 = s3[0], d1 = s3[1], d2 = s3[2];
+      for (int k = 0; k < width; ++k) {
+        px[k] -= row0[k] * a0 + row1[k] * b0 + row2[k] * c0 + row3[k] * d0;
+        py[k] -= row0[k] * a1 + row1[k] * b1 + row2[k] * c1 + row3[k] * d1;
+        pz[k] -= row0[k] * a2 + row1[k] * b2 + row2[k] * c2 + row3[k] * d2;
+      }
+    }
+  }
+  for (; r < num_rows; ++r) {
     const double* row = block + r * width;
     const double* source = y + 3 * static_cast<std::ptrdiff_t>(rows[r]);
     const double z0 = source[0], z1 = source[1], z2 = source[2];

@@ -82,6 +82,11 @@ class CholeskyFactor {
   // Non-zeros of L (the explicit zeros of the supernodes' diagonal blocks not counted).
   std::int64_t nonzeros() const { return symbolic_ ? symbolic_->factor_nonzeros() : 0; }
   int num_supernodes() const { return static_cast<int>(row_pointers_.size()) - 1; }
+  // Width (columns) and height (rows) of supernode s.
+  int supernode_width(int s) const {
+    return symbolic_->supernode_columns_[s + 1] - symbolic_->supernode_columns_[s];
+  }
+  std::int64_t supernode_height(int s) const { return row_pointers_[s + 1] - row_pointers_[s]; }
 
  private:
   std::shared_ptr<const SymbolicCholesky> symbolic_;

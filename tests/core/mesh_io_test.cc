@@ -716,6 +716,15 @@ TEST(ReadMeshTest, AsciiStlMalformedVertexLineIsInvalid) {
                 "non-finite");
 }
 
+TEST(ReadMeshTest, AsciiStlEndloopLineMustBeExact) {
+  // OpenMesh starts a facet at any line containing "outer", so this would misread silently.
+  const std::string stl =
+      "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+      "endloop outer\nendfacet\nendsolid x\n";
+  EXPECT_STATUS(ReadMesh(stl, MeshFormat::kStl).status(), StatusCode::kInvalidArgument,
+                "expected 'endloop'");
+}
+
 TEST(ReadMeshTest, StlThatIsNeitherAsciiNorBinaryIsInvalid) {
   EXPECT_STATUS(ReadMesh("hello", MeshFormat::kStl).status(), StatusCode::kInvalidArgument,
                 "not STL data");
@@ -744,6 +753,14 @@ TEST(ReadMeshTest, PlyPropertyBeforeAnyElementIsInvalid) {
   EXPECT_STATUS(
       ReadMesh("ply\nformat ascii 1.0\nproperty float x\nend_header\n", MeshFormat::kPly).status(),
       StatusCode::kInvalidArgument, "property comes before any element");
+}
+
+TEST(ReadMeshTest, PlyDataOnTheEndHeaderLineIsInvalid) {
+  EXPECT_STATUS(ReadMesh("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+                         "property float y\nproperty float z\nend_header 0 0 0\n1 0 0\n0 1 0\n",
+                         MeshFormat::kPly)
+                    .status(),
+                StatusCode::kInvalidArgument, "'end_header' must stand alone");
 }
 
 TEST(ReadMeshTest, PlyUnsupportedLayoutsAreNamed) {

@@ -1,0 +1,177 @@
+#include "deform_client.h"
+
+#include <algorithm>
+#include <chrono>
+#include <fstream>
+#include <sstream>
+#include <utility>
+
+#include "deform_stream_impl.h"
+
+namespace deform::client {
+namespace {
+
+std::shared_ptr<grpc::Channel> MakeChannel(const std::string& target,
+                                           const ClientOptions& options) {
+  grpc::ChannelArguments arguments;
+  arguments.SetMaxReceiveMessageSize(options.max_receive_message_bytes);
+  arguments.SetMaxSendMessageSize(-1);
+  return grpc::CreateCustomChannel(target, grpc::InsecureChannelCredentials(), arguments);
+}
+
+grpc::Status ReadWholeFile(const std::string& path, std::string* contents) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return grpc::Status(grpc::StatusCode::NOT_FOUND, "cannot open '" + path + "'");
+  std::ostringstream buffer;
+  buffer << in.rdbuf();
+  if (in.bad()) return grpc::Status(grpc::StatusCode::NOT_FOUND, "cannot read '" + path + "'");
+  *contents = std::move(buffer).str();
+  return grpc::Status::OK;
+}
+
+bool EndsWithTgf(const std::string& path) {
+  if (path.size() < 4) return false;
+  std::string extension = path.substr(path.size() - 4);
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return extension == ".tgf";
+}
+
+std::string BaseName(const std::string& path) {
+  const std::size_t slash = path.find_last_of('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+// Runs one LoadMesh call: sends `header` and the chunks of `mesh_bytes`, reads the progress.
+grpc::Status RunLoadMesh(deform::v1::DeformService::Stub* stub, const ClientOptions& options,
+                         const deform::v1::LoadMeshHeader& header, const std::string* mesh_bytes,
+                         deform::v1::MeshSummary* summary, const ProgressCallback& progress) {
+  grpc::ClientContext context;
+  auto stream = stub->LoadMesh(&context);
+  deform::v1::LoadMeshRequest request;
+  *request.mutable_header() = header;
+  bool writing = stream->Write(request);
+  if (mesh_bytes != nullptr) {
+    const std::size_t chunk = static_cast<std::size_t>(std::max(1, options.upload_chunk_bytes));
+    for (std::size_t offset = 0; writing && offset < mesh_bytes->size(); offset += chunk) {
+      request.set_chunk(mesh_bytes->substr(offset, chunk));
+      writing = stream->Write(request);
+    }
+  }
+  stream->WritesDone();
+  deform::v1::LoadMeshProgress message;
+  bool ready = false;
+  while (stream->Read(&message)) {
+    if (progress) progress(message);
+    if (message.stage() == deform::v1::LoadMeshProgress::READY) {
+      ready = true;
+      if (summary != nullptr) *summary = message.mesh();
+    }
+  }
+  grpc::Status status = stream->Finish();
+  if (status.ok() && !ready) {
+    return grpc::Status(grpc::StatusCode::INTERNAL, "LoadMesh ended without a READY message");
+  }
+  return status;
+}
+
+}  // namespace
+
+DeformClient::DeformClient(const std::string& target, ClientOptions options)
+    : DeformClient(MakeChannel(target, options), options) {}
+
+DeformClient::DeformClient(std::shared_ptr<grpc::Channel> channel, ClientOptions options)
+    : channel_(std::move(channel)),
+      stub_(deform::v1::DeformService::NewStub(channel_)),
+      options_(options) {}
+
+bool DeformClient::WaitForReady(int timeout_ms) {
+  return channel_->WaitForConnected(std::chrono::system_clock::now() +
+                                    std::chrono::milliseconds(timeout_ms));
+}
+
+grpc::Status DeformClient::LoadPhantom(int vertices, const deform::v1::MethodOptions& options,
+                                       deform::v1::MeshSummary* summary,
+                                       const ProgressCallback& progress, const std::string& name) {
+  deform::v1::LoadMeshHeader header;
+  header.set_name(name);
+  header.mutable_phantom()->set_vertices(vertices);
+  *header.mutable_options() = options;
+  return RunLoadMesh(stub_.get(), options_, header, nullptr, summary, progress);
+}
+
+grpc::Status DeformClient::LoadMeshFiles(const std::string& mesh_path,
+                                         const std::string& skeleton_path,
+                                         const deform::v1::MethodOptions& options,
+                                         deform::v1::MeshSummary* summary,
+                                         const ProgressCallback& progress) {
+  std::string mesh_bytes;
+  std::string skeleton_bytes;
+  grpc::Status status = ReadWholeFile(mesh_path, &mesh_bytes);
+  if (!status.ok()) return status;
+  status = ReadWholeFile(skeleton_path, &skeleton_bytes);
+  if (!status.ok()) return status;
+  const deform::v1::MeshFormat format = MeshFormatFromPath(mesh_path);
+  if (format == deform::v1::MESH_FORMAT_UNSPECIFIED) {
+    return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
+                        "unknown mesh format for '" + mesh_path + "' (.obj .ply .stl .off)");
+  }
+  const deform::v1::SkeletonFormat skeleton_format = EndsWithTgf(skeleton_path)
+                                                         ? deform::v1::SKELETON_FORMAT_TGF
+                                                         : deform::v1::SKELETON_FORMAT_JSON;
+  return LoadMeshBytes(BaseName(mesh_path), format, mesh_bytes, skeleton_format, skeleton_bytes,
+                       options, summary, progress);
+}
+
+grpc::Status DeformClient::LoadMeshBytes(const std::string& name, deform::v1::MeshFormat format,
+                                         const std::string& mesh_bytes,
+                                         deform::v1::SkeletonFormat skeleton_format,
+                                         const std::string& skeleton_bytes,
+                                         const deform::v1::MethodOptions& options,
+                                         deform::v1::MeshSummary* summary,
+                                         const ProgressCallback& progress) {
+  deform::v1::LoadMeshHeader header;
+  header.set_name(name);
+  deform::v1::UploadSource* upload = header.mutable_upload();
+  upload->set_format(format);
+  upload->set_mesh_bytes(mesh_bytes.size());
+  upload->set_skeleton_format(skeleton_format);
+  upload->set_skeleton(skeleton_bytes);
+  *header.mutable_options() = options;
+  return RunLoadMesh(stub_.get(), options_, header, &mesh_bytes, summary, progress);
+}
+
+grpc::Status DeformClient::GetMeshInfo(const std::string& mesh_id, bool include_geometry,
+                                       deform::v1::MeshInfo* info) {
+  grpc::ClientContext context;
+  deform::v1::GetMeshInfoRequest request;
+  request.set_mesh_id(mesh_id);
+  request.set_include_geometry(include_geometry);
+  return stub_->GetMeshInfo(&context, request, info);
+}
+
+grpc::Status DeformClient::ListMeshes(std::vector<deform::v1::MeshSummary>* meshes) {
+  grpc::ClientContext context;
+  deform::v1::ListMeshesResponse response;
+  const grpc::Status status =
+      stub_->ListMeshes(&context, deform::v1::ListMeshesRequest(), &response);
+  if (status.ok() && meshes != nullptr) {
+    meshes->assign(response.meshes().begin(), response.meshes().end());
+  }
+  return status;
+}
+
+grpc::Status DeformClient::UnloadMesh(const std::string& mesh_id) {
+  grpc::ClientContext context;
+  deform::v1::UnloadMeshRequest request;
+  request.set_mesh_id(mesh_id);
+  deform::v1::UnloadMeshResponse response;
+  return stub_->UnloadMesh(&context, request, &response);
+}
+
+std::unique_ptr<DeformStream> DeformClient::OpenStream(const std::string& mesh_id,
+                                                       StreamCallbacks callbacks) {
+  return internal::StartDeformStream(stub_.get(), mesh_id, std::move(callbacks));
+}
+
+}  // namespace deform::client

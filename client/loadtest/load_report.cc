@@ -1,0 +1,186 @@
+#include "loadtest/load_report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "loadtest/status_text.h"
+
+namespace deform::loadtest {
+namespace {
+
+// `value` rounded to `decimals` places (dividing by a power of ten keeps the JSON text short).
+double Round(double value, int decimals) {
+  const double scale = std::pow(10.0, decimals);
+  return std::round(value * scale) / scale;
+}
+double Ms(double value) { return Round(value, 3); }
+
+double Median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  return PercentileOfSorted(values, 0.5);
+}
+
+ServerTimings MedianTimings(const std::vector<ServerTimings>& timings) {
+  std::vector<double> queue, rhs, solve, encode;
+  queue.reserve(timings.size());
+  rhs.reserve(timings.size());
+  solve.reserve(timings.size());
+  encode.reserve(timings.size());
+  for (const ServerTimings& t : timings) {
+    queue.push_back(t.queue_ms);
+    rhs.push_back(t.rhs_ms);
+    solve.push_back(t.solve_ms);
+    encode.push_back(t.encode_ms);
+  }
+  return {Median(std::move(queue)), Median(std::move(rhs)), Median(std::move(solve)),
+          Median(std::move(encode))};
+}
+
+void CountError(LoadReport* report, const std::string& code, std::uint64_t count) {
+  if (count == 0) return;
+  report->errors += count;
+  report->errors_by_code[code] += count;
+}
+
+}  // namespace
+
+double LoadReport::delivered_fraction() const {
+  return frames_sent == 0 ? 0.0
+                          : static_cast<double>(frames_received) / static_cast<double>(frames_sent);
+}
+
+double LoadReport::throughput_fps() const {
+  return plan.duration_s <= 0 ? 0.0 : static_cast<double>(frames_received) / plan.duration_s;
+}
+
+LoadReport BuildReport(const RunDescription& run, const LoadPlan& plan, RunOutcome* outcome) {
+  LoadReport report;
+  report.run = run;
+  report.plan = plan;
+  report.send_lag_max_ms = outcome->send_lag_max_ms;
+  std::vector<ServerTimings> timings;
+  std::vector<double> factor_ms;
+  for (StreamOutcome& stream : outcome->streams) {
+    StreamStats& stats = stream.stats;
+    report.frames_sent += stream.poses_sent;
+    report.frames_received += stats.frames_received;
+    report.skipped_by_server += stats.skipped_by_server;
+    report.poses_rejected += stats.poses_rejected;
+    report.stiffness_rejected += stats.stiffness_rejected;
+    report.bad_frames += stats.bad_frames;
+    report.stiffness_sent += stream.stiffness_sent;
+    report.stiffness_applied += stats.stiffness_applied;
+    report.max_gap_ms = std::max(report.max_gap_ms, stream.max_gap_ms);
+    report.latency_ms.insert(report.latency_ms.end(), stats.latency_ms.begin(),
+                             stats.latency_ms.end());
+    timings.insert(timings.end(), stats.timings.begin(), stats.timings.end());
+    factor_ms.insert(factor_ms.end(), stats.stiffness_factor_ms.begin(),
+                     stats.stiffness_factor_ms.end());
+    stats.latency_ms = {};
+    stats.timings = {};
+    if (!stream.status.ok()) {
+      CountError(&report, StatusCodeName(stream.status.error_code()), 1);
+      if (report.first_stream_error.empty()) report.first_stream_error = StatusText(stream.status);
+    }
+  }
+  CountError(&report, "INVALID_ARGUMENT", report.poses_rejected + report.stiffness_rejected);
+  CountError(&report, "DATA_LOSS", report.bad_frames);
+  report.latency = Summarize(&report.latency_ms);
+  report.server_p50 = MedianTimings(timings);
+  report.stiffness_factor_ms_p50 = Median(std::move(factor_ms));
+  return report;
+}
+
+nlohmann::ordered_json ReportJson(const LoadReport& report) {
+  const LoadPlan& plan = report.plan;
+  nlohmann::ordered_json out;
+  out["target"] = report.run.target;
+  out["mesh"] = report.run.mesh;
+  out["vertices"] = report.run.vertices;
+  out["triangles"] = report.run.triangles;
+  out["streams"] = plan.streams;
+  out["rate_hz"] = plan.rate_hz;
+  out["duration_s"] = plan.duration_s;
+  out["warmup_s"] = plan.warmup_s;
+  out["posed"] = plan.posed.joint + ":" + plan.posed.axis;
+  out["frames_sent"] = report.frames_sent;
+  out["frames_received"] = report.frames_received;
+  out["delivered_fraction"] = Round(report.delivered_fraction(), 5);
+  out["skipped_by_server"] = report.skipped_by_server;
+  out["errors"] = report.errors;
+  out["errors_by_code"] = nlohmann::ordered_json::object();
+  for (const auto& [code, count] : report.errors_by_code) out["errors_by_code"][code] = count;
+  out["rejected_notices"] = {{"POSE_REJECTED", report.poses_rejected},
+                             {"STIFFNESS_REJECTED", report.stiffness_rejected}};
+  out["throughput_fps"] = Round(report.throughput_fps(), 1);
+  out["latency_ms"] = {{"p50", Ms(report.latency.p50)}, {"p90", Ms(report.latency.p90)},
+                       {"p99", Ms(report.latency.p99)}, {"p999", Ms(report.latency.p999)},
+                       {"max", Ms(report.latency.max)}, {"mean", Ms(report.latency.mean)}};
+  out["max_gap_ms"] = Ms(report.max_gap_ms);
+  out["stiffness_every_s"] = plan.stiffness_every_s;
+  out["stiffness_joint"] = report.run.stiffness_joint;
+  out["stiffness_updates_sent"] = report.stiffness_sent;
+  out["stiffness_updates_applied"] = report.stiffness_applied;
+  out["stiffness_factor_ms_p50"] = Ms(report.stiffness_factor_ms_p50);
+  out["server_solve_ms_p50"] = Ms(report.server_p50.solve_ms);
+  out["server_ms_p50"] = {{"queue", Ms(report.server_p50.queue_ms)},
+                          {"rhs", Ms(report.server_p50.rhs_ms)},
+                          {"solve", Ms(report.server_p50.solve_ms)},
+                          {"encode", Ms(report.server_p50.encode_ms)}};
+  out["send_lag_max_ms"] = Ms(report.send_lag_max_ms);
+  return out;
+}
+
+std::string ReportText(const LoadReport& report) {
+  const LoadPlan& plan = report.plan;
+  const LatencySummary& l = report.latency;
+  std::string text;
+  char line[512];
+  auto add = [&](const char* format, auto... values) {
+    std::snprintf(line, sizeof(line), format, values...);
+    text += line;
+  };
+  add("target %s, mesh %s (%s): %u vertices, %u triangles\n", report.run.target.c_str(),
+      report.run.mesh.c_str(), report.run.mesh_id.c_str(), report.run.vertices,
+      report.run.triangles);
+  add("%d streams x %.1f Hz posing %s:%s, %.1f s measured after %.1f s warm-up\n", plan.streams,
+      plan.rate_hz, plan.posed.joint.c_str(), plan.posed.axis.c_str(), plan.duration_s,
+      plan.warmup_s);
+  add("frames: %llu sent, %llu received (%.2f%%), %llu skipped by the server; %.1f frames/s\n",
+      static_cast<unsigned long long>(report.frames_sent),
+      static_cast<unsigned long long>(report.frames_received), 100.0 * report.delivered_fraction(),
+      static_cast<unsigned long long>(report.skipped_by_server), report.throughput_fps());
+  add("latency ms: p50 %.3f  p90 %.3f  p99 %.3f  p99.9 %.3f  max %.3f  (mean %.3f)\n", l.p50, l.p90,
+      l.p99, l.p999, l.max, l.mean);
+  add("largest gap between frames of one stream: %.3f ms\n", report.max_gap_ms);
+  add("server ms (median): queue %.3f  rhs %.3f  solve %.3f  encode %.3f\n",
+      report.server_p50.queue_ms, report.server_p50.rhs_ms, report.server_p50.solve_ms,
+      report.server_p50.encode_ms);
+  if (plan.stiffness_every_s > 0) {
+    add("stiffness on %s every %.2f s: %llu sent, %llu applied (median refactorisation %.3f ms)\n",
+        report.run.stiffness_joint.c_str(), plan.stiffness_every_s,
+        static_cast<unsigned long long>(report.stiffness_sent),
+        static_cast<unsigned long long>(report.stiffness_applied), report.stiffness_factor_ms_p50);
+  }
+  add("worst send lag against the schedule: %.3f ms\n", report.send_lag_max_ms);
+  if (report.errors == 0) {
+    text += "errors: none\n";
+  } else {
+    add("errors: %llu", static_cast<unsigned long long>(report.errors));
+    for (const auto& [code, count] : report.errors_by_code) {
+      add(" %s=%llu", code.c_str(), static_cast<unsigned long long>(count));
+    }
+    text += "\n";
+    if (!report.first_stream_error.empty()) {
+      text += "first stream error: " + report.first_stream_error + "\n";
+    }
+  }
+  if (!report.latency_ms.empty()) {
+    text += "latency histogram (ms, count, share, cumulative):\n";
+    text += LatencyHistogramText(report.latency_ms);
+  }
+  return text;
+}
+
+}  // namespace deform::loadtest

@@ -1,0 +1,61 @@
+// The load test's results: merged over streams, as one JSON object or a readable summary.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "loadtest/latency_stats.h"
+#include "loadtest/load_plan.h"
+#include "loadtest/load_runner.h"
+
+namespace deform::loadtest {
+
+// What the run was, for the report's header.
+struct RunDescription {
+  std::string target;
+  std::string mesh;  // file path or "phantom"
+  std::string mesh_id;
+  unsigned vertices = 0;
+  unsigned triangles = 0;
+  std::string stiffness_joint;  // empty without stiffness updates
+};
+
+struct LoadReport {
+  RunDescription run;
+  LoadPlan plan;
+  std::uint64_t frames_sent = 0;      // measured poses accepted by SendPose
+  std::uint64_t frames_received = 0;  // frames answering them
+  std::uint64_t skipped_by_server = 0;
+  // Errors over the whole run, warm-up included: streams that ended with a non-OK status (by
+  // code), rejected notices (counted as INVALID_ARGUMENT) and frames of the wrong size (DATA_LOSS).
+  std::uint64_t errors = 0;
+  std::map<std::string, std::uint64_t> errors_by_code;
+  std::uint64_t poses_rejected = 0;
+  std::uint64_t stiffness_rejected = 0;
+  std::uint64_t bad_frames = 0;
+  std::string first_stream_error;  // "CODE: message" of the first failed stream
+  std::vector<double> latency_ms;  // every measured frame's, ascending
+  LatencySummary latency;
+  double max_gap_ms = 0;
+  std::uint64_t stiffness_sent = 0;
+  std::uint64_t stiffness_applied = 0;
+  double stiffness_factor_ms_p50 = 0;
+  ServerTimings server_p50;  // median of each server timing over measured frames
+  double send_lag_max_ms = 0;
+
+  double delivered_fraction() const;
+  double throughput_fps() const;
+};
+
+// Merges the streams' outcomes (consumes their sample buffers).
+LoadReport BuildReport(const RunDescription& run, const LoadPlan& plan, RunOutcome* outcome);
+
+nlohmann::ordered_json ReportJson(const LoadReport& report);
+
+// A readable summary with a latency histogram.
+std::string ReportText(const LoadReport& report);
+
+}  // namespace deform::loadtest

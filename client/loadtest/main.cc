@@ -1,0 +1,207 @@
+// deform-loadtest: many concurrent Deform streams at headset rate against one server.
+//
+//   deform-loadtest [--target ADDR] [--mesh FILE --skeleton FILE] [--streams N] [--rate HZ]
+//                   [--duration S] [--warmup S] [--stiffness-every S] [--joint J --axis A]
+//                   [--json] [--fail-on-errors]
+//
+// Loads the mesh once, runs the streams, prints the results and unloads the mesh. Exit codes: 0
+// when the run completed (errors are counted in the report), 1 when it could not run (connect or
+// load failure) or, with --fail-on-errors, when errors were counted, 2 for usage errors.
+#include <CLI/CLI.hpp>
+#include <iostream>
+#include <string>
+
+#include "lib/deform_client.h"
+#include "loadtest/joint_selection.h"
+#include "loadtest/load_plan.h"
+#include "loadtest/load_report.h"
+#include "loadtest/load_runner.h"
+#include "loadtest/status_text.h"
+
+namespace {
+
+constexpr char kProgram[] = "deform-loadtest";
+
+// The two soft weights the stiffness updates alternate between (the default soft weight is 1).
+constexpr double kSoftWeights[] = {0.5, 1.0};
+
+struct LoadtestArgs {
+  std::string target = "127.0.0.1:50051";
+  std::string mesh_path;
+  std::string skeleton_path;
+  int phantom_vertices = 0;
+  int streams = 1;
+  double rate_hz = 90.0;
+  double duration_s = 10.0;
+  double warmup_s = 1.0;
+  double stiffness_every_s = 0.0;
+  std::string joint;
+  std::string axis;
+  double peak_degrees = 120.0;
+  double cycle_s = 2.0;
+  double drain_s = 2.0;
+  int connect_timeout_ms = 5000;
+  bool keep_mesh = false;
+  bool json = false;
+  bool fail_on_errors = false;
+};
+
+int Fail(const grpc::Status& status) {
+  std::cerr << kProgram << ": " << deform::loadtest::StatusText(status) << "\n";
+  return 1;
+}
+
+grpc::Status LoadMesh(deform::client::DeformClient& client, const LoadtestArgs& args,
+                      deform::v1::MeshSummary* summary) {
+  const deform::v1::MethodOptions defaults;
+  if (args.mesh_path.empty()) return client.LoadPhantom(args.phantom_vertices, defaults, summary);
+  return client.LoadMeshFiles(args.mesh_path, args.skeleton_path, defaults, summary);
+}
+
+// Runs the plan on a loaded mesh and prints the report; returns the exit code.
+int RunOnMesh(deform::client::DeformClient& client, const LoadtestArgs& args,
+              const deform::v1::MeshSummary& summary) {
+  deform::loadtest::LoadPlan plan;
+  plan.mesh_id = summary.mesh_id();
+  plan.vertex_count = summary.vertex_count();
+  plan.streams = args.streams;
+  plan.rate_hz = args.rate_hz;
+  plan.warmup_s = args.warmup_s;
+  plan.duration_s = args.duration_s;
+  plan.posed = deform::loadtest::ChoosePosedJoint(summary, args.joint, args.axis);
+  plan.peak_degrees = args.peak_degrees;
+  plan.cycle_s = args.cycle_s;
+  plan.drain_s = args.drain_s;
+
+  deform::loadtest::RunDescription run;
+  run.target = args.target;
+  run.mesh = args.mesh_path.empty() ? "phantom" : args.mesh_path;
+  run.mesh_id = summary.mesh_id();
+  run.vertices = summary.vertex_count();
+  run.triangles = summary.triangle_count();
+  if (args.stiffness_every_s > 0) {
+    run.stiffness_joint = deform::loadtest::ChooseRegionJoint(summary, plan.posed.joint);
+    if (run.stiffness_joint.empty()) {
+      return Fail(grpc::Status(grpc::StatusCode::FAILED_PRECONDITION,
+                               "--stiffness-every needs an inner joint (has_region); the mesh "
+                               "has none"));
+    }
+    plan.stiffness_every_s = args.stiffness_every_s;
+    for (double soft : kSoftWeights) {
+      plan.stiffness_updates.push_back(
+          deform::loadtest::SoftWeightUpdate(run.stiffness_joint, soft));
+    }
+  }
+
+  deform::loadtest::RunOutcome outcome = deform::loadtest::RunLoad(client, plan);
+  const deform::loadtest::LoadReport report = deform::loadtest::BuildReport(run, plan, &outcome);
+  if (args.json) {
+    std::cout << deform::loadtest::ReportJson(report).dump() << std::endl;
+  } else {
+    std::cout << deform::loadtest::ReportText(report) << std::flush;
+  }
+  return args.fail_on_errors && report.errors > 0 ? 1 : 0;
+}
+
+int Run(const LoadtestArgs& args) {
+  deform::client::DeformClient client(args.target);
+  if (!client.WaitForReady(args.connect_timeout_ms)) {
+    return Fail(grpc::Status(grpc::StatusCode::UNAVAILABLE,
+                             "cannot reach " + args.target + " within " +
+                                 std::to_string(args.connect_timeout_ms) + " ms"));
+  }
+  deform::v1::MeshSummary summary;
+  const grpc::Status loaded = LoadMesh(client, args, &summary);
+  if (!loaded.ok()) return Fail(loaded);
+
+  const int code = RunOnMesh(client, args, summary);
+  if (!args.keep_mesh) {
+    // The run is over: a failed unload is reported but does not change the exit code.
+    const grpc::Status unloaded = client.UnloadMesh(summary.mesh_id());
+    if (!unloaded.ok()) Fail(unloaded);
+  }
+  return code;
+}
+
+void AddFlags(CLI::App& app, LoadtestArgs& args) {
+  app.add_option("--target", args.target, "Server address host:port")->capture_default_str();
+  CLI::Option* mesh = app.add_option("--mesh", args.mesh_path,
+                                     "Mesh file to upload (.obj .ply .stl .off); default: the "
+                                     "built-in knee phantom");
+  CLI::Option* skeleton = app.add_option("--skeleton", args.skeleton_path,
+                                         "Skeleton file (.tgf or JSON); required with --mesh");
+  CLI::Option* phantom = app.add_option("--phantom-vertices", args.phantom_vertices,
+                                        "Phantom resolution (0 = the server's default)")
+                             ->capture_default_str()
+                             ->check(CLI::NonNegativeNumber);
+  mesh->needs(skeleton);
+  skeleton->needs(mesh);
+  mesh->excludes(phantom);
+
+  app.add_option("--streams", args.streams, "Concurrent Deform streams on the mesh")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 100000));
+  app.add_option("--rate", args.rate_hz,
+                 "Poses per second per stream; stream i sends pose k at t0 + (k + i/N) / rate")
+      ->capture_default_str()
+      ->check(CLI::Range(0.001, 100000.0));
+  app.add_option("--duration", args.duration_s, "Measured seconds, after the warm-up")
+      ->capture_default_str()
+      ->check(CLI::Range(0.001, 86400.0));
+  app.add_option("--warmup", args.warmup_s,
+                 "Seconds sent first and left out of the frame, latency and gap statistics")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 86400.0));
+  app.add_option("--stiffness-every", args.stiffness_every_s,
+                 "Every S measured seconds, each stream (staggered) sends a stiffness update "
+                 "setting an inner joint's soft weight, alternately 0.5 and 1 (0 = never)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 86400.0));
+  app.add_option("--joint", args.joint,
+                 "Joint the poses bend, name or 0-based index (default: knee when the skeleton "
+                 "has a knee with a flexion dof, else 1)");
+  app.add_option("--axis", args.axis,
+                 "Axis of the bend: a dof name or x|y|z (default: flexion for the knee, else x)");
+  app.add_option("--peak-degrees", args.peak_degrees,
+                 "Flexion runs 0 -> peak -> 0 along a cosine; streams are spread over the cycle")
+      ->capture_default_str();
+  app.add_option("--cycle-seconds", args.cycle_s, "Length of one flexion cycle")
+      ->capture_default_str()
+      ->check(CLI::Range(0.001, 86400.0));
+  app.add_option("--drain", args.drain_s,
+                 "After the last send: seconds to wait for the last frames, then for the "
+                 "streams to finish")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 3600.0));
+  app.add_option("--connect-timeout-ms", args.connect_timeout_ms,
+                 "How long to wait for the server to be reachable")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  app.add_flag("--keep-mesh", args.keep_mesh, "Leave the loaded mesh on the server");
+  app.add_flag("--json", args.json,
+               "Print one JSON object instead of the summary and latency histogram");
+  app.add_flag("--fail-on-errors", args.fail_on_errors,
+               "Exit 1 when any error was counted (failed streams, rejected notices, malformed "
+               "frames; warm-up included)");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "deform-loadtest: loads a mesh once (default: the built-in knee phantom), runs N concurrent "
+      "Deform streams sending flexion poses at a fixed rate for a warm-up plus the measured "
+      "duration, and reports delivery, pose-to-frame latency percentiles, the largest gap "
+      "between a stream's frames, errors by status code, stiffness updates and server timings."};
+  app.get_formatter()->column_width(34);
+  LoadtestArgs args;
+  AddFlags(app, args);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);
+    std::cerr << kProgram << ": " << e.what() << "\n";
+    return 2;
+  }
+  return Run(args);
+}

@@ -1,0 +1,81 @@
+// What one load-test stream observed. Its On* methods are the stream's callbacks: they run on
+// gRPC's threads (one at a time per stream), only record numbers, and never block for long.
+#pragma once
+
+#include <grpcpp/support/status.h>
+
+#include <chrono>
+#include <condition_variable>
+#include <cstddef>
+#include <cstdint>
+#include <mutex>
+#include <vector>
+
+#include "deform/v1/deform.pb.h"
+
+namespace deform::loadtest {
+
+// Server-side timings of one frame (FrameTimings), in milliseconds.
+struct ServerTimings {
+  double queue_ms = 0;
+  double rhs_ms = 0;
+  double solve_ms = 0;
+  double encode_ms = 0;
+};
+
+// Counts and samples of one stream. A frame counts as measured when the pose it answers is one of
+// the measured period's (its sequence is at least the first measured sequence).
+struct StreamStats {
+  std::vector<double> latency_ms;           // measured frames: receipt minus echoed send time
+  std::vector<ServerTimings> timings;       // measured frames
+  std::uint64_t frames_received = 0;        // measured frames
+  std::uint64_t frames_received_total = 0;  // including the warm-up
+  std::uint64_t skipped_by_server = 0;      // sum of measured frames' skipped_poses
+  std::uint64_t bad_frames = 0;             // positions not 12 bytes per vertex
+  double max_gap_ms = 0;  // largest interval between consecutive receipts after the warm-up
+  std::int64_t last_receipt_ns = 0;  // MonotonicNanos() of the last frame; 0 before any
+  std::uint64_t poses_rejected = 0;
+  std::uint64_t stiffness_applied = 0;
+  std::uint64_t stiffness_rejected = 0;
+  std::vector<double> stiffness_factor_ms;  // Notice.factor_ms of each STIFFNESS_APPLIED
+  grpc::Status final_status;
+  bool done = false;
+};
+
+class StreamRecorder {
+ public:
+  using Clock = std::chrono::steady_clock;
+
+  // `expected_frames` preallocates the sample buffers; `vertex_count` sets the expected size of a
+  // frame's positions.
+  StreamRecorder(std::size_t expected_frames, std::size_t vertex_count);
+
+  // Sets where the measured period starts: the first measured pose's sequence, and the time (on
+  // MonotonicNanos()'s clock) from which gaps between frames count. Call before the first send.
+  void SetMeasureStart(std::uint64_t first_measured_sequence, std::int64_t measure_start_ns);
+
+  void OnFrame(const deform::v1::DeformFrame& frame);
+  void OnNotice(const deform::v1::Notice& notice);
+  void OnDone(const grpc::Status& status);
+
+  // Waits until pose `sequence` (or a later one) is answered or rejected, or the stream ends.
+  // False on timeout.
+  bool WaitAnswered(std::uint64_t sequence, Clock::time_point deadline);
+  // Waits until the stream ends. False on timeout.
+  bool WaitDone(Clock::time_point deadline);
+  bool done();
+
+  // A copy of the stats so far (complete once done()).
+  StreamStats Snapshot();
+
+ private:
+  const std::size_t position_bytes_;
+  std::mutex mu_;
+  std::uint64_t first_measured_sequence_ = 0;
+  std::int64_t measure_start_ns_ = 0;
+  std::condition_variable changed_;
+  std::uint64_t last_settled_sequence_ = 0;  // highest sequence answered or rejected
+  StreamStats stats_;
+};
+
+}  // namespace deform::loadtest

@@ -1,0 +1,55 @@
+// deform-health-probe: asks a server's standard gRPC health service whether it is serving.
+//
+//   deform-health-probe [--target HOST:PORT] [--service NAME] [--timeout-ms MS]
+//
+// Exit code 0 when the status is SERVING, 1 otherwise (with the reason on stderr), 2 for bad flags.
+// Used by the container's HEALTHCHECK (no such probe is packaged in Debian).
+#include <grpcpp/grpcpp.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <iostream>
+#include <string>
+
+#include "health.grpc.pb.h"
+
+int main(int argc, char** argv) {
+  std::string target = "127.0.0.1:50051";
+  std::string service;
+  int timeout_ms = 2000;
+  CLI::App app{"Checks a gRPC server's health service; exit 0 when SERVING"};
+  app.add_option("--target", target, "Server address host:port")->capture_default_str();
+  app.add_option("--service", service, "Service name to check (empty: the whole server)");
+  app.add_option("--timeout-ms", timeout_ms, "Deadline of the check")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 600000));
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);
+    std::cerr << "deform-health-probe: " << e.what() << "\n";
+    return 2;
+  }
+
+  auto channel = grpc::CreateChannel(target, grpc::InsecureChannelCredentials());
+  auto stub = grpc::health::v1::Health::NewStub(channel);
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::milliseconds(timeout_ms));
+  grpc::health::v1::HealthCheckRequest request;
+  request.set_service(service);
+  grpc::health::v1::HealthCheckResponse response;
+  const grpc::Status status = stub->Check(&context, request, &response);
+  if (!status.ok()) {
+    std::cerr << "deform-health-probe: " << target << ": health check failed: code "
+              << status.error_code() << ": " << status.error_message() << "\n";
+    return 1;
+  }
+  if (response.status() != grpc::health::v1::HealthCheckResponse::SERVING) {
+    std::cerr << "deform-health-probe: " << target << " is "
+              << grpc::health::v1::HealthCheckResponse::ServingStatus_Name(response.status())
+              << "\n";
+    return 1;
+  }
+  std::cout << "SERVING\n";
+  return 0;
+}

@@ -1,0 +1,23 @@
+#include "vr/mesh_source.h"
+
+namespace deform::vr {
+
+grpc::Status AcquireMesh(client::DeformClient& client, const MeshSource& source,
+                         deform::v1::MeshSummary* summary, bool* loaded) {
+  *loaded = false;
+  if (!source.mesh_id.empty()) {
+    deform::v1::MeshInfo info;
+    grpc::Status status = client.GetMeshInfo(source.mesh_id, /*include_geometry=*/false, &info);
+    if (status.ok()) *summary = info.summary();
+    return status;
+  }
+  const deform::v1::MethodOptions defaults;
+  grpc::Status status =
+      source.mesh_path.empty()
+          ? client.LoadPhantom(source.phantom_vertices, defaults, summary)
+          : client.LoadMeshFiles(source.mesh_path, source.skeleton_path, defaults, summary);
+  *loaded = status.ok();
+  return status;
+}
+
+}  // namespace deform::vr

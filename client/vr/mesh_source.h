@@ -1,0 +1,23 @@
+// Where the VR stand-in's mesh comes from: the built-in phantom, uploaded files, or a mesh the
+// server already holds.
+#pragma once
+
+#include <string>
+
+#include "lib/deform_client.h"
+
+namespace deform::vr {
+
+struct MeshSource {
+  std::string mesh_id;    // non-empty: use this loaded mesh (nothing is loaded)
+  std::string mesh_path;  // non-empty: upload this file with `skeleton_path`
+  std::string skeleton_path;
+  int phantom_vertices = 0;  // otherwise: load the phantom at this resolution (0 = default)
+};
+
+// Loads or looks up the mesh and fills `summary`. `loaded` tells whether this call loaded it (and
+// so owns it). Returns the server's (or the file reader's) status.
+grpc::Status AcquireMesh(client::DeformClient& client, const MeshSource& source,
+                         deform::v1::MeshSummary* summary, bool* loaded);
+
+}  // namespace deform::vr

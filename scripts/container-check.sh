@@ -1,0 +1,102 @@
+#!/usr/bin/env bash
+# Builds the deformd image for real without a Docker engine (podman + a base image made by
+# mmdebstrap), runs it, waits for its health check, load-tests it, checks that it runs as
+# non-root and exits cleanly on SIGTERM, validates the compose file, and prints the image size.
+# Exits non-zero on any failure with the reason on its last line.
+set -uo pipefail
+cd "$(dirname "$0")/.."
+
+IMAGE="${DEFORM_IMAGE:-localhost/deformd:check}"
+CONTAINER="deformd-check-$$"
+PORT=50051  # the image's HEALTHCHECK probes this port
+BASE_IMAGE="docker.io/library/debian:bookworm-slim"
+WORK="$(mktemp -d)"
+
+fail() {
+  echo "container-check: FAILED: $*"
+  exit 1
+}
+cleanup() {
+  podman --runtime runc rm -f "$CONTAINER" >/dev/null 2>&1 || true
+  rm -rf "$WORK"
+}
+trap cleanup EXIT
+step() { echo "container-check: $*"; }
+
+step "installing podman, runc, mmdebstrap and docker-compose if missing"
+missing=()
+for p in podman runc mmdebstrap docker-compose uidmap; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get update -qq &&
+    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends \
+      "${missing[@]}" >/dev/null || fail "could not install ${missing[*]}"
+fi
+PODMAN=(podman --runtime runc)
+
+if ss -ltn 2>/dev/null | grep -q ":$PORT "; then
+  fail "port $PORT is in use on this host (the container runs with host networking)"
+fi
+
+if ! "${PODMAN[@]}" image exists "$BASE_IMAGE"; then
+  step "making the base image $BASE_IMAGE with mmdebstrap"
+  mmdebstrap --variant=minbase --quiet bookworm "$WORK/base.tar" ||
+    fail "mmdebstrap could not make a bookworm base"
+  "${PODMAN[@]}" import "$WORK/base.tar" "$BASE_IMAGE" >/dev/null ||
+    fail "podman could not import the base image"
+fi
+
+step "building $IMAGE (builds and tests the project inside the builder stage)"
+"${PODMAN[@]}" build --isolation chroot --network host --format docker \
+  -f docker/Dockerfile -t "$IMAGE" . >"$WORK/build.log" 2>&1 || {
+  tail -40 "$WORK/build.log"
+  fail "image build failed (log above)"
+}
+
+step "checking the runtime image holds no compiler and no -dev package"
+leftovers=$("${PODMAN[@]}" run --rm --network host --entrypoint /bin/sh "$IMAGE" -c \
+  'for c in gcc g++ cc c++ clang; do command -v $c; done; dpkg-query -W -f="\${Package}\n" | grep -- "-dev$"' \
+  2>/dev/null)
+[ -z "$leftovers" ] || fail "runtime image contains build tools or -dev packages: $leftovers"
+
+step "starting the container"
+"${PODMAN[@]}" run -d --name "$CONTAINER" --network host "$IMAGE" >/dev/null ||
+  fail "container did not start"
+
+step "waiting for the health check to pass"
+healthy=0
+for _ in $(seq 1 60); do
+  if "${PODMAN[@]}" healthcheck run "$CONTAINER" >/dev/null 2>&1; then healthy=1; break; fi
+  sleep 1
+done
+[ "$healthy" = 1 ] || {
+  "${PODMAN[@]}" logs "$CONTAINER" 2>&1 | tail -20
+  fail "health check did not pass within 60 s"
+}
+
+step "checking the server process runs as non-root"
+uid=$("${PODMAN[@]}" exec "$CONTAINER" awk '/^Uid:/ {print $2}' /proc/1/status)
+[ -n "$uid" ] && [ "$uid" != 0 ] || fail "deformd runs as uid '${uid}'"
+
+step "load-testing the container for 5 s (8 streams at 90 Hz on the phantom)"
+"${PODMAN[@]}" exec "$CONTAINER" deform-loadtest --target "127.0.0.1:$PORT" --streams 8 \
+  --rate 90 --duration 5 --json --fail-on-errors >"$WORK/load.json" ||
+  fail "load test failed or counted errors: $(cat "$WORK/load.json")"
+cat "$WORK/load.json"
+
+step "sending SIGTERM and waiting up to 5 s for a clean exit"
+start=$(date +%s.%N)
+"${PODMAN[@]}" kill --signal TERM "$CONTAINER" >/dev/null || fail "could not signal the container"
+code=$(timeout 6 "${PODMAN[@]}" wait "$CONTAINER") || fail "container still running 5 s after SIGTERM"
+elapsed=$(awk -v a="$start" -v b="$(date +%s.%N)" 'BEGIN { printf "%.2f", b - a }')
+[ "$code" = 0 ] || fail "deformd exited with code $code after SIGTERM"
+step "exited 0 after SIGTERM in ${elapsed} s"
+
+step "validating docker/compose.yaml"
+docker-compose -f docker/compose.yaml config -q || fail "docker/compose.yaml is invalid"
+
+size=$("${PODMAN[@]}" image inspect --format '{{.Size}}' "$IMAGE")
+step "runtime image $IMAGE: $((size / 1000000)) MB"
+echo "container-check: PASSED"

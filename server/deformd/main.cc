@@ -1,0 +1,142 @@
+// deformd: the real-time deformation server.
+//
+//   deformd [--listen ADDR] [--workers N] [--max-vertices N] [--max-meshes N] [--max-memory-mb N]
+//           [--max-message-mb N] [--max-upload-mb N] [--log-level LEVEL]
+//           [--preload MESH:SKELETON]... [--preload-phantom N]...
+//
+// Preloaded meshes are built before the server listens. SIGTERM or SIGINT drains: open streams
+// end with UNAVAILABLE, calls in progress get a few seconds, then the process exits 0.
+#include <pthread.h>
+#include <spdlog/spdlog.h>
+
+#include <CLI/CLI.hpp>
+#include <csignal>
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "core/model_input.h"
+#include "service/deform_server.h"
+#include "service/service_options.h"
+
+namespace {
+
+using deform::service::DeformServer;
+using deform::service::ServerOptions;
+
+struct Args {
+  ServerOptions server;
+  std::size_t max_memory_mb = 4096;
+  int max_message_mb = 64;
+  std::size_t max_upload_mb = 256;
+  std::string log_level = "info";
+  std::vector<std::string> preload;
+  std::vector<int> preload_phantom;
+  double shutdown_grace_s = 5;
+};
+
+bool PreloadAll(const Args& args, DeformServer* server) {
+  const deform::MeshLimits limits{args.server.limits.max_vertices,
+                                  deform::MeshLimits{}.max_triangles};
+  for (const std::string& spec : args.preload) {
+    const std::size_t colon = spec.rfind(':');
+    if (colon == std::string::npos || colon == 0 || colon + 1 == spec.size()) {
+      spdlog::error("--preload '{}' is not MESH:SKELETON", spec);
+      return false;
+    }
+    auto input = deform::LoadModelInput(spec.substr(0, colon), spec.substr(colon + 1), 0, limits);
+    if (!input.ok()) {
+      spdlog::error("--preload '{}': {}", spec, input.status().ToString());
+      return false;
+    }
+    const std::string name = input->description;
+    auto entry = server->Preload(std::move(*input), name);
+    if (!entry.ok()) {
+      spdlog::error("--preload '{}': {}", spec, entry.status().ToString());
+      return false;
+    }
+  }
+  for (const int vertices : args.preload_phantom) {
+    auto input = deform::LoadModelInput("", "", vertices, limits);
+    if (!input.ok()) {
+      spdlog::error("--preload-phantom {}: {}", vertices, input.status().ToString());
+      return false;
+    }
+    const std::string name = input->description;
+    auto entry = server->Preload(std::move(*input), name);
+    if (!entry.ok()) {
+      spdlog::error("--preload-phantom {}: {}", vertices, entry.status().ToString());
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // Every thread inherits this mask; the main thread alone takes the signals, with sigwait().
+  sigset_t stop_signals;
+  sigemptyset(&stop_signals);
+  sigaddset(&stop_signals, SIGINT);
+  sigaddset(&stop_signals, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
+
+  Args args;
+  CLI::App app{"deformd: real-time skeleton-driven deformation server (gRPC deform.v1)"};
+  app.add_option("--listen", args.server.listen_address, "Address to listen on, host:port")
+      ->capture_default_str();
+  app.add_option("--workers", args.server.workers,
+                 "Worker threads for solves and precomputation; 0 = one per core")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1024));
+  app.add_option("--max-vertices", args.server.limits.max_vertices, "Largest mesh, in vertices")
+      ->capture_default_str();
+  app.add_option("--max-meshes", args.server.limits.max_meshes, "Meshes loaded at once")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1 << 20));
+  app.add_option("--max-memory-mb", args.max_memory_mb,
+                 "Memory budget for loaded meshes (factor + geometry estimate), MiB")
+      ->capture_default_str();
+  app.add_option("--max-message-mb", args.max_message_mb, "Largest gRPC message, MiB")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 2047));
+  app.add_option("--max-upload-mb", args.max_upload_mb, "Largest LoadMesh upload, MiB")
+      ->capture_default_str();
+  app.add_option("--log-level", args.log_level, "trace, debug, info, warn, error or off")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
+  app.add_option("--preload", args.preload,
+                 "Load MESH:SKELETON (files) before serving; repeatable");
+  app.add_option("--preload-phantom", args.preload_phantom,
+                 "Load the knee phantom with about N vertices before serving; repeatable");
+  app.add_option("--shutdown-grace-s", args.shutdown_grace_s,
+                 "On SIGTERM/SIGINT, seconds given to calls in progress")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 600.0));
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+
+  spdlog::set_level(spdlog::level::from_str(args.log_level));
+  spdlog::set_pattern("[%Y-%m-%d %H:%M:%S.%e] [%^%l%$] %v");
+  args.server.limits.max_memory_bytes = args.max_memory_mb << 20;
+  args.server.limits.max_upload_bytes = args.max_upload_mb << 20;
+  args.server.max_message_bytes = args.max_message_mb << 20;
+
+  DeformServer server(args.server);
+  if (!PreloadAll(args, &server)) return 1;
+  const deform::Status started = server.Start();
+  if (!started.ok()) {
+    spdlog::error("{}", started.ToString());
+    return 1;
+  }
+
+  int signal_number = 0;
+  sigwait(&stop_signals, &signal_number);
+  spdlog::info("received {}, shutting down", signal_number == SIGTERM ? "SIGTERM" : "SIGINT");
+  server.Shutdown(std::chrono::milliseconds(static_cast<long>(args.shutdown_grace_s * 1000)));
+  return 0;
+}

@@ -1,0 +1,94 @@
+#include "service/deform_server.h"
+
+#include <grpcpp/ext/proto_server_reflection_plugin.h>
+#include <grpcpp/grpcpp.h>
+#include <grpcpp/health_check_service_interface.h>
+#include <spdlog/spdlog.h>
+
+#include <mutex>
+
+#include "service/deform_service.h"
+#include "service/mesh_loader.h"
+#include "service/service_core.h"
+
+namespace deform::service {
+
+struct DeformServer::Impl {
+  explicit Impl(const ServerOptions& server_options)
+      : options(server_options), core(server_options), service(&core) {}
+
+  const ServerOptions options;
+  ServiceCore core;
+  DeformServiceImpl service;
+  std::unique_ptr<grpc::Server> server;
+  int port = 0;
+  std::mutex shutdown_mutex;
+  bool shut_down = false;
+};
+
+DeformServer::DeformServer(const ServerOptions& options) : impl_(std::make_unique<Impl>(options)) {}
+
+DeformServer::~DeformServer() { Shutdown(); }
+
+Status DeformServer::Start() {
+  if (impl_->server != nullptr) return Status::FailedPrecondition("the server is already started");
+  grpc::EnableDefaultHealthCheckService(true);
+  grpc::reflection::InitProtoReflectionServerBuilderPlugin();
+  grpc::ServerBuilder builder;
+  builder.AddListeningPort(impl_->options.listen_address, grpc::InsecureServerCredentials(),
+                           &impl_->port);
+  builder.RegisterService(&impl_->service);
+  builder.SetMaxReceiveMessageSize(impl_->options.max_message_bytes);
+  builder.SetMaxSendMessageSize(impl_->options.max_message_bytes);
+  impl_->server = builder.BuildAndStart();
+  if (impl_->server == nullptr || impl_->port == 0) {
+    impl_->server.reset();
+    return Status::FailedPrecondition("cannot listen on '" + impl_->options.listen_address + "'");
+  }
+  if (grpc::HealthCheckServiceInterface* health = impl_->server->GetHealthCheckService()) {
+    health->SetServingStatus(v1::DeformService::service_full_name(), true);
+  }
+  spdlog::info("listening on {} with {} workers", listening_address(), impl_->core.pool.size());
+  return Status::Ok();
+}
+
+int DeformServer::port() const { return impl_->port; }
+
+std::string DeformServer::listening_address() const {
+  const std::string& address = impl_->options.listen_address;
+  const std::size_t colon = address.rfind(':');
+  const std::string host = colon == std::string::npos ? address : address.substr(0, colon);
+  return host + ":" + std::to_string(impl_->port);
+}
+
+StatusOr<std::shared_ptr<const MeshEntry>> DeformServer::Preload(ModelInput input,
+                                                                 const std::string& name) {
+  DEFORM_ASSIGN_OR_RETURN(MeshRegistry::Reservation reservation, impl_->core.registry.Reserve());
+  LoadJob job;
+  job.name = name.empty() ? input.description : name;
+  job.mesh = std::move(input.mesh);
+  job.skeleton = std::move(input.skeleton);
+  job.options = ModelOptions::Paper();
+  return BuildAndRegister(&impl_->core.registry, std::move(reservation), std::move(job));
+}
+
+void DeformServer::Shutdown(std::chrono::milliseconds grace) {
+  std::lock_guard<std::mutex> lock(impl_->shutdown_mutex);
+  if (impl_->shut_down) return;
+  impl_->shut_down = true;
+  if (impl_->server != nullptr) {
+    spdlog::info("draining: {} open streams", impl_->core.streams.count());
+    if (grpc::HealthCheckServiceInterface* health = impl_->server->GetHealthCheckService()) {
+      health->SetServingStatus(false);
+    }
+    impl_->core.streams.DrainAll();
+    impl_->server->Shutdown(std::chrono::system_clock::now() + grace);
+    impl_->server->Wait();
+  }
+  impl_->core.pool.Shutdown();
+  spdlog::info("stopped");
+}
+
+ServiceCore& DeformServer::core() { return impl_->core; }
+
+}  // namespace deform::service

@@ -1,0 +1,33 @@
+// The deform.v1.DeformService implementation: a thin layer that converts messages, looks things
+// up in the ServiceCore and maps statuses. Streaming RPCs get their own reactors
+// (load_mesh_reactor.h, deform_stream_reactor.h). Thread-safe; `core` must outlive it.
+#pragma once
+
+#include "deform/v1/deform.grpc.pb.h"
+#include "service/service_core.h"
+
+namespace deform::service {
+
+class DeformServiceImpl final : public v1::DeformService::CallbackService {
+ public:
+  explicit DeformServiceImpl(ServiceCore* core) : core_(core) {}
+
+  grpc::ServerBidiReactor<v1::LoadMeshRequest, v1::LoadMeshProgress>* LoadMesh(
+      grpc::CallbackServerContext* context) override;
+  grpc::ServerUnaryReactor* GetMeshInfo(grpc::CallbackServerContext* context,
+                                        const v1::GetMeshInfoRequest* request,
+                                        v1::MeshInfo* response) override;
+  grpc::ServerUnaryReactor* ListMeshes(grpc::CallbackServerContext* context,
+                                       const v1::ListMeshesRequest* request,
+                                       v1::ListMeshesResponse* response) override;
+  grpc::ServerUnaryReactor* UnloadMesh(grpc::CallbackServerContext* context,
+                                       const v1::UnloadMeshRequest* request,
+                                       v1::UnloadMeshResponse* response) override;
+  grpc::ServerBidiReactor<v1::DeformRequest, v1::DeformResponse>* Deform(
+      grpc::CallbackServerContext* context) override;
+
+ private:
+  ServiceCore* const core_;
+};
+
+}  // namespace deform::service

@@ -1,0 +1,23 @@
+// The LoadMesh RPC: one reactor per call (deletes itself when gRPC and the worker are done).
+//
+// Reads the header, then the upload's chunks into memory (checking the announced size and the
+// upload limit as they come), then on half-close sends RECEIVED and hands parsing, validation and
+// precomputation to the worker pool (background priority). Progress messages (VALIDATED, WEIGHTS,
+// FACTORISED, READY) are written in order, one write in flight at a time; the call ends with OK
+// after READY, or with the mapped error status (INVALID_ARGUMENT naming the problem,
+// RESOURCE_EXHAUSTED for limits). A mesh slot is reserved when the header arrives, so a client
+// over the mesh limit is refused before it sends its bytes.
+#pragma once
+
+#include <grpcpp/support/server_callback.h>
+
+#include "deform/v1/deform.pb.h"
+#include "service/service_core.h"
+
+namespace deform::service {
+
+// A new reactor for one LoadMesh call. `core` must outlive it.
+grpc::ServerBidiReactor<v1::LoadMeshRequest, v1::LoadMeshProgress>* NewLoadMeshReactor(
+    ServiceCore* core);
+
+}  // namespace deform::service

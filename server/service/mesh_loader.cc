@@ -1,0 +1,47 @@
+#include "service/mesh_loader.h"
+
+#include <spdlog/spdlog.h>
+
+#include <utility>
+
+namespace deform::service {
+namespace {
+
+double MillisecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+}  // namespace
+
+StatusOr<std::shared_ptr<const MeshEntry>> BuildAndRegister(MeshRegistry* registry,
+                                                            MeshRegistry::Reservation reservation,
+                                                            LoadJob job,
+                                                            const LoadProgress& progress) {
+  job.options.limits.max_vertices = registry->limits().max_vertices;
+  DEFORM_RETURN_IF_ERROR(ValidateMesh(job.mesh, job.options.limits).WithContext("mesh"));
+  const std::size_t geometry_bytes = static_cast<std::size_t>(job.mesh.num_vertices()) * 400 +
+                                     static_cast<std::size_t>(job.mesh.num_triangles()) * 12;
+  DEFORM_RETURN_IF_ERROR(registry->CheckMemoryAvailable(geometry_bytes));
+  if (progress) progress(LoadStage::kValidated, MillisecondsSince(job.start));
+
+  const double build_start_ms = MillisecondsSince(job.start);
+  const int vertices = job.mesh.num_vertices();
+  DEFORM_ASSIGN_OR_RETURN(
+      std::shared_ptr<const DeformationModel> model,
+      DeformationModel::Build(std::move(job.mesh), std::move(job.skeleton), job.options));
+  if (progress) {
+    progress(LoadStage::kWeights, build_start_ms + model->precompute_seconds() * 1e3);
+    progress(LoadStage::kFactorised, MillisecondsSince(job.start));
+  }
+  DEFORM_ASSIGN_OR_RETURN(std::shared_ptr<const MeshEntry> entry,
+                          registry->Register(std::move(reservation), job.name, std::move(model)));
+  spdlog::info(
+      "mesh={} name='{}' loaded: {} vertices, precompute {:.1f} ms, factor {:.1f} ms, "
+      "about {} KiB",
+      entry->id, entry->name, vertices, entry->precompute_ms, entry->factor_ms,
+      entry->memory_bytes >> 10);
+  return entry;
+}
+
+}  // namespace deform::service

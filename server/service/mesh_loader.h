@@ -1,0 +1,48 @@
+// Turns a parsed mesh and skeleton into a registered deformation model, reporting the stages a
+// LoadMesh client sees. Shared by the LoadMesh RPC and the server's --preload flags.
+//
+// Runs for as long as the precomputation takes (about a second per 100k vertices): call it on a
+// worker thread, never on a gRPC thread. Thread-safe; `progress` is called on the calling thread.
+#pragma once
+
+#include <chrono>
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "core/deformation_model.h"
+#include "core/mesh.h"
+#include "core/skeleton.h"
+#include "core/status.h"
+#include "service/mesh_registry.h"
+
+namespace deform::service {
+
+enum class LoadStage {
+  kValidated,   // mesh and skeleton checked
+  kWeights,     // weights, regions and symbolic analysis done (reported when Build returns)
+  kFactorised,  // first numeric factorisation done
+};
+
+// `elapsed_ms` is measured from the `start` given to BuildAndRegister. kWeights is reported after
+// DeformationModel::Build returns (the two are not separable from outside) with the time at which
+// its precomputation part ended.
+using LoadProgress = std::function<void(LoadStage stage, double elapsed_ms)>;
+
+struct LoadJob {
+  std::string name;
+  TriangleMesh mesh;
+  Skeleton skeleton;
+  ModelOptions options;  // options.limits.max_vertices is set from the registry's limits
+  std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
+};
+
+// Validates (ValidateMesh against the registry's vertex limit, the memory budget for the
+// geometry), builds the model and registers it with `reservation`. Errors: INVALID_ARGUMENT for a
+// bad mesh or options (naming the problem), RESOURCE_EXHAUSTED for limits.
+StatusOr<std::shared_ptr<const MeshEntry>> BuildAndRegister(MeshRegistry* registry,
+                                                            MeshRegistry::Reservation reservation,
+                                                            LoadJob job,
+                                                            const LoadProgress& progress = {});
+
+}  // namespace deform::service

@@ -1,0 +1,39 @@
+// A client's pose, checked and resolved against a skeleton, ready to become a core Pose.
+//
+// The Deform stream converts each PoseUpdate as it arrives (on the gRPC thread: name look-ups
+// only) and solves it later on a worker. PoseInput's vectors keep their capacity when refilled,
+// so a stream that recycles its PoseInputs allocates nothing per pose once warmed up.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <chrono>
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "core/pose.h"
+#include "core/skeleton.h"
+#include "core/status.h"
+#include "deform/v1/deform.pb.h"
+
+namespace deform::service {
+
+struct PoseInput {
+  std::uint64_t sequence = 0;
+  std::int64_t client_timestamp_ns = 0;
+  std::chrono::steady_clock::time_point arrival;
+  std::vector<PoseTerm> angles;                               // in the order sent
+  std::vector<std::pair<int, Eigen::Quaterniond>> rotations;  // unit quaternions, in order
+};
+
+// Fills `input` from `update` (sequence, timestamp, resolved angles and rotations; `arrival` is
+// left to the caller). INVALID_ARGUMENT naming the problem for an unknown joint or axis, an angle
+// or quaternion component that is NaN or infinite, or a zero quaternion.
+Status PoseInputFromProto(const v1::PoseUpdate& update, const Skeleton& skeleton, PoseInput* input);
+
+// The core pose of `input`: per joint, its rotations (composed in order), then its angles
+// (composed in order, named degrees of freedom clamped to their range). Returns the number of
+// angles clamped. `pose`'s buffers are reused: allocation-free once sized.
+StatusOr<int> PoseFromInput(const Skeleton& skeleton, const PoseInput& input, Pose* pose);
+
+}  // namespace deform::service

@@ -1,0 +1,186 @@
+#include "service/proto_conversion.h"
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <string>
+
+namespace deform::service {
+namespace {
+
+void PutUint32(std::uint32_t bits, char* out) {
+  out[0] = static_cast<char>(bits & 0xffu);
+  out[1] = static_cast<char>((bits >> 8) & 0xffu);
+  out[2] = static_cast<char>((bits >> 16) & 0xffu);
+  out[3] = static_cast<char>((bits >> 24) & 0xffu);
+}
+
+Status CheckWeight(double weight, const std::string& what) {
+  if (!std::isfinite(weight) || weight <= 0 || weight > kMaxMaterialWeight) {
+    return Status::InvalidArgument(what + " must be finite and in (0, " +
+                                   std::to_string(kMaxMaterialWeight) + "], got " +
+                                   std::to_string(weight));
+  }
+  return Status::Ok();
+}
+
+// Zero fields keep `defaults`; set fields must be valid weights.
+StatusOr<JointMaterial> MaterialFromProto(const v1::JointMaterial& proto,
+                                          const JointMaterial& defaults, const std::string& what) {
+  JointMaterial material = defaults;
+  if (proto.rigid() != 0) material.rigid = proto.rigid();
+  if (proto.soft() != 0) material.soft = proto.soft();
+  if (proto.seam() != 0) material.seam = proto.seam();
+  DEFORM_RETURN_IF_ERROR(CheckWeight(material.rigid, what + " rigid weight"));
+  DEFORM_RETURN_IF_ERROR(CheckWeight(material.soft, what + " soft weight"));
+  DEFORM_RETURN_IF_ERROR(CheckWeight(material.seam, what + " seam weight"));
+  return material;
+}
+
+StatusOr<int> JointOf(const Skeleton& skeleton, const std::string& name, const char* what) {
+  auto joint = skeleton.FindJoint(name);
+  if (!joint.ok()) {
+    return Status::InvalidArgument(std::string(what) + ": " + joint.status().message());
+  }
+  return *joint;
+}
+
+// The joint index of a stiffness term, which must have a joint region.
+StatusOr<int> RegionJointOf(const DeformationModel& model, const std::string& name,
+                            const char* what) {
+  DEFORM_ASSIGN_OR_RETURN(const int joint, JointOf(model.skeleton(), name, what));
+  for (const JointRegion& region : model.joint_regions().regions) {
+    if (region.joint == joint) return joint;
+  }
+  return Status::InvalidArgument(std::string(what) + ": joint '" +
+                                 model.skeleton().joint(joint).name +
+                                 "' has no joint region (only inner joints have a material)");
+}
+
+}  // namespace
+
+StatusOr<ModelOptions> ModelOptionsFromProto(const v1::MethodOptions& proto,
+                                             const Skeleton& skeleton) {
+  ModelOptions options = ModelOptions::Paper();
+  if (proto.region_radius_factor() != 0) {
+    if (!std::isfinite(proto.region_radius_factor()) || proto.region_radius_factor() < 0) {
+      return Status::InvalidArgument("region_radius_factor must be positive and finite, got " +
+                                     std::to_string(proto.region_radius_factor()));
+    }
+    options.regions.radius_factor = proto.region_radius_factor();
+  }
+  for (const v1::JointRadius& radius : proto.region_radii()) {
+    DEFORM_ASSIGN_OR_RETURN(const int joint, JointOf(skeleton, radius.joint(), "region_radii"));
+    if (!std::isfinite(radius.radius()) || radius.radius() <= 0) {
+      return Status::InvalidArgument("region radius of joint '" + radius.joint() +
+                                     "' must be positive and finite, got " +
+                                     std::to_string(radius.radius()));
+    }
+    options.regions.explicit_radius.emplace_back(joint, radius.radius());
+  }
+  if (proto.has_default_material()) {
+    DEFORM_ASSIGN_OR_RETURN(
+        options.default_material,
+        MaterialFromProto(proto.default_material(), JointMaterial{}, "default material"));
+  }
+  return options;
+}
+
+StatusOr<Stiffness> StiffnessFromProto(const v1::StiffnessUpdate& proto,
+                                       const DeformationModel& model) {
+  Stiffness stiffness;
+  for (const v1::JointMaterialUpdate& update : proto.joint_materials()) {
+    DEFORM_ASSIGN_OR_RETURN(const int joint,
+                            RegionJointOf(model, update.joint(), "joint_materials"));
+    DEFORM_ASSIGN_OR_RETURN(const JointMaterial material,
+                            MaterialFromProto(update.material(), model.options().default_material,
+                                              "material of joint '" + update.joint() + "'"));
+    stiffness.joint_materials.emplace_back(joint, material);
+  }
+  for (const v1::RegionWeight& weight : proto.region_weights()) {
+    DEFORM_ASSIGN_OR_RETURN(const int joint,
+                            RegionJointOf(model, weight.joint(), "region_weights"));
+    DEFORM_RETURN_IF_ERROR(
+        CheckWeight(weight.weight(), "region weight of joint '" + weight.joint() + "'"));
+    stiffness.region_weights.emplace_back(joint, weight.weight());
+  }
+  if (proto.vertex_indices_size() != proto.vertex_weights_size()) {
+    return Status::InvalidArgument(
+        "vertex_indices has " + std::to_string(proto.vertex_indices_size()) +
+        " entries but vertex_weights has " + std::to_string(proto.vertex_weights_size()));
+  }
+  const std::uint32_t vertices = static_cast<std::uint32_t>(model.mesh().num_vertices());
+  stiffness.vertex_weights.reserve(proto.vertex_indices_size());
+  for (int k = 0; k < proto.vertex_indices_size(); ++k) {
+    const std::uint32_t vertex = proto.vertex_indices(k);
+    if (vertex >= vertices) {
+      return Status::InvalidArgument("vertex_indices[" + std::to_string(k) +
+                                     "] = " + std::to_string(vertex) + " but the mesh has " +
+                                     std::to_string(vertices) + " vertices");
+    }
+    DEFORM_RETURN_IF_ERROR(
+        CheckWeight(proto.vertex_weights(k), "weight of vertex " + std::to_string(vertex)));
+    stiffness.vertex_weights.emplace_back(static_cast<int>(vertex), proto.vertex_weights(k));
+  }
+  return stiffness;
+}
+
+void FillMeshSummary(const MeshEntry& entry, v1::MeshSummary* summary) {
+  const DeformationModel& model = *entry.model;
+  const Skeleton& skeleton = model.skeleton();
+  summary->set_mesh_id(entry.id);
+  summary->set_name(entry.name);
+  summary->set_vertex_count(static_cast<std::uint32_t>(model.mesh().num_vertices()));
+  summary->set_triangle_count(static_cast<std::uint32_t>(model.mesh().num_triangles()));
+  summary->set_bone_count(static_cast<std::uint32_t>(skeleton.num_bones()));
+  summary->set_factor_bytes(entry.factor_bytes);
+  summary->set_precompute_ms(entry.precompute_ms);
+  summary->set_factor_ms(entry.factor_ms);
+  summary->set_open_streams(static_cast<std::uint32_t>(entry.open_streams.load()));
+  summary->clear_joints();
+  for (int j = 0; j < skeleton.num_joints(); ++j) {
+    const Joint& joint = skeleton.joint(j);
+    v1::JointInfo* info = summary->add_joints();
+    info->set_name(joint.name);
+    info->set_index(static_cast<std::uint32_t>(j));
+    for (int c = 0; c < 3; ++c) info->add_rest_position(joint.rest_position[c]);
+    for (const DegreeOfFreedom& dof : joint.dofs) {
+      v1::DegreeOfFreedom* out = info->add_dofs();
+      out->set_name(dof.name);
+      for (int c = 0; c < 3; ++c) out->add_axis(dof.axis[c]);
+      out->set_min_degrees(dof.min_degrees);
+      out->set_max_degrees(dof.max_degrees);
+    }
+    bool has_region = false;
+    for (const JointRegion& region : model.joint_regions().regions) {
+      has_region = has_region || region.joint == j;
+    }
+    info->set_has_region(has_region);
+  }
+}
+
+void FillMeshGeometry(const DeformationModel& model, v1::MeshInfo* info) {
+  const TriangleMesh& mesh = model.mesh();
+  std::string* positions = info->mutable_rest_positions();
+  positions->resize(static_cast<std::size_t>(mesh.num_vertices()) * 3 * 4);
+  EncodeFloat32(mesh.vertices.data(), static_cast<std::size_t>(mesh.num_vertices()) * 3,
+                positions->data());
+  std::string* triangles = info->mutable_triangles();
+  const std::size_t indices = static_cast<std::size_t>(mesh.num_triangles()) * 3;
+  triangles->resize(indices * 4);
+  const int* source = mesh.triangles.data();
+  for (std::size_t k = 0; k < indices; ++k) {
+    PutUint32(static_cast<std::uint32_t>(source[k]), triangles->data() + 4 * k);
+  }
+}
+
+void EncodeFloat32(const double* values, std::size_t count, char* out) {
+  for (std::size_t k = 0; k < count; ++k) {
+    const float value = static_cast<float>(values[k]);
+    std::uint32_t bits;
+    std::memcpy(&bits, &value, sizeof(bits));
+    PutUint32(bits, out + 4 * k);
+  }
+}
+
+}  // namespace deform::service

@@ -1,0 +1,31 @@
+// Limits and settings of the deformation service. Plain values, no behaviour.
+#pragma once
+
+#include <cstddef>
+#include <string>
+
+namespace deform::service {
+
+struct ServiceLimits {
+  // Meshes with more vertices are refused with RESOURCE_EXHAUSTED. Default: 2,000,000.
+  std::size_t max_vertices = 2'000'000;
+  // Meshes loaded (or being loaded) at once. Default: 64.
+  int max_meshes = 64;
+  // Budget for loaded meshes, estimated from factor bytes and geometry (EstimateModelBytes).
+  // Default: 4 GiB.
+  std::size_t max_memory_bytes = std::size_t{4} << 30;
+  // Largest upload (mesh file plus skeleton file) accepted by LoadMesh. Default: 256 MiB.
+  std::size_t max_upload_bytes = std::size_t{256} << 20;
+};
+
+struct ServerOptions {
+  // "host:port"; port 0 picks a free port (DeformServer::port() tells which). Default: loopback.
+  std::string listen_address = "127.0.0.1:50051";
+  // Worker threads for solves and precomputation; <= 0 means the number of cores. Default: 0.
+  int workers = 0;
+  // Largest gRPC message received or sent. Default: 64 MiB.
+  int max_message_bytes = 64 << 20;
+  ServiceLimits limits;
+};
+
+}  // namespace deform::service

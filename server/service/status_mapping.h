@@ -1,0 +1,16 @@
+// The one place where the core's error values become gRPC statuses.
+//
+// deform::StatusCode mirrors the canonical gRPC codes one to one, so the mapping keeps the code
+// and the message unchanged. Thread-safe (pure functions).
+#pragma once
+
+#include <grpcpp/support/status.h>
+
+#include "core/status.h"
+
+namespace deform::service {
+
+grpc::StatusCode ToGrpcCode(StatusCode code);
+grpc::Status ToGrpcStatus(const Status& status);
+
+}  // namespace deform::service

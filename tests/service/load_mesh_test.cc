@@ -1,0 +1,332 @@
+// LoadMesh, GetMeshInfo, ListMeshes and UnloadMesh through the client library, with each class of
+// bad input answered by its status while another client's stream goes on.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "core/mesh_io.h"
+#include "core/phantom.h"
+#include "core/skeleton.h"
+#include "tests/service/service_fixture.h"
+#include "tests/shared_data.h"
+
+namespace deform::testing {
+namespace {
+
+using ::testing::ElementsAre;
+using ::testing::HasSubstr;
+using ::testing::StartsWith;
+
+// A phantom written as OBJ bytes with its skeleton as JSON: an upload that needs no shared data.
+struct UploadFiles {
+  std::string mesh_path;
+  std::string skeleton_path;
+  std::string mesh_bytes;
+  std::string skeleton_bytes;
+  int vertices = 0;
+};
+
+UploadFiles WritePhantomFiles(int vertices) {
+  UploadFiles files;
+  auto phantom = MakeKneePhantom(vertices);
+  EXPECT_TRUE(phantom.ok());
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() /
+      ("deform_service_test_" + std::to_string(::getpid()) + "_" + std::to_string(vertices));
+  std::filesystem::create_directories(dir);
+  files.mesh_path = (dir / "phantom.obj").string();
+  files.skeleton_path = (dir / "phantom.json").string();
+  EXPECT_TRUE(WriteMeshFile(phantom->mesh, files.mesh_path).ok());
+  files.skeleton_bytes = SkeletonToJson(phantom->skeleton);
+  std::ofstream(files.skeleton_path) << files.skeleton_bytes;
+  std::ifstream in(files.mesh_path, std::ios::binary);
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  files.mesh_bytes = bytes.str();
+  files.vertices = phantom->mesh.num_vertices();
+  return files;
+}
+
+class LoadMeshTest : public ServiceTest {};
+
+TEST_F(LoadMeshTest, PhantomLoadReportsEveryStageInOrder) {
+  StartServer();
+  std::vector<v1::LoadMeshProgress::Stage> stages;
+  std::vector<double> elapsed;
+  v1::MeshSummary summary;
+  const grpc::Status status = client_->LoadPhantom(
+      600, {}, &summary,
+      [&](const v1::LoadMeshProgress& progress) {
+        stages.push_back(progress.stage());
+        elapsed.push_back(progress.elapsed_ms());
+      },
+      "knee");
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_THAT(stages, ElementsAre(v1::LoadMeshProgress::RECEIVED, v1::LoadMeshProgress::VALIDATED,
+                                  v1::LoadMeshProgress::WEIGHTS, v1::LoadMeshProgress::FACTORISED,
+                                  v1::LoadMeshProgress::READY));
+  for (std::size_t k = 1; k < elapsed.size(); ++k) EXPECT_LE(elapsed[k - 1], elapsed[k]);
+
+  auto phantom = MakeKneePhantom(600);
+  ASSERT_TRUE(phantom.ok());
+  EXPECT_EQ(summary.name(), "knee");
+  EXPECT_EQ(summary.vertex_count(), static_cast<std::uint32_t>(phantom->mesh.num_vertices()));
+  EXPECT_EQ(summary.triangle_count(), static_cast<std::uint32_t>(phantom->mesh.num_triangles()));
+  EXPECT_EQ(summary.bone_count(), 2u);
+  EXPECT_GT(summary.factor_bytes(), 0u);
+  ASSERT_EQ(summary.joints_size(), 3);
+  EXPECT_EQ(summary.joints(1).name(), "knee");
+  EXPECT_TRUE(summary.joints(1).has_region());
+  EXPECT_FALSE(summary.joints(0).has_region());
+  ASSERT_GE(summary.joints(1).dofs_size(), 1);
+  EXPECT_EQ(summary.joints(1).dofs(0).name(), "flexion");
+
+  std::vector<v1::MeshSummary> meshes;
+  ASSERT_TRUE(client_->ListMeshes(&meshes).ok());
+  ASSERT_EQ(meshes.size(), 2u);  // the background mesh and this one
+  EXPECT_EQ(meshes[0].mesh_id(), background_mesh_id_);
+  EXPECT_EQ(meshes[0].open_streams(), 1u);
+  EXPECT_EQ(meshes[1].mesh_id(), summary.mesh_id());
+
+  v1::MeshInfo info;
+  ASSERT_TRUE(client_->GetMeshInfo(summary.mesh_id(), true, &info).ok());
+  EXPECT_EQ(info.summary().mesh_id(), summary.mesh_id());
+  const std::vector<float> rest = client::DecodePositions(info.rest_positions());
+  ASSERT_EQ(rest.size(), 3u * phantom->mesh.num_vertices());
+  for (int i = 0; i < phantom->mesh.num_vertices(); ++i) {
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_FLOAT_EQ(rest[3 * i + c], static_cast<float>(phantom->mesh.vertices(i, c)));
+    }
+  }
+  EXPECT_EQ(info.triangles().size(), 12u * phantom->mesh.num_triangles());
+  v1::MeshInfo without;
+  ASSERT_TRUE(client_->GetMeshInfo(summary.mesh_id(), false, &without).ok());
+  EXPECT_TRUE(without.rest_positions().empty());
+  ExpectBackgroundStreamAlive();
+}
+
+TEST_F(LoadMeshTest, UploadedFilesBuildTheMesh) {
+  StartServer();
+  const UploadFiles files = WritePhantomFiles(800);
+  v1::MeshSummary summary;
+  std::vector<v1::LoadMeshProgress::Stage> stages;
+  const grpc::Status status = client_->LoadMeshFiles(
+      files.mesh_path, files.skeleton_path, {}, &summary,
+      [&](const v1::LoadMeshProgress& progress) { stages.push_back(progress.stage()); });
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(summary.vertex_count(), static_cast<std::uint32_t>(files.vertices));
+  EXPECT_EQ(summary.name(), "phantom.obj");
+  EXPECT_EQ(stages.back(), v1::LoadMeshProgress::READY);
+  EXPECT_EQ(stages.front(), v1::LoadMeshProgress::RECEIVED);
+
+  // Small chunks arrive the same.
+  client::ClientOptions small_chunks;
+  small_chunks.upload_chunk_bytes = 1000;
+  client::DeformClient chunked(server_->target(), small_chunks);
+  ASSERT_TRUE(chunked
+                  .LoadMeshBytes("chunked", v1::MESH_FORMAT_OBJ, files.mesh_bytes,
+                                 v1::SKELETON_FORMAT_JSON, files.skeleton_bytes, {}, &summary)
+                  .ok());
+  EXPECT_EQ(summary.vertex_count(), static_cast<std::uint32_t>(files.vertices));
+}
+
+TEST_F(LoadMeshTest, SharedLegUploads) {
+  DEFORM_REQUIRE_SHARED_FILE(mesh, "leg/leg_1633.obj");
+  DEFORM_REQUIRE_SHARED_FILE(skeleton, "leg/leg.tgf");
+  StartServer();
+  v1::MeshSummary summary;
+  const grpc::Status status = client_->LoadMeshFiles(mesh, skeleton, {}, &summary);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(summary.vertex_count(), 1633u);
+  EXPECT_EQ(summary.joints_size(), 5);
+}
+
+TEST_F(LoadMeshTest, MissingFileIsNotFoundWithoutContactingTheServer) {
+  client::DeformClient offline("127.0.0.1:1");
+  v1::MeshSummary summary;
+  EXPECT_EQ(offline.LoadMeshFiles("/nonexistent/mesh.obj", "/nonexistent/leg.tgf", {}, &summary)
+                .error_code(),
+            grpc::StatusCode::NOT_FOUND);
+}
+
+TEST_F(LoadMeshTest, UnknownMeshIsNotFound) {
+  StartServer();
+  v1::MeshInfo info;
+  const grpc::Status info_status = client_->GetMeshInfo("mesh-999", false, &info);
+  EXPECT_EQ(info_status.error_code(), grpc::StatusCode::NOT_FOUND);
+  EXPECT_THAT(info_status.error_message(), HasSubstr("mesh-999"));
+  EXPECT_EQ(client_->UnloadMesh("mesh-999").error_code(), grpc::StatusCode::NOT_FOUND);
+  EXPECT_EQ(client_->UnloadMesh("").error_code(), grpc::StatusCode::NOT_FOUND);
+  StreamRecorder recorder;
+  auto stream = client_->OpenStream("mesh-999", recorder.Callbacks());
+  EXPECT_EQ(stream->Wait().error_code(), grpc::StatusCode::NOT_FOUND);
+  ExpectBackgroundStreamAlive();
+}
+
+TEST_F(LoadMeshTest, TruncatedUploadIsInvalidArgument) {
+  StartServer();
+  grpc::ClientContext context;
+  auto stream = client_->stub()->LoadMesh(&context);
+  v1::LoadMeshRequest request;
+  v1::UploadSource* upload = request.mutable_header()->mutable_upload();
+  upload->set_format(v1::MESH_FORMAT_OBJ);
+  upload->set_mesh_bytes(1000);
+  upload->set_skeleton_format(v1::SKELETON_FORMAT_TGF);
+  upload->set_skeleton("1 0 0 0\n2 0 1 0\n#\n1 2\n#\n");
+  ASSERT_TRUE(stream->Write(request));
+  request.set_chunk(std::string(400, 'v'));
+  stream->Write(request);
+  stream->WritesDone();
+  v1::LoadMeshProgress progress;
+  while (stream->Read(&progress)) {
+  }
+  const grpc::Status status = stream->Finish();
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("truncated upload: received 400 of the 1000"));
+  ExpectBackgroundStreamAlive();
+}
+
+TEST_F(LoadMeshTest, ProtocolViolationsAreInvalidArgument) {
+  StartServer();
+  {
+    grpc::ClientContext context;
+    auto stream = client_->stub()->LoadMesh(&context);
+    v1::LoadMeshRequest request;
+    request.set_chunk("v 0 0 0\n");
+    stream->Write(request);
+    stream->WritesDone();
+    const grpc::Status status = stream->Finish();
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_THAT(status.error_message(), HasSubstr("header"));
+  }
+  {
+    grpc::ClientContext context;
+    auto stream = client_->stub()->LoadMesh(&context);
+    stream->WritesDone();
+    EXPECT_EQ(stream->Finish().error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  }
+  {
+    v1::MeshSummary summary;
+    const grpc::Status status = client_->LoadMeshBytes("x", v1::MESH_FORMAT_UNSPECIFIED, "v 0 0 0",
+                                                       v1::SKELETON_FORMAT_TGF, "#", {}, &summary);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+    EXPECT_THAT(status.error_message(), HasSubstr("format"));
+  }
+  ExpectBackgroundStreamAlive();
+}
+
+TEST_F(LoadMeshTest, GarbageMeshIsInvalidArgumentNamingTheMesh) {
+  StartServer();
+  const UploadFiles files = WritePhantomFiles(400);
+  std::string garbage;
+  for (int i = 0; i < 5000; ++i) garbage.push_back(static_cast<char>((i * 7919 + 13) % 251));
+  v1::MeshSummary summary;
+  for (const v1::MeshFormat format :
+       {v1::MESH_FORMAT_OBJ, v1::MESH_FORMAT_PLY, v1::MESH_FORMAT_STL, v1::MESH_FORMAT_OFF}) {
+    const grpc::Status status = client_->LoadMeshBytes(
+        "garbage", format, garbage, v1::SKELETON_FORMAT_JSON, files.skeleton_bytes, {}, &summary);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << format;
+    EXPECT_THAT(status.error_message(), StartsWith("mesh")) << status.error_message();
+  }
+  // A file cut in half (with the size announced right): faces lost, vertices unused.
+  const std::string half = files.mesh_bytes.substr(0, files.mesh_bytes.size() / 2);
+  const grpc::Status cut =
+      client_->LoadMeshBytes("half", v1::MESH_FORMAT_OBJ, half, v1::SKELETON_FORMAT_JSON,
+                             files.skeleton_bytes, {}, &summary);
+  EXPECT_EQ(cut.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(cut.error_message(), StartsWith("mesh")) << cut.error_message();
+  ExpectBackgroundStreamAlive();
+  std::vector<v1::MeshSummary> meshes;
+  ASSERT_TRUE(client_->ListMeshes(&meshes).ok());
+  EXPECT_EQ(meshes.size(), 1u);  // nothing half-registered
+}
+
+TEST_F(LoadMeshTest, BadSkeletonOrOptionsAreInvalidArgument) {
+  StartServer();
+  const UploadFiles files = WritePhantomFiles(400);
+  v1::MeshSummary summary;
+  const grpc::Status skeleton =
+      client_->LoadMeshBytes("bad skeleton", v1::MESH_FORMAT_OBJ, files.mesh_bytes,
+                             v1::SKELETON_FORMAT_JSON, "{ not json", {}, &summary);
+  EXPECT_EQ(skeleton.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(skeleton.error_message(), StartsWith("skeleton"));
+
+  v1::MethodOptions options;
+  v1::JointRadius* radius = options.add_region_radii();
+  radius->set_joint("elbow");
+  radius->set_radius(1);
+  const grpc::Status unknown_joint = client_->LoadPhantom(400, options, &summary);
+  EXPECT_EQ(unknown_joint.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(unknown_joint.error_message(), HasSubstr("elbow"));
+
+  v1::MethodOptions negative;
+  negative.mutable_default_material()->set_soft(-1);
+  EXPECT_EQ(client_->LoadPhantom(400, negative, &summary).error_code(),
+            grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_EQ(client_->LoadPhantom(-5, {}, &summary).error_code(),
+            grpc::StatusCode::INVALID_ARGUMENT);
+  ExpectBackgroundStreamAlive();
+}
+
+TEST_F(LoadMeshTest, TooManyVerticesIsResourceExhausted) {
+  service::ServerOptions options = TestServerOptions();
+  options.limits.max_vertices = 1000;
+  StartServer(options);
+  v1::MeshSummary summary;
+  const grpc::Status phantom = client_->LoadPhantom(2000, {}, &summary);
+  EXPECT_EQ(phantom.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_THAT(phantom.error_message(), HasSubstr("1000"));
+  const UploadFiles files = WritePhantomFiles(2000);
+  const grpc::Status upload =
+      client_->LoadMeshFiles(files.mesh_path, files.skeleton_path, {}, &summary);
+  EXPECT_EQ(upload.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << upload.error_message();
+  ExpectBackgroundStreamAlive();
+}
+
+TEST_F(LoadMeshTest, TooManyMeshesIsResourceExhausted) {
+  service::ServerOptions options = TestServerOptions();
+  options.limits.max_meshes = 2;
+  StartServer(options);
+  const std::string second = LoadPhantom(300);  // the background mesh is the first
+  v1::MeshSummary summary;
+  const grpc::Status third = client_->LoadPhantom(300, {}, &summary);
+  EXPECT_EQ(third.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_THAT(third.error_message(), HasSubstr("mesh limit"));
+  ExpectBackgroundStreamAlive();
+  ASSERT_TRUE(client_->UnloadMesh(second).ok());
+  EXPECT_TRUE(client_->LoadPhantom(300, {}, &summary).ok());
+}
+
+TEST_F(LoadMeshTest, MemoryBudgetIsResourceExhausted) {
+  service::ServerOptions options = TestServerOptions();
+  options.limits.max_memory_bytes = 1 << 20;
+  StartServer(options);
+  v1::MeshSummary summary;
+  const grpc::Status status = client_->LoadPhantom(3000, {}, &summary);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_THAT(status.error_message(), HasSubstr("memory budget"));
+  ExpectBackgroundStreamAlive();
+}
+
+TEST_F(LoadMeshTest, UploadLimitIsResourceExhausted) {
+  service::ServerOptions options = TestServerOptions();
+  options.limits.max_upload_bytes = 4096;
+  StartServer(options);
+  const UploadFiles files = WritePhantomFiles(400);
+  v1::MeshSummary summary;
+  const grpc::Status status =
+      client_->LoadMeshBytes("big", v1::MESH_FORMAT_OBJ, files.mesh_bytes, v1::SKELETON_FORMAT_JSON,
+                             files.skeleton_bytes, {}, &summary);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_THAT(status.error_message(), HasSubstr("exceeds the limit of 4096 bytes"));
+  ExpectBackgroundStreamAlive();
+}
+
+}  // namespace
+}  // namespace deform::testing

@@ -1,0 +1,102 @@
+#include "service/mesh_registry.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "core/phantom.h"
+#include "service/status_mapping.h"
+
+namespace deform::service {
+namespace {
+
+using ::testing::HasSubstr;
+
+std::shared_ptr<const DeformationModel> SmallModel() {
+  auto phantom = MakeKneePhantom(300);
+  EXPECT_TRUE(phantom.ok());
+  auto model = DeformationModel::Build(phantom->mesh, phantom->skeleton, ModelOptions::Paper());
+  EXPECT_TRUE(model.ok()) << model.status().ToString();
+  return *model;
+}
+
+TEST(MeshRegistryTest, RegistersFindsListsAndUnloads) {
+  MeshRegistry registry(ServiceLimits{});
+  const auto model = SmallModel();
+  auto reservation = registry.Reserve();
+  ASSERT_TRUE(reservation.ok());
+  auto first = registry.Register(std::move(*reservation), "first", model);
+  ASSERT_TRUE(first.ok()) << first.status().ToString();
+  auto second = registry.Register(registry.Reserve().value(), "second", model);
+  ASSERT_TRUE(second.ok());
+  EXPECT_NE((*first)->id, (*second)->id);
+  EXPECT_EQ((*first)->memory_bytes, EstimateModelBytes(*model));
+  EXPECT_EQ(registry.memory_bytes_used(), 2 * EstimateModelBytes(*model));
+
+  auto found = registry.Find((*first)->id);
+  ASSERT_TRUE(found.ok());
+  EXPECT_EQ((*found)->name, "first");
+  ASSERT_EQ(registry.List().size(), 2u);
+  EXPECT_EQ(registry.List()[0]->name, "first");
+
+  ASSERT_TRUE(registry.Unload((*first)->id).ok());
+  EXPECT_TRUE((*first)->unloaded.load());
+  EXPECT_EQ(registry.Find((*first)->id).status().code(), StatusCode::kNotFound);
+  EXPECT_EQ(registry.Unload((*first)->id).code(), StatusCode::kNotFound);
+  EXPECT_EQ(registry.Find("nonsense").status().code(), StatusCode::kNotFound);
+  EXPECT_EQ(registry.mesh_count(), 1);
+  EXPECT_EQ(registry.memory_bytes_used(), EstimateModelBytes(*model));
+}
+
+TEST(MeshRegistryTest, ReservationsCountAgainstTheMeshLimitUntilReleased) {
+  ServiceLimits limits;
+  limits.max_meshes = 2;
+  MeshRegistry registry(limits);
+  auto a = registry.Reserve();
+  auto b = registry.Reserve();
+  ASSERT_TRUE(a.ok() && b.ok());
+  auto c = registry.Reserve();
+  ASSERT_FALSE(c.ok());
+  EXPECT_EQ(c.status().code(), StatusCode::kResourceExhausted);
+  EXPECT_THAT(c.status().message(), HasSubstr("mesh limit"));
+  a->Release();
+  EXPECT_TRUE(registry.Reserve().ok());  // and released again at once
+  {
+    auto d = registry.Reserve();
+    ASSERT_TRUE(d.ok());
+    EXPECT_FALSE(registry.Reserve().ok());
+  }
+  EXPECT_TRUE(registry.Reserve().ok());
+}
+
+TEST(MeshRegistryTest, MemoryBudgetRefusesAModelThatDoesNotFit) {
+  const auto model = SmallModel();
+  ServiceLimits limits;
+  limits.max_memory_bytes = EstimateModelBytes(*model) + EstimateModelBytes(*model) / 2;
+  limits.max_meshes = 2;
+  MeshRegistry registry(limits);
+  ASSERT_TRUE(registry.Register(registry.Reserve().value(), "fits", model).ok());
+  auto refused = registry.Register(registry.Reserve().value(), "too much", model);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_EQ(refused.status().code(), StatusCode::kResourceExhausted);
+  EXPECT_THAT(refused.status().message(), HasSubstr("memory budget"));
+  EXPECT_EQ(registry.mesh_count(), 1);
+  // The refused load's slot was released: one mesh loaded, one slot free.
+  auto slot = registry.Reserve();
+  EXPECT_TRUE(slot.ok());
+  EXPECT_FALSE(registry.Reserve().ok());
+}
+
+TEST(StatusMappingTest, KeepsCodeAndMessage) {
+  EXPECT_TRUE(ToGrpcStatus(Status::Ok()).ok());
+  const grpc::Status status = ToGrpcStatus(Status::ResourceExhausted("too big"));
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_EQ(status.error_message(), "too big");
+  EXPECT_EQ(ToGrpcCode(StatusCode::kInvalidArgument), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_EQ(ToGrpcCode(StatusCode::kNotFound), grpc::StatusCode::NOT_FOUND);
+  EXPECT_EQ(ToGrpcCode(StatusCode::kOutOfRange), grpc::StatusCode::OUT_OF_RANGE);
+  EXPECT_EQ(ToGrpcCode(StatusCode::kFailedPrecondition), grpc::StatusCode::FAILED_PRECONDITION);
+  EXPECT_EQ(ToGrpcCode(StatusCode::kInternal), grpc::StatusCode::INTERNAL);
+}
+
+}  // namespace
+}  // namespace deform::service

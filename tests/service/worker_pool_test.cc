@@ -1,0 +1,129 @@
+#include "service/worker_pool.h"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <functional>
+#include <mutex>
+#include <string>
+#include <vector>
+
+namespace deform::service {
+namespace {
+
+// A one-shot gate tests open explicitly (no sleeps).
+class Gate {
+ public:
+  void Open() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    open_ = true;
+    cv_.notify_all();
+  }
+  bool Wait(std::chrono::seconds timeout = std::chrono::seconds(60)) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    return cv_.wait_for(lock, timeout, [this] { return open_; });
+  }
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  bool open_ = false;
+};
+
+class FunctionTask final : public UrgentTask {
+ public:
+  explicit FunctionTask(std::function<void()> body) : body_(std::move(body)) {}
+  void RunUrgent() override { body_(); }
+
+ private:
+  std::function<void()> body_;
+};
+
+class EventLog {
+ public:
+  void Add(const std::string& event) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    events_.push_back(event);
+  }
+  std::vector<std::string> events() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return events_;
+  }
+
+ private:
+  std::mutex mutex_;
+  std::vector<std::string> events_;
+};
+
+TEST(WorkerPoolTest, UrgentTasksOvertakeQueuedBackgroundTasks) {
+  WorkerPool pool(1);
+  EventLog log;
+  Gate blocker_running, release_blocker;
+  pool.PostBackground([&] {
+    blocker_running.Open();
+    release_blocker.Wait();
+    log.Add("blocker");
+  });
+  ASSERT_TRUE(blocker_running.Wait());
+  pool.PostBackground([&] { log.Add("background"); });
+  FunctionTask urgent([&] { log.Add("urgent"); });
+  pool.PostUrgent(&urgent);
+  release_blocker.Open();
+  pool.Shutdown();
+  EXPECT_EQ(log.events(), (std::vector<std::string>{"blocker", "urgent", "background"}));
+}
+
+TEST(WorkerPoolTest, BackgroundWorkLeavesOneWorkerForUrgentTasks) {
+  WorkerPool pool(2);
+  EventLog log;
+  Gate first_running, release_first, urgent_ran;
+  std::atomic<bool> second_started{false};
+  pool.PostBackground([&] {
+    first_running.Open();
+    release_first.Wait();
+    log.Add("first");
+  });
+  ASSERT_TRUE(first_running.Wait());
+  pool.PostBackground([&] {
+    second_started.store(true);
+    log.Add("second");
+  });
+  FunctionTask urgent([&] {
+    log.Add("urgent");
+    urgent_ran.Open();
+  });
+  pool.PostUrgent(&urgent);
+  // The second worker is free for the urgent task, but may not take the second background task.
+  ASSERT_TRUE(urgent_ran.Wait());
+  EXPECT_FALSE(second_started.load());
+  release_first.Open();
+  pool.Shutdown();
+  EXPECT_EQ(log.events(), (std::vector<std::string>{"urgent", "first", "second"}));
+}
+
+TEST(WorkerPoolTest, ShutdownRunsEverythingQueuedIncludingWorkPostedByTasks) {
+  std::atomic<int> runs{0};
+  FunctionTask urgent([&] { runs.fetch_add(1); });
+  {
+    WorkerPool pool(2);
+    for (int i = 0; i < 50; ++i) {
+      pool.PostBackground([&] {
+        runs.fetch_add(1);
+        if (runs.load() == 10) pool.PostUrgent(&urgent);
+      });
+    }
+    pool.Shutdown();
+    pool.Shutdown();  // idempotent
+  }
+  EXPECT_EQ(runs.load(), 51);
+}
+
+TEST(WorkerPoolTest, ZeroThreadsMeansOnePerCore) {
+  WorkerPool pool(0);
+  EXPECT_GE(pool.size(), 1);
+}
+
+}  // namespace
+}  // namespace deform::service
