@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "deform/v1/deform.pb.h"
-#include "loadtest/joint_selection.h"
+#include "lib/joint_choice.h"
 
 namespace deform::loadtest {
 
@@ -22,7 +22,7 @@ struct LoadPlan {
   // ceil(duration_s * rate_hz) ticks are.
   double warmup_s = 1.0;
   double duration_s = 10.0;
-  JointAxis posed;              // the joint bent by every pose
+  client::JointAxis posed;      // the joint bent by every pose
   double peak_degrees = 120.0;  // flexion runs 0 -> peak -> 0 along a cosine ...
   double cycle_s = 2.0;         // ... once per cycle; stream i's phase is i / streams of a cycle
   // Every `stiffness_every_s` seconds of the measured period (0 = never), stream i sends the next

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "loadtest/status_text.h"
+#include "lib/status_names.h"
 
 namespace deform::loadtest {
 namespace {
@@ -80,8 +80,9 @@ LoadReport BuildReport(const RunDescription& run, const LoadPlan& plan, RunOutco
     stats.latency_ms = {};
     stats.timings = {};
     if (!stream.status.ok()) {
-      CountError(&report, StatusCodeName(stream.status.error_code()), 1);
-      if (report.first_stream_error.empty()) report.first_stream_error = StatusText(stream.status);
+      CountError(&report, client::StatusCodeName(stream.status.error_code()), 1);
+      if (report.first_stream_error.empty())
+        report.first_stream_error = client::StatusText(stream.status);
     }
   }
   CountError(&report, "INVALID_ARGUMENT", report.poses_rejected + report.stiffness_rejected);

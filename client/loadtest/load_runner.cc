@@ -6,7 +6,7 @@
 #include <memory>
 #include <thread>
 
-#include "loadtest/flexion.h"
+#include "lib/flexion_trajectory.h"
 
 namespace deform::loadtest {
 namespace {
@@ -56,7 +56,7 @@ deform::v1::PoseUpdate MakePose(const LoadPlan& plan, double t_seconds) {
   deform::v1::JointAngle* angle = pose.add_angles();
   angle->set_joint(plan.posed.joint);
   angle->set_axis(plan.posed.axis);
-  angle->set_degrees(FlexionDegreesAt(t_seconds, plan.cycle_s, plan.peak_degrees));
+  angle->set_degrees(client::FlexionDegreesAt(t_seconds, plan.cycle_s, plan.peak_degrees));
   return pose;
 }
 

@@ -12,11 +12,11 @@
 #include <string>
 
 #include "lib/deform_client.h"
-#include "loadtest/joint_selection.h"
+#include "lib/joint_choice.h"
+#include "lib/status_names.h"
 #include "loadtest/load_plan.h"
 #include "loadtest/load_report.h"
 #include "loadtest/load_runner.h"
-#include "loadtest/status_text.h"
 
 namespace {
 
@@ -47,7 +47,7 @@ struct LoadtestArgs {
 };
 
 int Fail(const grpc::Status& status) {
-  std::cerr << kProgram << ": " << deform::loadtest::StatusText(status) << "\n";
+  std::cerr << kProgram << ": " << deform::client::StatusText(status) << "\n";
   return 1;
 }
 
@@ -68,7 +68,7 @@ int RunOnMesh(deform::client::DeformClient& client, const LoadtestArgs& args,
   plan.rate_hz = args.rate_hz;
   plan.warmup_s = args.warmup_s;
   plan.duration_s = args.duration_s;
-  plan.posed = deform::loadtest::ChoosePosedJoint(summary, args.joint, args.axis);
+  plan.posed = deform::client::ChoosePosedJoint(summary, args.joint, args.axis);
   plan.peak_degrees = args.peak_degrees;
   plan.cycle_s = args.cycle_s;
   plan.drain_s = args.drain_s;
@@ -80,7 +80,7 @@ int RunOnMesh(deform::client::DeformClient& client, const LoadtestArgs& args,
   run.vertices = summary.vertex_count();
   run.triangles = summary.triangle_count();
   if (args.stiffness_every_s > 0) {
-    run.stiffness_joint = deform::loadtest::ChooseRegionJoint(summary, plan.posed.joint);
+    run.stiffness_joint = deform::client::ChooseRegionJoint(summary, plan.posed.joint);
     if (run.stiffness_joint.empty()) {
       return Fail(grpc::Status(grpc::StatusCode::FAILED_PRECONDITION,
                                "--stiffness-every needs an inner joint (has_region); the mesh "

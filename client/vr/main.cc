@@ -15,17 +15,17 @@
 
 #include "core/mesh_io.h"
 #include "lib/deform_client.h"
-#include "vr/flexion_trajectory.h"
+#include "lib/flexion_trajectory.h"
+#include "lib/joint_choice.h"
+#include "lib/status_names.h"
 #include "vr/frame_mesh.h"
-#include "vr/joint_choice.h"
 #include "vr/mesh_source.h"
 #include "vr/pose_player.h"
-#include "vr/status_text.h"
 #include "vr/vr_report.h"
 
 namespace {
 
-using deform::vr::JointAxis;
+using deform::client::JointAxis;
 
 constexpr char kProgram[] = "deform-vr";
 
@@ -50,7 +50,7 @@ struct VrArgs {
 };
 
 int Fail(const grpc::Status& status) {
-  std::cerr << kProgram << ": " << deform::vr::StatusText(status) << "\n";
+  std::cerr << kProgram << ": " << deform::client::StatusText(status) << "\n";
   return 1;
 }
 
@@ -74,7 +74,7 @@ deform::vr::PoseGenerator MakePoseGenerator(const VrArgs& args, const JointAxis&
     deform::v1::JointAngle* angle = pose.add_angles();
     angle->set_joint(knee.joint);
     angle->set_axis(knee.axis);
-    angle->set_degrees(deform::vr::FlexionDegreesAt(k / rate, cycle, peak));
+    angle->set_degrees(deform::client::FlexionDegreesAt(k / rate, cycle, peak));
     return pose;
   };
 }
@@ -97,7 +97,7 @@ int WriteLastFrame(deform::client::DeformClient& client, const std::string& mesh
 
 int RunOnMesh(deform::client::DeformClient& client, const VrArgs& args,
               const deform::v1::MeshSummary& summary) {
-  const JointAxis knee = deform::vr::ChooseKneeAxis(summary, args.joint, args.axis);
+  const JointAxis knee = deform::client::ChoosePosedJoint(summary, args.joint, args.axis);
   deform::vr::PlaybackSettings settings;
   settings.rate_hz = args.rate_hz;
   settings.poses = PosesToSend(args);

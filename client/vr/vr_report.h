@@ -4,7 +4,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "vr/joint_choice.h"
+#include "lib/joint_choice.h"
 #include "vr/pose_player.h"
 
 namespace deform::vr {
@@ -14,8 +14,8 @@ struct RunDescription {
   std::string mesh_name;
   unsigned vertices = 0;
   unsigned triangles = 0;
-  std::string pose;  // the scripted pose, or empty for the flexion trajectory
-  JointAxis knee;    // the trajectory's joint and axis
+  std::string pose;        // the scripted pose, or empty for the flexion trajectory
+  client::JointAxis knee;  // the trajectory's joint and axis
   double peak_degrees = 0;
   double cycle_s = 0;
   double rate_hz = 0;

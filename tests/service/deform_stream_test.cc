@@ -173,6 +173,15 @@ TEST_F(DeformStreamTest, NanAngleIsRejectedAndTheStreamGoesOn) {
   EXPECT_EQ(rejected.sequence(), 2u);
   EXPECT_THAT(rejected.message(), HasSubstr("finite"));
   ASSERT_TRUE(stream->SendPose(KneePose(3, std::numeric_limits<double>::infinity(), 10)));
+  // Wait for pose 3's rejection before sending pose 4: the client keeps only the newest unsent
+  // pose, so pose 4 sent at once could replace pose 3 before it leaves.
+  ASSERT_TRUE(recorder.WaitUntil([&] {
+    int count = 0;
+    for (const RecordedEvent& event : recorder.EventsLocked()) {
+      count += !event.is_frame && event.notice.kind() == v1::Notice::POSE_REJECTED;
+    }
+    return count >= 2;
+  }));
   ASSERT_TRUE(stream->SendPose(KneePose(4, 45)));
   ASSERT_TRUE(recorder.WaitForFrameWithSequence(4));
   stream->Close();

@@ -86,6 +86,8 @@ class StreamRecorder {
     std::lock_guard<std::mutex> lock(mutex_);
     return last_frame_;
   }
+  // The events so far; only inside a WaitUntil predicate (the lock is held there).
+  const std::vector<RecordedEvent>& EventsLocked() const { return events_; }
   std::vector<RecordedEvent> events() {
     std::lock_guard<std::mutex> lock(mutex_);
     return events_;

@@ -1,6 +1,6 @@
-#include "loadtest/joint_selection.h"
+#include "joint_choice.h"
 
-namespace deform::loadtest {
+namespace deform::client {
 namespace {
 
 bool Names(const deform::v1::JointInfo& joint, const std::string& name_or_index) {
@@ -38,4 +38,4 @@ std::string ChooseRegionJoint(const deform::v1::MeshSummary& summary,
   return {};
 }
 
-}  // namespace deform::loadtest
+}  // namespace deform::client

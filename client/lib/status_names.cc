@@ -1,6 +1,6 @@
-#include "vr/status_text.h"
+#include "status_names.h"
 
-namespace deform::vr {
+namespace deform::client {
 
 const char* StatusCodeName(grpc::StatusCode code) {
   switch (code) {
@@ -51,4 +51,4 @@ std::string StatusText(const grpc::Status& status) {
   return text;
 }
 
-}  // namespace deform::vr
+}  // namespace deform::client

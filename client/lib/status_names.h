@@ -1,11 +1,11 @@
-// Text for gRPC statuses in one-line error messages.
+// Text for gRPC statuses in the clients' one-line error messages and error counts.
 #pragma once
 
 #include <grpcpp/support/status.h>
 
 #include <string>
 
-namespace deform::vr {
+namespace deform::client {
 
 // The canonical name of a status code, e.g. "INVALID_ARGUMENT"; "UNKNOWN_CODE" for values outside
 // the canonical list.
@@ -14,4 +14,4 @@ const char* StatusCodeName(grpc::StatusCode code);
 // "CODE: message", or just "CODE" when the message is empty or repeats the code's name.
 std::string StatusText(const grpc::Status& status);
 
-}  // namespace deform::vr
+}  // namespace deform::client
