@@ -80,8 +80,8 @@ Status DeformationModel::Precompute() {
   diagonal_ = BoundingBoxDiagonal(mesh_.vertices);
   const VertexAdjacency adjacency = BuildVertexAdjacency(mesh_.triangles, n);
   const std::vector<NearestBone> nearest = NearestBones(mesh_.vertices, skeleton_);
-  DEFORM_ASSIGN_OR_RETURN(regions_, ComputeJointRegions(mesh_, skeleton_, adjacency, nearest,
-                                                        options_.regions));
+  DEFORM_ASSIGN_OR_RETURN(
+      regions_, ComputeJointRegions(mesh_, skeleton_, adjacency, nearest, options_.regions));
 
   // Rigid zones: outside every joint region, a vertex belongs wholly to its nearest bone.
   std::vector<int> fixed_bone(n, -1);
@@ -106,9 +106,8 @@ Status DeformationModel::Precompute() {
                           ? regions_.membership_offsets[i + 1] - regions_.membership_offsets[i]
                           : 0;
     // Weight of the edge to each joint node, in units of one one-ring edge.
-    const double node_edge = options_.joint_node_one_neighbor
-                                 ? 1.0
-                                 : options_.joint_node_balance * adjacency.degree(i);
+    const double node_edge =
+        options_.joint_node_one_neighbor ? 1.0 : options_.joint_node_balance * adjacency.degree(i);
     const double share = 1.0 / (adjacency.degree(i) + nodes * node_edge);
     triplets.emplace_back(i, i, 1.0);
     for (int p = adjacency.offsets[i]; p < adjacency.offsets[i + 1]; ++p) {
@@ -185,7 +184,8 @@ Eigen::SparseMatrix<double> DeformationModel::BuildNormalMatrix(
   const int n = mesh_.num_vertices();
   Eigen::SparseMatrix<double, Eigen::RowMajor, int> weighted = laplacian_;
   for (int i = 0; i < n; ++i) {
-    for (Eigen::SparseMatrix<double, Eigen::RowMajor, int>::InnerIterator it(weighted, i); it; ++it) {
+    for (Eigen::SparseMatrix<double, Eigen::RowMajor, int>::InnerIterator it(weighted, i); it;
+         ++it) {
       it.valueRef() *= row_weights_squared[i];
     }
   }
@@ -207,6 +207,7 @@ DeformScratch DeformationModel::MakeScratch() const {
   DeformScratch scratch;
   scratch.num_vertices = mesh_.num_vertices();
   scratch.bone_transforms.resize(skeleton_.num_bones());
+  scratch.bone_rotations.resize(skeleton_.num_bones());
   scratch.solution.resize(mesh_.num_vertices() + num_nodes_, 3);
   scratch.rotated_deltas.resize(mesh_.num_vertices(), 3);
   scratch.solve_work.resize(default_factorization_->factor().WorkSize());
@@ -235,20 +236,26 @@ void DeformationModel::AssembleRightHandSide(const MaterialFactorization& factor
   const auto& bw = bone_weights_;
   const auto& w2 = factorization.row_weights_squared_;
   auto& r = scratch->rotated_deltas;
+  for (size_t k = 0; k < bones.size(); ++k) {
+    scratch->bone_rotations[k] = bones[k].rotation.toRotationMatrix();
+  }
   for (int i = 0; i < n; ++i) {
     const int begin = bw.offsets[i], end = bw.offsets[i + 1];
-    Eigen::Quaterniond q = bones[bw.bones[begin]].rotation;
-    if (end - begin > 1) {
-      const Eigen::Quaterniond first = q;
-      q.coeffs() *= bw.weights[begin];
-      for (int p = begin + 1; p < end; ++p) {
-        const Eigen::Quaterniond& qk = bones[bw.bones[p]].rotation;
-        const double sign = first.dot(qk) < 0 ? -1.0 : 1.0;
-        q.coeffs() += (sign * bw.weights[p]) * qk.coeffs();
-      }
-      q.normalize();
+    const Eigen::Vector3d delta = rest_deltas_.row(i).transpose();
+    if (end - begin == 1) {  // most vertices: wholly one bone's
+      r.row(i) = w2[i] * (scratch->bone_rotations[bw.bones[begin]] * delta).transpose();
+      continue;
     }
-    r.row(i) = w2[i] * (q * rest_deltas_.row(i).transpose()).transpose();
+    const Eigen::Quaterniond& first = bones[bw.bones[begin]].rotation;
+    Eigen::Quaterniond q;
+    q.coeffs() = bw.weights[begin] * first.coeffs();
+    for (int p = begin + 1; p < end; ++p) {
+      const Eigen::Quaterniond& qk = bones[bw.bones[p]].rotation;
+      const double sign = first.dot(qk) < 0 ? -1.0 : 1.0;
+      q.coeffs() += (sign * bw.weights[p]) * qk.coeffs();
+    }
+    q.normalize();
+    r.row(i) = w2[i] * (q * delta).transpose();
   }
 
   // A^T b = L'^T r + anchor_weight^2 c + node_weight^2 o.

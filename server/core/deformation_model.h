@@ -58,8 +58,9 @@ struct ModelOptions {
   // Anchors are vertices in a bone's rigid zone (harmonic weight 1) at least this many region
   // radii away from every joint centre. Default: 2.
   double anchor_distance_factor = 2.0;
-  // Fill-reducing ordering for the Cholesky factor. Default: METIS nested dissection.
-  Ordering ordering = Ordering::kMetis;
+  // Fill-reducing ordering for the Cholesky factor. Default: kAuto (AMD or METIS, whichever
+  // fills less).
+  Ordering ordering = Ordering::kAuto;
   MeshLimits limits;
 
   static ModelOptions Paper() { return {}; }
@@ -88,7 +89,8 @@ class MaterialFactorization {
 // Per-caller buffers for Deform(). Create with DeformationModel::MakeScratch(); one per stream.
 struct DeformScratch {
   std::vector<RigidTransform> bone_transforms;  // K
-  Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> solution;  // (n + m) by 3
+  std::vector<Eigen::Matrix3d> bone_rotations;  // K, the same rotations as matrices
+  Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> solution;        // (n + m) by 3
   Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> rotated_deltas;  // n by 3
   std::vector<double> solve_work;  // CholeskyFactor::WorkSize()
 
@@ -105,12 +107,14 @@ struct DeformTimings {
 
 class DeformationModel {
  public:
-  static StatusOr<std::shared_ptr<const DeformationModel>> Build(TriangleMesh mesh, Skeleton skeleton,
-                                                               const ModelOptions& options);
+  static StatusOr<std::shared_ptr<const DeformationModel>> Build(TriangleMesh mesh,
+                                                                 Skeleton skeleton,
+                                                                 const ModelOptions& options);
 
   // A new factorisation for `stiffness`, reusing the symbolic analysis. INVALID_ARGUMENT for
   // non-finite or non-positive weights, unknown joints or vertex indices out of range.
-  StatusOr<std::shared_ptr<const MaterialFactorization>> Factorize(const Stiffness& stiffness) const;
+  StatusOr<std::shared_ptr<const MaterialFactorization>> Factorize(
+      const Stiffness& stiffness) const;
   // The factorisation built by Build() for options.default_material.
   const std::shared_ptr<const MaterialFactorization>& default_factorization() const {
     return default_factorization_;
@@ -147,7 +151,8 @@ class DeformationModel {
  private:
   DeformationModel() = default;
   Status Precompute();
-  StatusOr<std::shared_ptr<const MaterialFactorization>> FactorizeImpl(const Stiffness& stiffness) const;
+  StatusOr<std::shared_ptr<const MaterialFactorization>> FactorizeImpl(
+      const Stiffness& stiffness) const;
   Eigen::SparseMatrix<double> BuildNormalMatrix(const Eigen::VectorXd& row_weights_squared) const;
 
   TriangleMesh mesh_;
@@ -161,10 +166,10 @@ class DeformationModel {
   // L' (n by n + m), uniform weights, compressed by rows; and its transpose for A^T b.
   Eigen::SparseMatrix<double, Eigen::RowMajor, int> laplacian_;
   Eigen::SparseMatrix<double, Eigen::RowMajor, int> laplacian_transpose_;
-  Positions rest_deltas_;                      // n by 3: L' x_rest
-  std::vector<int> anchors_;                   // vertex indices
-  std::vector<int> anchor_bone_;               // the bone each anchor follows
-  Positions anchor_rest_;                      // anchors by 3
+  Positions rest_deltas_;         // n by 3: L' x_rest
+  std::vector<int> anchors_;      // vertex indices
+  std::vector<int> anchor_bone_;  // the bone each anchor follows
+  Positions anchor_rest_;         // anchors by 3
   std::shared_ptr<const SymbolicCholesky> symbolic_;
   std::shared_ptr<const MaterialFactorization> default_factorization_;
   double precompute_seconds_ = 0;

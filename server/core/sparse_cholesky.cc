@@ -95,6 +95,8 @@ const char* OrderingName(Ordering ordering) {
       return "amd";
     case Ordering::kMetis:
       return "metis";
+    case Ordering::kAuto:
+      return "auto";
   }
   return "unknown";
 }
@@ -103,6 +105,11 @@ StatusOr<std::shared_ptr<const SymbolicCholesky>> SymbolicCholesky::Analyze(cons
                                                                             Ordering ordering) {
   if (a.rows() != a.cols()) return Status::InvalidArgument("Cholesky needs a square matrix");
   if (!a.isCompressed()) return Status::InvalidArgument("Cholesky needs a compressed matrix");
+  if (ordering == Ordering::kAuto) {
+    DEFORM_ASSIGN_OR_RETURN(auto amd, Analyze(a, Ordering::kAmd));
+    DEFORM_ASSIGN_OR_RETURN(auto metis, Analyze(a, Ordering::kMetis));
+    return amd->factor_nonzeros() < metis->factor_nonzeros() ? amd : metis;
+  }
   const int n = static_cast<int>(a.cols());
   auto s = std::make_shared<SymbolicCholesky>();
   s->n_ = n;

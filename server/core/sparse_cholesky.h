@@ -25,7 +25,9 @@ namespace deform {
 enum class Ordering {
   kNatural,  // no reordering (for tests)
   kAmd,      // approximate minimum degree (Eigen's)
-  kMetis,    // nested dissection (METIS_NodeND); the default, least fill on surface meshes
+  kMetis,    // nested dissection (METIS_NodeND); least fill on large surface meshes
+  kAuto,     // both of the above, keeping the one whose factor has fewer non-zeros (AMD tends to
+             // win below a few thousand vertices, METIS above)
 };
 
 const char* OrderingName(Ordering ordering);
@@ -38,6 +40,7 @@ class SymbolicCholesky {
       const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& a, Ordering ordering);
 
   int size() const { return n_; }
+  // The ordering used (kAmd or kMetis when kAuto was asked for).
   Ordering ordering() const { return ordering_; }
   // Non-zeros of the factor L, diagonal included.
   std::int64_t factor_nonzeros() const { return column_pointers_.back(); }
@@ -46,15 +49,15 @@ class SymbolicCholesky {
   friend class CholeskyFactor;
   int n_ = 0;
   Ordering ordering_ = Ordering::kMetis;
-  std::vector<int> permutation_;          // permutation_[new] = old
+  std::vector<int> permutation_;  // permutation_[new] = old
   // Upper triangle of C = P A P^T, column-major, rows ascending in each column.
   std::vector<int> c_column_pointers_;
   std::vector<int> c_row_indices_;
-  std::vector<int> a_to_c_;               // A's value index -> C's value index, or -1 (lower part)
+  std::vector<int> a_to_c_;  // A's value index -> C's value index, or -1 (lower part)
   std::int64_t a_nonzeros_ = 0;
-  std::vector<int> a_column_pointers_;    // A's pattern, to check later matrices against
+  std::vector<int> a_column_pointers_;  // A's pattern, to check later matrices against
   std::vector<int> a_row_indices_;
-  std::vector<int> elimination_tree_;     // parent of each column of L, -1 for a root
+  std::vector<int> elimination_tree_;          // parent of each column of L, -1 for a root
   std::vector<std::int64_t> column_pointers_;  // of L, n + 1
   // Supernodes: supernode s holds columns [supernode_columns_[s], supernode_columns_[s + 1]).
   std::vector<int> supernode_columns_;
@@ -67,8 +70,9 @@ class CholeskyFactor {
 
   // `a` must have exactly the pattern that `symbolic` was analysed with. INTERNAL if `a` is not
   // positive definite (names the pivot).
-  static StatusOr<CholeskyFactor> Factorize(std::shared_ptr<const SymbolicCholesky> symbolic,
-                                            const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& a);
+  static StatusOr<CholeskyFactor> Factorize(
+      std::shared_ptr<const SymbolicCholesky> symbolic,
+      const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& a);
 
   int size() const { return symbolic_ ? symbolic_->size() : 0; }
   // Solves A X = B for three right-hand sides stored interleaved: b[3 i + c] is row i, column c.

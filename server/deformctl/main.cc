@@ -5,16 +5,16 @@
 //   deformctl phantom --out FILE [--skeleton-out FILE] [--vertices N]
 //
 // Prints one JSON object on stdout; errors are one line on stderr and a non-zero exit code.
-#include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
 
+#include <CLI/CLI.hpp>
 #include <fstream>
 #include <iostream>
+#include <nlohmann/json.hpp>
 #include <string>
 
-#include "core/method_comparison.h"
 #include "core/mesh_io.h"
+#include "core/method_comparison.h"
 #include "core/model_input.h"
 #include "core/phantom.h"
 
@@ -31,7 +31,7 @@ struct DeformArgs {
   std::string out_path;
   int repeat = 1;
   double radius_factor = 1.5;
-  std::string ordering = "metis";
+  std::string ordering = "auto";
 };
 
 struct PhantomArgs {
@@ -58,7 +58,9 @@ int RunDeform(const DeformArgs& args) {
 
   deform::ModelOptions options = deform::ModelOptions::Paper();
   options.regions.radius_factor = args.radius_factor;
-  if (args.ordering == "amd") {
+  if (args.ordering == "metis") {
+    options.ordering = deform::Ordering::kMetis;
+  } else if (args.ordering == "amd") {
     options.ordering = deform::Ordering::kAmd;
   } else if (args.ordering == "natural") {
     options.ordering = deform::Ordering::kNatural;
@@ -121,26 +123,49 @@ int RunPhantom(const PhantomArgs& args) {
 
 int main(int argc, char** argv) {
   spdlog::set_level(spdlog::level::warn);
-  CLI::App app{"deformctl: joint-aware Laplacian deformation of a limb mesh, from the command line"};
+  CLI::App app{
+      "deformctl: joint-aware Laplacian deformation of a limb mesh, from the command line"};
   app.require_subcommand(1);
 
   DeformArgs deform_args;
-  CLI::App* deform_cmd = app.add_subcommand("deform", "Pose a mesh and print quality and timings as JSON");
-  deform_cmd->add_option("--mesh", deform_args.mesh_path, "Mesh file (.obj .ply .stl .off); default: the built-in knee phantom");
-  deform_cmd->add_option("--skeleton", deform_args.skeleton_path, "Skeleton file (.tgf or JSON); required with --mesh");
-  deform_cmd->add_option("--phantom-vertices", deform_args.phantom_vertices, "Resolution of the phantom")->capture_default_str();
-  deform_cmd->add_option("--pose", deform_args.pose, "JOINT:AXIS:DEGREES[,...], e.g. knee:flexion:90 or 1:x:90")->capture_default_str();
-  deform_cmd->add_option("--method", deform_args.method, "paper | laplacian | lbs | dqs")->capture_default_str();
-  deform_cmd->add_option("--out", deform_args.out_path, "Write the deformed mesh (format from the extension)");
-  deform_cmd->add_option("--repeat", deform_args.repeat, "Frames to time; solve_ms is their median")->capture_default_str()->check(CLI::Range(1, 100000));
-  deform_cmd->add_option("--radius-factor", deform_args.radius_factor, "Joint region radius in limb radii")->capture_default_str();
-  deform_cmd->add_option("--ordering", deform_args.ordering, "Fill-reducing ordering: metis | amd | natural")->capture_default_str()->check(CLI::IsMember({"metis", "amd", "natural"}));
+  CLI::App* deform_cmd =
+      app.add_subcommand("deform", "Pose a mesh and print quality and timings as JSON");
+  deform_cmd->add_option("--mesh", deform_args.mesh_path,
+                         "Mesh file (.obj .ply .stl .off); default: the built-in knee phantom");
+  deform_cmd->add_option("--skeleton", deform_args.skeleton_path,
+                         "Skeleton file (.tgf or JSON); required with --mesh");
+  deform_cmd
+      ->add_option("--phantom-vertices", deform_args.phantom_vertices, "Resolution of the phantom")
+      ->capture_default_str();
+  deform_cmd
+      ->add_option("--pose", deform_args.pose,
+                   "JOINT:AXIS:DEGREES[,...], e.g. knee:flexion:90 or 1:x:90")
+      ->capture_default_str();
+  deform_cmd->add_option("--method", deform_args.method, "paper | laplacian | lbs | dqs")
+      ->capture_default_str();
+  deform_cmd->add_option("--out", deform_args.out_path,
+                         "Write the deformed mesh (format from the extension)");
+  deform_cmd->add_option("--repeat", deform_args.repeat, "Frames to time; solve_ms is their median")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 100000));
+  deform_cmd
+      ->add_option("--radius-factor", deform_args.radius_factor,
+                   "Joint region radius in limb radii")
+      ->capture_default_str();
+  deform_cmd
+      ->add_option("--ordering", deform_args.ordering,
+                   "Fill-reducing ordering: auto | metis | amd | natural")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"auto", "metis", "amd", "natural"}));
 
   PhantomArgs phantom_args;
-  CLI::App* phantom_cmd = app.add_subcommand("phantom", "Write the built-in knee phantom and its skeleton");
+  CLI::App* phantom_cmd =
+      app.add_subcommand("phantom", "Write the built-in knee phantom and its skeleton");
   phantom_cmd->add_option("--out", phantom_args.out_path, "Mesh file to write")->required();
-  phantom_cmd->add_option("--skeleton-out", phantom_args.skeleton_out_path, "Skeleton JSON file to write");
-  phantom_cmd->add_option("--vertices", phantom_args.vertices, "Approximate vertex count")->capture_default_str();
+  phantom_cmd->add_option("--skeleton-out", phantom_args.skeleton_out_path,
+                          "Skeleton JSON file to write");
+  phantom_cmd->add_option("--vertices", phantom_args.vertices, "Approximate vertex count")
+      ->capture_default_str();
 
   try {
     app.parse(argc, argv);

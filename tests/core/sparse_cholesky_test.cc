@@ -35,7 +35,8 @@ ColMajorMatrix RandomSpdMatrix(int n, int edges_per_row, unsigned seed) {
   return a;
 }
 
-Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> RandomRightHandSides(int n, unsigned seed) {
+Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> RandomRightHandSides(int n,
+                                                                               unsigned seed) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> normal;
   Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> b(n, 3);
@@ -99,7 +100,8 @@ TEST_P(SparseCholeskyTest, RefactorisationReusesTheAnalysis) {
 }
 
 INSTANTIATE_TEST_SUITE_P(AllOrderings, SparseCholeskyTest,
-                         ::testing::Values(Ordering::kNatural, Ordering::kAmd, Ordering::kMetis),
+                         ::testing::Values(Ordering::kNatural, Ordering::kAmd, Ordering::kMetis,
+                                           Ordering::kAuto),
                          [](const auto& info) { return std::string(OrderingName(info.param)); });
 
 TEST(SparseCholesky, MetisOrderingFillsLessThanNatural) {
@@ -121,6 +123,17 @@ TEST(SparseCholesky, MetisOrderingFillsLessThanNatural) {
   auto natural = SymbolicCholesky::Analyze(a, Ordering::kNatural);
   ASSERT_TRUE(metis.ok() && natural.ok());
   EXPECT_LT((*metis)->factor_nonzeros(), (*natural)->factor_nonzeros());
+}
+
+TEST(SparseCholesky, AutoOrderingKeepsTheSmallerFactor) {
+  const ColMajorMatrix a = RandomSpdMatrix(400, 3, 21);
+  auto amd = SymbolicCholesky::Analyze(a, Ordering::kAmd);
+  auto metis = SymbolicCholesky::Analyze(a, Ordering::kMetis);
+  auto chosen = SymbolicCholesky::Analyze(a, Ordering::kAuto);
+  ASSERT_TRUE(amd.ok() && metis.ok() && chosen.ok());
+  EXPECT_EQ((*chosen)->factor_nonzeros(),
+            std::min((*amd)->factor_nonzeros(), (*metis)->factor_nonzeros()));
+  EXPECT_NE((*chosen)->ordering(), Ordering::kAuto);
 }
 
 TEST(SparseCholesky, IndefiniteMatrixIsRefused) {
