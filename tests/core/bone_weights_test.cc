@@ -5,6 +5,7 @@
 #include "core/deformation_model.h"
 #include "core/mesh_io.h"
 #include "core/phantom.h"
+#include "tests/core/shared_leg_model.h"
 #include "tests/shared_data.h"
 
 namespace deform {
@@ -35,13 +36,8 @@ TEST(HarmonicBoneWeights, LieInTheUnitIntervalAndSumToOneOnThePhantom) {
 }
 
 TEST(HarmonicBoneWeights, LieInTheUnitIntervalAndSumToOneOnTheSharedLeg) {
-  DEFORM_REQUIRE_SHARED_FILE(mesh_path, "leg/leg_1633.obj");
-  DEFORM_REQUIRE_SHARED_FILE(tgf, "leg/leg.tgf");
-  auto mesh = ReadMeshFile(mesh_path);
-  ASSERT_TRUE(mesh.ok()) << mesh.status().ToString();
-  auto model = DeformationModel::Build(*mesh, *ReadSkeletonFile(tgf), ModelOptions::Paper());
-  ASSERT_TRUE(model.ok()) << model.status().ToString();
-  ExpectPartitionOfUnity((*model)->bone_weights());
+  DEFORM_SHARED_LEG_MODEL(model);
+  ExpectPartitionOfUnity(model->bone_weights());
 }
 
 TEST(HarmonicBoneWeights, KeepTheDirichletValues) {

@@ -8,13 +8,14 @@
 #include "core/mesh_io.h"
 #include "core/phantom.h"
 #include "tests/allocation_counter.h"
+#include "tests/core/shared_leg_model.h"
 #include "tests/shared_data.h"
 
 namespace deform {
 namespace {
 
-std::shared_ptr<const DeformationModel> BuildPhantomModel(int vertices = 2000,
-                                                          ModelOptions options = ModelOptions::Paper()) {
+std::shared_ptr<const DeformationModel> BuildPhantomModel(
+    int vertices = 2000, ModelOptions options = ModelOptions::Paper()) {
   auto phantom = MakeKneePhantom(vertices);
   EXPECT_TRUE(phantom.ok());
   auto model = DeformationModel::Build(phantom->mesh, phantom->skeleton, options);
@@ -48,21 +49,17 @@ TEST(DeformationModel, RestPoseReproducesThePhantom) {
 }
 
 TEST(DeformationModel, RestPoseReproducesTheSharedLeg) {
-  DEFORM_REQUIRE_SHARED_FILE(mesh_path, "leg/leg_1633.obj");
-  DEFORM_REQUIRE_SHARED_FILE(tgf, "leg/leg.tgf");
-  auto mesh = ReadMeshFile(mesh_path);
-  ASSERT_TRUE(mesh.ok()) << mesh.status().ToString();
-  auto model = DeformationModel::Build(*mesh, *ReadSkeletonFile(tgf), ModelOptions::Paper());
-  ASSERT_TRUE(model.ok()) << model.status().ToString();
-  EXPECT_EQ((*model)->num_joint_nodes(), 3);  // knee, ankle, ball
-  const Positions posed = DeformOnce(**model, Pose::Rest((*model)->skeleton()));
-  EXPECT_LT(MaxDistance(posed, mesh->vertices), 1e-5 * (*model)->bounding_box_diagonal());
+  DEFORM_SHARED_LEG_MODEL(model);
+  EXPECT_EQ(model->num_joint_nodes(), 3);  // knee, ankle, ball
+  const Positions posed = DeformOnce(*model, Pose::Rest(model->skeleton()));
+  EXPECT_LT(MaxDistance(posed, model->mesh().vertices), 1e-5 * model->bounding_box_diagonal());
 }
 
 TEST(DeformationModel, RigidMotionOfTheSkeletonMovesTheMeshRigidly) {
   auto model = BuildPhantomModel();
   Pose pose = Pose::Rest(model->skeleton());
-  pose.root.rotation = Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()));
+  pose.root.rotation =
+      Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()));
   pose.root.translation = Eigen::Vector3d(0.5, -2, 3);
   const Positions posed = DeformOnce(*model, pose);
   Positions expected(model->mesh().num_vertices(), 3);
@@ -206,10 +203,10 @@ TEST(DeformationModel, RefusesBadStiffness) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   std::vector<Stiffness> bad(5);
   bad[0].joint_materials = {{1, {nan, 1, 1}}};
-  bad[1].joint_materials = {{0, {1, 1, 1}}};       // the hip has no region
-  bad[2].vertex_weights = {{1 << 20, 1.0}};        // no such vertex
-  bad[3].vertex_weights = {{3, -1.0}};             // negative
-  bad[4].region_weights = {{1, 1e9}};              // absurdly stiff
+  bad[1].joint_materials = {{0, {1, 1, 1}}};  // the hip has no region
+  bad[2].vertex_weights = {{1 << 20, 1.0}};   // no such vertex
+  bad[3].vertex_weights = {{3, -1.0}};        // negative
+  bad[4].region_weights = {{1, 1e9}};         // absurdly stiff
   for (const Stiffness& s : bad) {
     auto f = model->Factorize(s);
     ASSERT_FALSE(f.ok());

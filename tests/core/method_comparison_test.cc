@@ -8,15 +8,11 @@
 
 #include "core/mesh_io.h"
 #include "core/phantom.h"
+#include "tests/core/shared_leg_model.h"
 #include "tests/shared_data.h"
 
 namespace deform {
 namespace {
-
-struct Case {
-  std::string knee_axis;  // pose spec prefix
-  double degrees;
-};
 
 void ExpectPaperBeatsBaselines(const DeformationModel& model, const std::string& knee_axis) {
   for (double degrees : {90.0, 120.0}) {
@@ -44,13 +40,8 @@ TEST(MethodComparison, PaperBeatsLaplacianAndLbsOnThePhantom) {
 }
 
 TEST(MethodComparison, PaperBeatsLaplacianAndLbsOnTheSharedLeg) {
-  DEFORM_REQUIRE_SHARED_FILE(mesh_path, "leg/leg_1633.obj");
-  DEFORM_REQUIRE_SHARED_FILE(tgf, "leg/leg.tgf");
-  auto mesh = ReadMeshFile(mesh_path);
-  ASSERT_TRUE(mesh.ok()) << mesh.status().ToString();
-  auto model = DeformationModel::Build(*mesh, *ReadSkeletonFile(tgf), ModelOptions::Paper());
-  ASSERT_TRUE(model.ok()) << model.status().ToString();
-  ExpectPaperBeatsBaselines(**model, "1:x");
+  DEFORM_SHARED_LEG_MODEL(model);
+  ExpectPaperBeatsBaselines(*model, "1:x");
 }
 
 TEST(MethodComparison, EveryMethodReproducesTheRestPose) {
