@@ -35,6 +35,9 @@ if [ ${#missing[@]} -gt 0 ]; then
       "${missing[@]}" >/dev/null || fail "could not install ${missing[*]}"
 fi
 PODMAN=(podman --runtime runc)
+# Podman's default limits (1,048,576 open files) need CAP_SYS_RESOURCE to raise, which sandboxed
+# machines like this one lack; explicit limits at or below the host's start everywhere.
+RUN_FLAGS=(--network host --ulimit nofile=16384:16384 --ulimit nproc=16384:16384)
 
 if ss -ltn 2>/dev/null | grep -q ":$PORT "; then
   fail "port $PORT is in use on this host (the container runs with host networking)"
@@ -56,13 +59,19 @@ step "building $IMAGE (builds and tests the project inside the builder stage)"
 }
 
 step "checking the runtime image holds no compiler and no -dev package"
-leftovers=$("${PODMAN[@]}" run --rm --network host --entrypoint /bin/sh "$IMAGE" -c \
-  'for c in gcc g++ cc c++ clang; do command -v $c; done; dpkg-query -W -f="\${Package}\n" | grep -- "-dev$"' \
-  2>/dev/null)
+inventory=$("${PODMAN[@]}" run --rm "${RUN_FLAGS[@]}" --entrypoint /bin/sh "$IMAGE" -c \
+  'for c in gcc g++ cc c++ clang ld; do command -v $c; done
+   dpkg-query -W -f="\${Package}\n" | grep -- "-dev$"
+   echo inventory-complete') || fail "could not run a shell in the runtime image"
+case "$inventory" in
+  *inventory-complete) ;;
+  *) fail "the runtime image inventory did not complete: $inventory" ;;
+esac
+leftovers=$(printf '%s\n' "$inventory" | grep -v '^inventory-complete$' || true)
 [ -z "$leftovers" ] || fail "runtime image contains build tools or -dev packages: $leftovers"
 
 step "starting the container"
-"${PODMAN[@]}" run -d --name "$CONTAINER" --network host "$IMAGE" >/dev/null ||
+"${PODMAN[@]}" run -d --name "$CONTAINER" "${RUN_FLAGS[@]}" "$IMAGE" >/dev/null ||
   fail "container did not start"
 
 step "waiting for the health check to pass"
