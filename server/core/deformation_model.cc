@@ -54,7 +54,8 @@ ModelOptions ModelOptions::PlainLaplacian() {
 }
 
 StatusOr<std::shared_ptr<const DeformationModel>> DeformationModel::Build(
-    TriangleMesh mesh, Skeleton skeleton, const ModelOptions& options) {
+    TriangleMesh mesh, Skeleton skeleton, const ModelOptions& options,
+    const std::function<void()>& on_precomputed) {
   const auto start = Clock::now();
   DEFORM_RETURN_IF_ERROR(ValidateMesh(mesh, options.limits));
   if (!(options.joint_node_weight > 0) || !(options.anchor_weight > 0) ||
@@ -68,6 +69,7 @@ StatusOr<std::shared_ptr<const DeformationModel>> DeformationModel::Build(
   model->options_ = options;
   DEFORM_RETURN_IF_ERROR(model->Precompute());
   model->precompute_seconds_ = SecondsSince(start);
+  if (on_precomputed) on_precomputed();
   DEFORM_ASSIGN_OR_RETURN(model->default_factorization_, model->FactorizeImpl(Stiffness{}));
   spdlog::debug("model built: {} vertices, {} joint nodes, {} anchors, factor {} non-zeros",
                 model->mesh_.num_vertices(), model->num_nodes_, model->anchors_.size(),

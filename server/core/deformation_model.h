@@ -18,6 +18,7 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -107,9 +108,11 @@ struct DeformTimings {
 
 class DeformationModel {
  public:
-  static StatusOr<std::shared_ptr<const DeformationModel>> Build(TriangleMesh mesh,
-                                                                 Skeleton skeleton,
-                                                                 const ModelOptions& options);
+  // `on_precomputed`, if given, is called on the calling thread once the weights, regions and
+  // symbolic analysis are done, before the first numeric factorisation (for progress reports).
+  static StatusOr<std::shared_ptr<const DeformationModel>> Build(
+      TriangleMesh mesh, Skeleton skeleton, const ModelOptions& options,
+      const std::function<void()>& on_precomputed = {});
 
   // A new factorisation for `stiffness`, reusing the symbolic analysis. INVALID_ARGUMENT for
   // non-finite or non-positive weights, unknown joints or vertex indices out of range.

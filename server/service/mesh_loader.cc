@@ -25,15 +25,14 @@ StatusOr<std::shared_ptr<const MeshEntry>> BuildAndRegister(MeshRegistry* regist
   DEFORM_RETURN_IF_ERROR(registry->CheckMemoryAvailable(geometry_bytes));
   if (progress) progress(LoadStage::kValidated, MillisecondsSince(job.start));
 
-  const double build_start_ms = MillisecondsSince(job.start);
   const int vertices = job.mesh.num_vertices();
-  DEFORM_ASSIGN_OR_RETURN(
-      std::shared_ptr<const DeformationModel> model,
-      DeformationModel::Build(std::move(job.mesh), std::move(job.skeleton), job.options));
-  if (progress) {
-    progress(LoadStage::kWeights, build_start_ms + model->precompute_seconds() * 1e3);
-    progress(LoadStage::kFactorised, MillisecondsSince(job.start));
-  }
+  const auto on_precomputed = [&] {
+    if (progress) progress(LoadStage::kWeights, MillisecondsSince(job.start));
+  };
+  DEFORM_ASSIGN_OR_RETURN(std::shared_ptr<const DeformationModel> model,
+                          DeformationModel::Build(std::move(job.mesh), std::move(job.skeleton),
+                                                  job.options, on_precomputed));
+  if (progress) progress(LoadStage::kFactorised, MillisecondsSince(job.start));
   DEFORM_ASSIGN_OR_RETURN(std::shared_ptr<const MeshEntry> entry,
                           registry->Register(std::move(reservation), job.name, std::move(model)));
   spdlog::info(

@@ -20,13 +20,12 @@ namespace deform::service {
 
 enum class LoadStage {
   kValidated,   // mesh and skeleton checked
-  kWeights,     // weights, regions and symbolic analysis done (reported when Build returns)
+  kWeights,     // weights, regions and symbolic analysis done
   kFactorised,  // first numeric factorisation done
 };
 
-// `elapsed_ms` is measured from the `start` given to BuildAndRegister. kWeights is reported after
-// DeformationModel::Build returns (the two are not separable from outside) with the time at which
-// its precomputation part ended.
+// `elapsed_ms` is measured from the `start` given to BuildAndRegister. Each stage is reported as
+// it completes, on the thread running BuildAndRegister.
 using LoadProgress = std::function<void(LoadStage stage, double elapsed_ms)>;
 
 struct LoadJob {

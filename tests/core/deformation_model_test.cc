@@ -218,6 +218,25 @@ TEST(DeformationModel, RefusesBadStiffness) {
   EXPECT_TRUE(model->Factorize(good).ok());
 }
 
+TEST(DeformationModel, ReportsThePrecomputationBeforeFactorising) {
+  auto phantom = MakeKneePhantom(600);
+  int calls = 0;
+  auto model = DeformationModel::Build(phantom->mesh, phantom->skeleton, ModelOptions::Paper(),
+                                       [&] { ++calls; });
+  ASSERT_TRUE(model.ok());
+  EXPECT_EQ(calls, 1);
+  auto refused = DeformationModel::Build(
+      phantom->mesh, phantom->skeleton,
+      [] {
+        ModelOptions o;
+        o.limits.max_vertices = 10;
+        return o;
+      }(),
+      [&] { ++calls; });
+  EXPECT_FALSE(refused.ok());
+  EXPECT_EQ(calls, 1);  // not reached for input refused by validation
+}
+
 TEST(DeformationModel, ExplicitRegionRadiusIsUsed) {
   ModelOptions options = ModelOptions::Paper();
   options.regions.explicit_radius = {{1, 0.3}};
