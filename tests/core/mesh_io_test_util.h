@@ -121,12 +121,10 @@ inline std::string AsciiStl(const TriangleMesh& mesh) {
   return text + "endsolid cube\n";
 }
 
-inline std::string AsciiPly(const TriangleMesh& mesh) {
-  std::string text = "ply\nformat ascii 1.0\ncomment a test\nelement vertex " +
-                     std::to_string(mesh.num_vertices()) +
-                     "\nproperty float x\nproperty float y\nproperty float z\nelement face " +
-                     std::to_string(mesh.num_triangles()) +
-                     "\nproperty list uchar int vertex_indices\nend_header\n";
+// "x y z" lines for the vertices, then "3 a b c" lines for the triangles: the body that ASCII PLY
+// and OFF share.
+inline std::string AsciiVertexAndFaceLines(const TriangleMesh& mesh) {
+  std::string text;
   for (int v = 0; v < mesh.num_vertices(); ++v) {
     text += std::to_string(mesh.vertices(v, 0)) + " " + std::to_string(mesh.vertices(v, 1)) + " " +
             std::to_string(mesh.vertices(v, 2)) + "\n";
@@ -137,6 +135,15 @@ inline std::string AsciiPly(const TriangleMesh& mesh) {
             "\n";
   }
   return text;
+}
+
+inline std::string AsciiPly(const TriangleMesh& mesh) {
+  std::string text = "ply\nformat ascii 1.0\ncomment a test\nelement vertex " +
+                     std::to_string(mesh.num_vertices()) +
+                     "\nproperty float x\nproperty float y\nproperty float z\nelement face " +
+                     std::to_string(mesh.num_triangles()) +
+                     "\nproperty list uchar int vertex_indices\nend_header\n";
+  return text + AsciiVertexAndFaceLines(mesh);
 }
 
 struct BinaryPlyOptions {
@@ -178,16 +185,7 @@ inline std::string BinaryPly(const TriangleMesh& mesh, const BinaryPlyOptions& o
 inline std::string Off(const TriangleMesh& mesh) {
   std::string text = "OFF\n" + std::to_string(mesh.num_vertices()) + " " +
                      std::to_string(mesh.num_triangles()) + " 0\n";
-  for (int v = 0; v < mesh.num_vertices(); ++v) {
-    text += std::to_string(mesh.vertices(v, 0)) + " " + std::to_string(mesh.vertices(v, 1)) + " " +
-            std::to_string(mesh.vertices(v, 2)) + "\n";
-  }
-  for (int t = 0; t < mesh.num_triangles(); ++t) {
-    text += "3 " + std::to_string(mesh.triangles(t, 0)) + " " +
-            std::to_string(mesh.triangles(t, 1)) + " " + std::to_string(mesh.triangles(t, 2)) +
-            "\n";
-  }
-  return text;
+  return text + AsciiVertexAndFaceLines(mesh);
 }
 
 inline std::string Obj(const TriangleMesh& mesh) {
