@@ -46,11 +46,10 @@ std::vector<int> ChooseAnchors(const VertexAdjacency& adjacency, const std::vect
 
 }  // namespace
 
-ModelOptions ModelOptions::PlainLaplacian() {
-  ModelOptions options;
-  options.use_joint_nodes = false;
-  options.uniform_material = true;
-  return options;
+ModelOptions ModelOptions::PlainLaplacian(ModelOptions base) {
+  base.use_joint_nodes = false;
+  base.uniform_material = true;
+  return base;
 }
 
 StatusOr<std::shared_ptr<const DeformationModel>> DeformationModel::Build(

@@ -30,10 +30,14 @@ StatusOr<Method> MethodFromName(std::string_view name) {
 
 const char* MethodName(Method method) {
   switch (method) {
-    case Method::kPaper: return "paper";
-    case Method::kLaplacian: return "laplacian";
-    case Method::kLbs: return "lbs";
-    case Method::kDqs: return "dqs";
+    case Method::kPaper:
+      return "paper";
+    case Method::kLaplacian:
+      return "laplacian";
+    case Method::kLbs:
+      return "lbs";
+    case Method::kDqs:
+      return "dqs";
   }
   return "unknown";
 }
@@ -56,14 +60,10 @@ StatusOr<MethodRun> RunMethod(const DeformationModel& paper_model, Method method
     std::shared_ptr<const DeformationModel> plain;
     const DeformationModel* model = &paper_model;
     if (method == Method::kLaplacian) {
-      ModelOptions options = ModelOptions::PlainLaplacian();
-      options.regions = paper_model.options().regions;
-      options.anchor_weight = paper_model.options().anchor_weight;
-      options.anchor_distance_factor = paper_model.options().anchor_distance_factor;
-      options.ordering = paper_model.options().ordering;
-      options.limits = paper_model.options().limits;
-      DEFORM_ASSIGN_OR_RETURN(plain,
-                              DeformationModel::Build(paper_model.mesh(), paper_model.skeleton(), options));
+      // The same regions (so the same harmonic weights), anchors and ordering as the paper model.
+      DEFORM_ASSIGN_OR_RETURN(
+          plain, DeformationModel::Build(paper_model.mesh(), paper_model.skeleton(),
+                                         ModelOptions::PlainLaplacian(paper_model.options())));
       model = plain.get();
       run.precompute_seconds = model->precompute_seconds();
     }
@@ -85,7 +85,8 @@ StatusOr<MethodRun> RunMethod(const DeformationModel& paper_model, Method method
       const auto start = Clock::now();
       ForwardKinematics(paper_model.skeleton(), pose, &bones);
       if (method == Method::kLbs) {
-        LinearBlendSkinning(paper_model.mesh().vertices, paper_model.bone_weights(), bones, &run.posed);
+        LinearBlendSkinning(paper_model.mesh().vertices, paper_model.bone_weights(), bones,
+                            &run.posed);
       } else {
         DualQuaternionSkinning(paper_model.mesh().vertices, paper_model.bone_weights(), bones,
                                &run.posed);

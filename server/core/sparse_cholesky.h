@@ -81,16 +81,10 @@ class CholeskyFactor {
   // Doubles of scratch Solve3 needs: 3 * size() plus room for the widest supernode. The same for
   // every factor of one symbolic analysis.
   std::size_t WorkSize() const;
-  // Bytes one triangular pass reads: values, row indices and column pointers of L.
+  // Bytes one triangular pass reads: the supernodes' values, row indices and pointers.
   std::size_t bytes() const;
   // Non-zeros of L (the explicit zeros of the supernodes' diagonal blocks not counted).
   std::int64_t nonzeros() const { return symbolic_ ? symbolic_->factor_nonzeros() : 0; }
-  int num_supernodes() const { return static_cast<int>(row_pointers_.size()) - 1; }
-  // Width (columns) and height (rows) of supernode s.
-  int supernode_width(int s) const {
-    return symbolic_->supernode_columns_[s + 1] - symbolic_->supernode_columns_[s];
-  }
-  std::int64_t supernode_height(int s) const { return row_pointers_[s + 1] - row_pointers_[s]; }
 
  private:
   std::shared_ptr<const SymbolicCholesky> symbolic_;
