@@ -8,15 +8,6 @@
 #include <limits>
 #include <numeric>
 #include <string>
-#include <type_traits>
-
-// The solve kernels are compiled twice, for AVX2+FMA and for the baseline, and picked at load
-// time by the CPU (GCC's target_clones), so one binary runs everywhere and fast where it can.
-#if defined(__GNUC__) && defined(__x86_64__) && !defined(__clang__)
-#define DEFORM_SOLVE_KERNEL __attribute__((target_clones("arch=haswell", "default")))
-#else
-#define DEFORM_SOLVE_KERNEL
-#endif
 
 namespace deform {
 namespace {
@@ -286,7 +277,7 @@ StatusOr<CholeskyFactor> CholeskyFactor::Factorize(std::shared_ptr<const Symboli
     f.value_pointers_[sn + 1] = f.value_pointers_[sn] + rows * width;
   }
   f.row_indices_.resize(f.row_pointers_.back());
-  f.values_.assign(f.value_pointers_.back(), 0.0);
+  f.values_.assign(f.value_pointers_.back() + kSolveValuePadding, 0.0);
   for (int sn = 0; sn < num_supernodes; ++sn) {
     const int first = s.supernode_columns_[sn];
     const int width = s.supernode_columns_[sn + 1] - first;
@@ -306,300 +297,32 @@ StatusOr<CholeskyFactor> CholeskyFactor::Factorize(std::shared_ptr<const Symboli
 }
 
 std::size_t CholeskyFactor::WorkSize() const {
-  return symbolic_ ? 3 * static_cast<std::size_t>(symbolic_->n_ + symbolic_->max_supernode_width_)
+  return symbolic_ ? static_cast<std::size_t>(
+                         SolveWorkSize(symbolic_->n_, symbolic_->max_supernode_width_))
                    : 0;
 }
 
-namespace {
-
-// The supernode kernels. A supernode's own unknowns are kept planar (all x, then y, then z) in a
-// small buffer while its block is applied, so every inner loop is a contiguous dot product or
-// axpy over the block's row; kWidth > 0 fixes the width at compile time (the common narrow
-// supernodes), 0 reads it at run time.
-template <int kWidth>
-DEFORM_SOLVE_KERNEL void ForwardUpdate(const double* __restrict block, const int* __restrict rows,
-                                       std::int64_t first_row, std::int64_t num_rows,
-                                       int dynamic_width, const double* __restrict planar,
-                                       double* __restrict y) {
-  const int width = kWidth > 0 ? kWidth : dynamic_width;
-  const double* px = planar;
-  const double* py = planar + width;
-  const double* pz = planar + 2 * width;
-  std::int64_t r = first_row;
-  if (kWidth == 0) {
-    // Four rows at a time share each load of the supernode's unknowns.
-    for (; r + 4 <= num_rows; r += 4) {
-      const double* row0 = block + r * width;
-      const double* row1 = row0 + width;
-      const double* row2 = row1 + width;
-      const double* row3 = row2 + width;
-      double a0 = 0, a1 = 0, a2 = 0, b0 = 0, b1 = 0, b2 = 0;
-      double c0 = 0, c1 = 0, c2 = 0, d0 = 0, d1 = 0, d2 = 0;
-      for (int k = 0; k < width; ++k) {
-        const double x = px[k], yv = py[k], z = pz[k];
-        a0 += row0[k] * x;
-        a1 += row0[k] * yv;
-        a2 += row0[k] * z;
-        b0 += row1[k] * x;
-        b1 += row1[k] * yv;
-        b2 += row1[k] * z;
-        c0 += row2[k] * x;
-        c1 += row2[k] * yv;
-        c2 += row2[k] * z;
-        d0 += row3[k] * x;
-        d1 += row3[k] * yv;
-        d2 += row3[k] * z;
-      }
-      double* t0 = y + 3 * static_cast<std::ptrdiff_t>(rows[r]);
-      double* t1 = y + 3 * static_cast<std::ptrdiff_t>(rows[r + 1]);
-      double* t2 = y + 3 * static_cast<std::ptrdiff_t>(rows[r + 2]);
-      double* t3 = y + 3 * static_cast<std::ptrdiff_t>(rows[r + 3]);
-      t0[0] -= a0;
-      t0[1] -= a1;
-      t0[2] -= a2;
-      t1[0] -= b0;
-      t1[1] -= b1;
-      t1[2] -= b2;
-      t2[0] -= c0;
-      t2[1] -= c1;
-      t2[2] -= c2;
-      t3[0] -= d0;
-      t3[1] -= d1;
-      t3[2] -= d2;
-    }
-  }
-  for (; r < num_rows; ++r) {
-    const double* row = block + r * width;
-    double s0 = 0, s1 = 0, s2 = 0;
-    for (int k = 0; k < width; ++k) {
-      s0 += row[k] * px[k];
-      s1 += row[k] * py[k];
-      s2 += row[k] * pz[k];
-    }
-    double* target = y + 3 * static_cast<std::ptrdiff_t>(rows[r]);
-    target[0] -= s0;
-    target[1] -= s1;
-    target[2] -= s2;
-  }
-}
-
-template <int kWidth>
-DEFORM_SOLVE_KERNEL void BackwardUpdate(const double* __restrict block, const int* __restrict rows,
-                                        std::int64_t first_row, std::int64_t num_rows,
-                                        int dynamic_width, double* __restrict planar,
-                                        const double* __restrict y) {
-  const int width = kWidth > 0 ? kWidth : dynamic_width;
-  double* px = planar;
-  double* py = planar + width;
-  double* pz = planar + 2 * width;
-  std::int64_t r = first_row;
-  if (kWidth == 0) {
-    // Four rows at a time share each load and store of the accumulators.
-    for (; r + 4 <= num_rows; r += 4) {
-      const double* row0 = block + r * width;
-      const double* row1 = row0 + width;
-      const double* row2 = row1 + width;
-      const double* row3 = row2 + width;
-      const double* s0 = y + 3 * static_cast<std::ptrdiff_t>(rows[r]);
-      const double* s1 = y + 3 * static_cast<std::ptrdiff_t>(rows[r + 1]);
-      const double* s2 = y + 3 * static_cast<std::ptrdiff_t>(rows[r + 2]);
-      const double* s3 = y + 3 * static_cast<std::ptrdiff_t>(rows[r + 3]);
-      const double a0 = s0[0], a1 = s0[1], a2 = s0[2], b0 = s1[0], b1 = s1[1], b2 = s1[2];
-      const double c0 = s2[0], c1 = s2[1], c2 = s2[2], d0 = s3[0], d1 = s3[1], d2 = s3[2];
-      for (int k = 0; k < width; ++k) {
-        px[k] -= row0[k] * a0 + row1[k] * b0 + row2[k] * c0 + row3[k] * d0;
-        py[k] -= row0[k] * a1 + row1[k] * b1 + row2[k] * c1 + row3[k] * d1;
-        pz[k] -= row0[k] * a2 + row1[k] * b2 + row2[k] * c2 + row3[k] * d2;
-      }
-    }
-  }
-  for (; r < num_rows; ++r) {
-    const double* row = block + r * width;
-    const double* source = y + 3 * static_cast<std::ptrdiff_t>(rows[r]);
-    const double z0 = source[0], z1 = source[1], z2 = source[2];
-    for (int k = 0; k < width; ++k) {
-      px[k] -= row[k] * z0;
-      py[k] -= row[k] * z1;
-      pz[k] -= row[k] * z2;
-    }
-  }
-}
-
-// Forward substitution with a supernode's dense lower-triangular diagonal block (row-major,
-// `width` square): solves for its unknowns, given interleaved in `ys`, writing them back to `ys`
-// and planar into `planar`. Rows go four at a time, so the sums over the already solved unknowns
-// run as twelve independent chains instead of three.
-DEFORM_SOLVE_KERNEL void ForwardDiagonal(const double* __restrict block, int width,
-                                         double* __restrict ys, double* __restrict planar) {
-  double* px = planar;
-  double* py = planar + width;
-  double* pz = planar + 2 * width;
-  int c = 0;
-  for (; c + 4 <= width; c += 4) {
-    const double* r0 = block + c * width;
-    const double* r1 = r0 + width;
-    const double* r2 = r1 + width;
-    const double* r3 = r2 + width;
-    double a0 = ys[3 * c], a1 = ys[3 * c + 1], a2 = ys[3 * c + 2];
-    double b0 = ys[3 * c + 3], b1 = ys[3 * c + 4], b2 = ys[3 * c + 5];
-    double c0 = ys[3 * c + 6], c1 = ys[3 * c + 7], c2 = ys[3 * c + 8];
-    double d0 = ys[3 * c + 9], d1 = ys[3 * c + 10], d2 = ys[3 * c + 11];
-    for (int k = 0; k < c; ++k) {
-      const double x = px[k], y = py[k], z = pz[k];
-      a0 -= r0[k] * x;
-      a1 -= r0[k] * y;
-      a2 -= r0[k] * z;
-      b0 -= r1[k] * x;
-      b1 -= r1[k] * y;
-      b2 -= r1[k] * z;
-      c0 -= r2[k] * x;
-      c1 -= r2[k] * y;
-      c2 -= r2[k] * z;
-      d0 -= r3[k] * x;
-      d1 -= r3[k] * y;
-      d2 -= r3[k] * z;
-    }
-    // The 4 by 4 triangle at the tile's corner.
-    px[c] = a0 / r0[c];
-    py[c] = a1 / r0[c];
-    pz[c] = a2 / r0[c];
-    b0 -= r1[c] * px[c];
-    b1 -= r1[c] * py[c];
-    b2 -= r1[c] * pz[c];
-    px[c + 1] = b0 / r1[c + 1];
-    py[c + 1] = b1 / r1[c + 1];
-    pz[c + 1] = b2 / r1[c + 1];
-    c0 -= r2[c] * px[c] + r2[c + 1] * px[c + 1];
-    c1 -= r2[c] * py[c] + r2[c + 1] * py[c + 1];
-    c2 -= r2[c] * pz[c] + r2[c + 1] * pz[c + 1];
-    px[c + 2] = c0 / r2[c + 2];
-    py[c + 2] = c1 / r2[c + 2];
-    pz[c + 2] = c2 / r2[c + 2];
-    d0 -= r3[c] * px[c] + r3[c + 1] * px[c + 1] + r3[c + 2] * px[c + 2];
-    d1 -= r3[c] * py[c] + r3[c + 1] * py[c + 1] + r3[c + 2] * py[c + 2];
-    d2 -= r3[c] * pz[c] + r3[c + 1] * pz[c + 1] + r3[c + 2] * pz[c + 2];
-    px[c + 3] = d0 / r3[c + 3];
-    py[c + 3] = d1 / r3[c + 3];
-    pz[c + 3] = d2 / r3[c + 3];
-  }
-  for (; c < width; ++c) {
-    const double* row = block + c * width;
-    double s0 = ys[3 * c], s1 = ys[3 * c + 1], s2 = ys[3 * c + 2];
-    for (int k = 0; k < c; ++k) {
-      s0 -= row[k] * px[k];
-      s1 -= row[k] * py[k];
-      s2 -= row[k] * pz[k];
-    }
-    px[c] = s0 / row[c];
-    py[c] = s1 / row[c];
-    pz[c] = s2 / row[c];
-  }
-  for (int k = 0; k < width; ++k) {
-    ys[3 * k] = px[k];
-    ys[3 * k + 1] = py[k];
-    ys[3 * k + 2] = pz[k];
-  }
-}
-
-// Back substitution with the transpose of the diagonal block: `planar` holds the right-hand side
-// on entry; the solution goes to `ys` (interleaved). Each solved unknown updates the ones before
-// it along its contiguous row of the block (independent updates, no long sums).
-DEFORM_SOLVE_KERNEL void BackwardDiagonal(const double* __restrict block, int width,
-                                          double* __restrict ys, double* __restrict planar) {
-  double* px = planar;
-  double* py = planar + width;
-  double* pz = planar + 2 * width;
-  for (int c = width - 1; c >= 0; --c) {
-    const double* row = block + c * width;
-    const double x0 = px[c] / row[c], x1 = py[c] / row[c], x2 = pz[c] / row[c];
-    ys[3 * c] = x0;
-    ys[3 * c + 1] = x1;
-    ys[3 * c + 2] = x2;
-    for (int k = 0; k < c; ++k) {
-      px[k] -= row[k] * x0;
-      py[k] -= row[k] * x1;
-      pz[k] -= row[k] * x2;
-    }
-  }
-}
-
-template <typename Kernel>
-void DispatchByWidth(int width, Kernel&& kernel) {
-  switch (width) {
-    case 1:
-      kernel(std::integral_constant<int, 1>());
-      break;
-    case 2:
-      kernel(std::integral_constant<int, 2>());
-      break;
-    case 3:
-      kernel(std::integral_constant<int, 3>());
-      break;
-    case 4:
-      kernel(std::integral_constant<int, 4>());
-      break;
-    default:
-      kernel(std::integral_constant<int, 0>());
-      break;
-  }
-}
-
-}  // namespace
-
 void CholeskyFactor::Solve3(const double* b, double* x, double* work) const {
+  static const Solve3Function best = Solve3For(BestSolveKernel());
+  best(View(), b, x, work);
+}
+
+void CholeskyFactor::Solve3(const double* b, double* x, double* work, SolveKernel kernel) const {
+  Solve3For(kernel)(View(), b, x, work);
+}
+
+SupernodalFactorView CholeskyFactor::View() const {
   const SymbolicCholesky& s = *symbolic_;
-  const int n = s.n_;
-  const int num_supernodes = static_cast<int>(s.supernode_columns_.size()) - 1;
-  const int* perm = s.permutation_.data();
-  double* __restrict y = work;
-  double* __restrict planar = work + 3 * static_cast<std::ptrdiff_t>(n);  // 3 * widest supernode
-
-  for (int i = 0; i < n; ++i) {
-    const double* src = b + 3 * static_cast<std::ptrdiff_t>(perm[i]);
-    y[3 * i] = src[0];
-    y[3 * i + 1] = src[1];
-    y[3 * i + 2] = src[2];
-  }
-
-  // L y = P b, one pass over the factor.
-  for (int sn = 0; sn < num_supernodes; ++sn) {
-    const int first = s.supernode_columns_[sn];
-    const int width = s.supernode_columns_[sn + 1] - first;
-    const int* rows = row_indices_.data() + row_pointers_[sn];
-    const std::int64_t num_rows = row_pointers_[sn + 1] - row_pointers_[sn];
-    const double* block = values_.data() + value_pointers_[sn];
-    double* ys = y + 3 * static_cast<std::ptrdiff_t>(first);  // the supernode's own unknowns
-    ForwardDiagonal(block, width, ys, planar);
-    DispatchByWidth(width, [&](auto w) {
-      ForwardUpdate<decltype(w)::value>(block, rows, width, num_rows, width, planar, y);
-    });
-  }
-
-  // L^T z = y, one pass over the factor backwards.
-  for (int sn = num_supernodes - 1; sn >= 0; --sn) {
-    const int first = s.supernode_columns_[sn];
-    const int width = s.supernode_columns_[sn + 1] - first;
-    const int* rows = row_indices_.data() + row_pointers_[sn];
-    const std::int64_t num_rows = row_pointers_[sn + 1] - row_pointers_[sn];
-    const double* block = values_.data() + value_pointers_[sn];
-    double* ys = y + 3 * static_cast<std::ptrdiff_t>(first);
-    for (int k = 0; k < width; ++k) {
-      planar[k] = ys[3 * k];
-      planar[width + k] = ys[3 * k + 1];
-      planar[2 * width + k] = ys[3 * k + 2];
-    }
-    DispatchByWidth(width, [&](auto w) {
-      BackwardUpdate<decltype(w)::value>(block, rows, width, num_rows, width, planar, y);
-    });
-    BackwardDiagonal(block, width, ys, planar);
-  }
-
-  for (int i = 0; i < n; ++i) {
-    double* dst = x + 3 * static_cast<std::ptrdiff_t>(perm[i]);
-    dst[0] = y[3 * i];
-    dst[1] = y[3 * i + 1];
-    dst[2] = y[3 * i + 2];
-  }
+  SupernodalFactorView view;
+  view.size = s.n_;
+  view.num_supernodes = static_cast<int>(s.supernode_columns_.size()) - 1;
+  view.supernode_columns = s.supernode_columns_.data();
+  view.permutation = s.permutation_.data();
+  view.row_pointers = row_pointers_.data();
+  view.value_pointers = value_pointers_.data();
+  view.row_indices = row_indices_.data();
+  view.values = values_.data();
+  return view;
 }
 
 std::size_t CholeskyFactor::bytes() const {

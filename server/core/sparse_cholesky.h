@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "core/status.h"
+#include "core/supernodal_solve.h"
 
 namespace deform {
 
@@ -77,7 +78,10 @@ class CholeskyFactor {
   int size() const { return symbolic_ ? symbolic_->size() : 0; }
   // Solves A X = B for three right-hand sides stored interleaved: b[3 i + c] is row i, column c.
   // `x` may equal `b`. `work` holds WorkSize() doubles. Allocation-free; const and thread-safe.
+  // Runs the fastest kernel this CPU supports (see supernodal_solve.h).
   void Solve3(const double* b, double* x, double* work) const;
+  // The same with a chosen kernel, which must be available (for tests and benchmarks).
+  void Solve3(const double* b, double* x, double* work, SolveKernel kernel) const;
   // Doubles of scratch Solve3 needs: 3 * size() plus room for the widest supernode. The same for
   // every factor of one symbolic analysis.
   std::size_t WorkSize() const;
@@ -87,6 +91,8 @@ class CholeskyFactor {
   std::int64_t nonzeros() const { return symbolic_ ? symbolic_->factor_nonzeros() : 0; }
 
  private:
+  SupernodalFactorView View() const;
+
   std::shared_ptr<const SymbolicCholesky> symbolic_;
   // Supernode s: its rows are row_indices_[row_pointers_[s] .. row_pointers_[s + 1]) (its own
   // columns first, then the rows below, ascending); its values are a dense row-major block of

@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <cmath>
 #include <random>
+#include <string>
 
 namespace deform {
 namespace {
@@ -103,6 +105,47 @@ INSTANTIATE_TEST_SUITE_P(AllOrderings, SparseCholeskyTest,
                          ::testing::Values(Ordering::kNatural, Ordering::kAmd, Ordering::kMetis,
                                            Ordering::kAuto),
                          [](const auto& info) { return std::string(OrderingName(info.param)); });
+
+// Every compiled solve kernel this CPU can run gives the dense answer, on matrices whose
+// supernodes have widths and heights with every remainder modulo four (the kernels' tails).
+class SolveKernelTest : public ::testing::TestWithParam<SolveKernel> {};
+
+TEST_P(SolveKernelTest, MatchesDenseCholeskyOnEveryShape) {
+  if (!SolveKernelAvailable(GetParam())) {
+    GTEST_SKIP() << SolveKernelName(GetParam()) << " is not available on this build or CPU";
+  }
+  for (const int n : {1, 2, 3, 5, 6, 7, 37, 300, 301, 302, 303}) {
+    for (const Ordering ordering : {Ordering::kNatural, Ordering::kAmd, Ordering::kMetis}) {
+      const ColMajorMatrix a = RandomSpdMatrix(n, 4, 100 + n);
+      auto symbolic = SymbolicCholesky::Analyze(a, ordering);
+      ASSERT_TRUE(symbolic.ok()) << symbolic.status().ToString();
+      auto factor = CholeskyFactor::Factorize(*symbolic, a);
+      ASSERT_TRUE(factor.ok()) << factor.status().ToString();
+
+      const auto b = RandomRightHandSides(n, 5 + n);
+      Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> x(n, 3);
+      std::vector<double> work(factor->WorkSize(), std::nan(""));  // the kernel must not read it
+      factor->Solve3(b.data(), x.data(), work.data(), GetParam());
+
+      const Eigen::MatrixXd dense = Eigen::MatrixXd(a);
+      const Eigen::MatrixXd expected = dense.llt().solve(Eigen::MatrixXd(b));
+      EXPECT_LT((Eigen::MatrixXd(x) - expected).norm(), 1e-10 * expected.norm())
+          << "n " << n << ", " << OrderingName(ordering);
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(AllKernels, SolveKernelTest,
+                         ::testing::Values(SolveKernel::kBaseline, SolveKernel::kAvx2Fma),
+                         [](const auto& info) {
+                           return std::string(info.param == SolveKernel::kBaseline ? "baseline"
+                                                                                   : "avx2_fma");
+                         });
+
+TEST(SolveKernel, TheBestIsAvailable) {
+  EXPECT_TRUE(SolveKernelAvailable(BestSolveKernel())) << SolveKernelName(BestSolveKernel());
+  EXPECT_TRUE(SolveKernelAvailable(SolveKernel::kBaseline));
+}
 
 TEST(SparseCholesky, MetisOrderingFillsLessThanNatural) {
   // A 2D grid Laplacian: nested dissection beats the natural (banded) order.
