@@ -85,6 +85,16 @@ LoadReport BuildReport(const RunDescription& run, const LoadPlan& plan, RunOutco
         report.first_stream_error = client::StatusText(stream.status);
     }
   }
+  // latency_ms[i] and timings[i] are the same frame's (both appended per stream, in order).
+  std::vector<double> server_total, outside_server;
+  for (std::size_t i = 0; i < timings.size() && i < report.latency_ms.size(); ++i) {
+    const ServerTimings& t = timings[i];
+    const double total = t.queue_ms + t.rhs_ms + t.solve_ms + t.encode_ms;
+    server_total.push_back(total);
+    outside_server.push_back(report.latency_ms[i] - total);
+  }
+  report.server_total = Summarize(&server_total);
+  report.outside_server = Summarize(&outside_server);
   CountError(&report, "INVALID_ARGUMENT", report.poses_rejected + report.stiffness_rejected);
   CountError(&report, "DATA_LOSS", report.bad_frames);
   report.latency = Summarize(&report.latency_ms);
@@ -129,6 +139,12 @@ nlohmann::ordered_json ReportJson(const LoadReport& report) {
                           {"rhs", Ms(report.server_p50.rhs_ms)},
                           {"solve", Ms(report.server_p50.solve_ms)},
                           {"encode", Ms(report.server_p50.encode_ms)}};
+  out["server_total_ms"] = {{"p50", Ms(report.server_total.p50)},
+                            {"p99", Ms(report.server_total.p99)},
+                            {"max", Ms(report.server_total.max)}};
+  out["outside_server_ms"] = {{"p50", Ms(report.outside_server.p50)},
+                              {"p99", Ms(report.outside_server.p99)},
+                              {"max", Ms(report.outside_server.max)}};
   out["send_lag_max_ms"] = Ms(report.send_lag_max_ms);
   return out;
 }
@@ -158,6 +174,9 @@ std::string ReportText(const LoadReport& report) {
   add("server ms (median): queue %.3f  rhs %.3f  solve %.3f  encode %.3f\n",
       report.server_p50.queue_ms, report.server_p50.rhs_ms, report.server_p50.solve_ms,
       report.server_p50.encode_ms);
+  add("server total ms: p50 %.3f  p99 %.3f; outside the server (gRPC, wake-ups): p50 %.3f  p99 %.3f\n",
+      report.server_total.p50, report.server_total.p99, report.outside_server.p50,
+      report.outside_server.p99);
   if (plan.stiffness_every_s > 0) {
     add("stiffness on %s every %.2f s: %llu sent, %llu applied (median refactorisation %.3f ms)\n",
         report.run.stiffness_joint.c_str(), plan.stiffness_every_s,

@@ -44,6 +44,10 @@ struct LoadReport {
   std::uint64_t stiffness_applied = 0;
   double stiffness_factor_ms_p50 = 0;
   ServerTimings server_p50;  // median of each server timing over measured frames
+  // Per measured frame: the server's share (queue + rhs + solve + encode) and the rest of the
+  // latency (gRPC, the network and both sides' thread wake-ups).
+  LatencySummary server_total;
+  LatencySummary outside_server;
   double send_lag_max_ms = 0;
 
   double delivered_fraction() const;
