@@ -73,11 +73,16 @@ StatusOr<MethodRun> RunMethod(const DeformationModel& paper_model, Method method
     run.joint_nodes = model->num_joint_nodes();
     run.anchors = static_cast<int>(model->anchor_vertices().size());
     DeformScratch scratch = model->MakeScratch();
+    std::vector<double> solve_seconds;
+    solve_seconds.reserve(repeat);
     for (int r = 0; r < repeat; ++r) {
       const auto start = Clock::now();
-      model->Deform(factorization, pose, &scratch);
+      DeformTimings timings;
+      model->Deform(factorization, pose, &scratch, &timings);
       frame_seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
+      solve_seconds.push_back(timings.solve);
     }
+    run.solve_seconds = Median(solve_seconds);
     run.posed = scratch.positions();
   } else {
     std::vector<RigidTransform> bones;
@@ -94,7 +99,8 @@ StatusOr<MethodRun> RunMethod(const DeformationModel& paper_model, Method method
       frame_seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
     }
   }
-  run.solve_seconds = Median(frame_seconds);
+  run.frame_seconds = Median(frame_seconds);
+  if (method == Method::kLbs || method == Method::kDqs) run.solve_seconds = run.frame_seconds;
 
   std::vector<RigidTransform> bones;
   ForwardKinematics(paper_model.skeleton(), pose, &bones);

@@ -27,7 +27,11 @@ struct MethodRun {
   double precompute_seconds = 0;  // model precomputation (weights, regions, symbolic analysis)
   double factor_seconds = 0;      // numeric factorisation (0 for skinning)
   std::size_t factor_bytes = 0;   // bytes of the stored factor (0 for skinning)
-  double solve_seconds = 0;       // median per-frame time over `repeat` frames
+  // Medians over `repeat` frames. For paper and laplacian, solve_seconds is the two triangular
+  // passes (what the memory-read bound limits) and frame_seconds the whole frame (kinematics,
+  // rotation blend, right-hand side, solve); for the skinning methods both are the whole frame.
+  double solve_seconds = 0;
+  double frame_seconds = 0;
   int joint_nodes = 0;
   int anchors = 0;
 };
