@@ -119,6 +119,22 @@ void BM_TriangularSolve(benchmark::State& state, BenchMesh mesh, SolveKernel ker
   ReportAgainstBound(state, factorization.factor().bytes(), seconds);
 }
 
+// The right-hand side alone: kinematics, rotation blend and the product with L'^T.
+void BM_RightHandSide(benchmark::State& state, BenchMesh mesh) {
+  auto model = ModelFor(mesh);
+  if (!model) return state.SkipWithError("mesh could not be loaded");
+  const Pose pose = PoseFor(*model, mesh);
+  DeformScratch scratch = model->MakeScratch();
+  const auto& factorization = *model->default_factorization();
+  std::vector<double> seconds;
+  for (auto _ : state) {
+    const auto start = Clock::now();
+    model->AssembleRightHandSide(factorization, pose, &scratch);
+    seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
+  }
+  state.counters["median_ms"] = Median(seconds) * 1e3;
+}
+
 // Baseline: Eigen's SimplicialLLT (AMD ordering) on the same system, three columns at once.
 void BM_EigenBaselineSolve(benchmark::State& state, BenchMesh mesh) {
   auto model = ModelFor(mesh);
@@ -210,6 +226,8 @@ int main(int argc, char** argv) {
         ->Unit(benchmark::kMillisecond)->Iterations(large ? 2 : 5);
     benchmark::RegisterBenchmark(("Frame/" + mesh.name).c_str(), BM_Frame, mesh)
         ->Unit(benchmark::kMillisecond)->MinTime(1.0);
+    benchmark::RegisterBenchmark(("RightHandSide/" + mesh.name).c_str(), BM_RightHandSide, mesh)
+        ->Unit(benchmark::kMillisecond)->MinTime(0.5);
     benchmark::RegisterBenchmark(("TriangularSolve/" + mesh.name).c_str(), BM_TriangularSolve, mesh,
                                  deform::BestSolveKernel())
         ->Unit(benchmark::kMillisecond)->MinTime(1.0);

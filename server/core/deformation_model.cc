@@ -227,8 +227,44 @@ void DeformationModel::Deform(const MaterialFactorization& factorization, const 
   }
 }
 
-// Entries of L'^T ahead of the one being summed whose rows of r are prefetched.
-constexpr int kPrefetchDistance = 48;
+namespace {
+
+// out = m r for a row-major sparse m and n by 3 row-major r and out. Two partial sums per row, so
+// consecutive entries do not wait on each other's adds.
+void MultiplySparseBy3(const Eigen::SparseMatrix<double, Eigen::RowMajor, int>& m,
+                       const double* __restrict r, double* __restrict out) {
+  const int* columns = m.innerIndexPtr();
+  const double* values = m.valuePtr();
+  const int* row_begin = m.outerIndexPtr();
+  for (int row = 0; row < m.outerSize(); ++row) {
+    double a0 = 0, a1 = 0, a2 = 0, b0 = 0, b1 = 0, b2 = 0;
+    int p = row_begin[row];
+    const int end = row_begin[row + 1];
+    for (; p + 2 <= end; p += 2) {
+      const double* x = r + 3 * static_cast<std::ptrdiff_t>(columns[p]);
+      const double* y = r + 3 * static_cast<std::ptrdiff_t>(columns[p + 1]);
+      const double u = values[p], v = values[p + 1];
+      a0 += u * x[0];
+      a1 += u * x[1];
+      a2 += u * x[2];
+      b0 += v * y[0];
+      b1 += v * y[1];
+      b2 += v * y[2];
+    }
+    if (p < end) {
+      const double* x = r + 3 * static_cast<std::ptrdiff_t>(columns[p]);
+      a0 += values[p] * x[0];
+      a1 += values[p] * x[1];
+      a2 += values[p] * x[2];
+    }
+    double* target = out + 3 * static_cast<std::ptrdiff_t>(row);
+    target[0] = a0 + b0;
+    target[1] = a1 + b1;
+    target[2] = a2 + b2;
+  }
+}
+
+}  // namespace
 
 void DeformationModel::AssembleRightHandSide(const MaterialFactorization& factorization,
                                              const Pose& pose, DeformScratch* scratch) const {
@@ -264,28 +300,7 @@ void DeformationModel::AssembleRightHandSide(const MaterialFactorization& factor
 
   // A^T b = L'^T r + anchor_weight^2 c + node_weight^2 o.
   auto& rhs = scratch->solution;
-  const int* neighbours = laplacian_transpose_.innerIndexPtr();
-  const int num_entries = laplacian_transpose_.nonZeros();
-  for (int row = 0; row < laplacian_transpose_.outerSize(); ++row) {
-    double s0 = 0, s1 = 0, s2 = 0;
-    for (int p = laplacian_transpose_.outerIndexPtr()[row];
-         p < laplacian_transpose_.outerIndexPtr()[row + 1]; ++p) {
-      // The one-rings of a scanned mesh are scattered over the whole vertex range: fetch the
-      // rows needed a few one-rings ahead.
-      if (p + kPrefetchDistance < num_entries) {
-        const int ahead = neighbours[p + kPrefetchDistance];
-        __builtin_prefetch(r.data() + 3 * static_cast<std::ptrdiff_t>(ahead));
-      }
-      const int i = neighbours[p];
-      const double v = laplacian_transpose_.valuePtr()[p];
-      s0 += v * r(i, 0);
-      s1 += v * r(i, 1);
-      s2 += v * r(i, 2);
-    }
-    rhs(row, 0) = s0;
-    rhs(row, 1) = s1;
-    rhs(row, 2) = s2;
-  }
+  MultiplySparseBy3(laplacian_transpose_, r.data(), rhs.data());
   const double anchor2 = options_.anchor_weight * options_.anchor_weight;
   for (size_t a = 0; a < anchors_.size(); ++a) {
     const Eigen::Vector3d target = bones[anchor_bone_[a]].Apply(anchor_rest_.row(a).transpose());
