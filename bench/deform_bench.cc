@@ -65,6 +65,18 @@ double Median(std::vector<double> v) {
   return v.empty() ? 0 : v[v.size() / 2];
 }
 
+// Runs `frame` once per benchmark iteration and returns each run's wall time in seconds.
+template <typename Frame>
+std::vector<double> TimeEach(benchmark::State& state, Frame&& frame) {
+  std::vector<double> seconds;
+  for (auto _ : state) {
+    const auto start = Clock::now();
+    frame();
+    seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
+  }
+  return seconds;
+}
+
 void ReportAgainstBound(benchmark::State& state, std::size_t factor_bytes,
                         const std::vector<double>& seconds) {
   const double median_ms = Median(seconds) * 1e3;
@@ -89,12 +101,7 @@ void BM_Frame(benchmark::State& state, BenchMesh mesh) {
   const Pose pose = PoseFor(*model, mesh);
   DeformScratch scratch = model->MakeScratch();
   const auto& factorization = *model->default_factorization();
-  std::vector<double> seconds;
-  for (auto _ : state) {
-    const auto start = Clock::now();
-    model->Deform(factorization, pose, &scratch);
-    seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
-  }
+  const auto seconds = TimeEach(state, [&] { model->Deform(factorization, pose, &scratch); });
   ReportAgainstBound(state, factorization.factor().bytes(), seconds);
   state.counters["vertices"] = model->mesh().num_vertices();
 }
@@ -109,13 +116,10 @@ void BM_TriangularSolve(benchmark::State& state, BenchMesh mesh, SolveKernel ker
   const auto& factorization = *model->default_factorization();
   model->AssembleRightHandSide(factorization, pose, &scratch);
   const auto rhs = scratch.solution;
-  std::vector<double> seconds;
-  for (auto _ : state) {
-    const auto start = Clock::now();
+  const auto seconds = TimeEach(state, [&] {
     factorization.factor().Solve3(rhs.data(), scratch.solution.data(), scratch.solve_work.data(),
                                   kernel);
-    seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
-  }
+  });
   ReportAgainstBound(state, factorization.factor().bytes(), seconds);
 }
 
@@ -126,12 +130,8 @@ void BM_RightHandSide(benchmark::State& state, BenchMesh mesh) {
   const Pose pose = PoseFor(*model, mesh);
   DeformScratch scratch = model->MakeScratch();
   const auto& factorization = *model->default_factorization();
-  std::vector<double> seconds;
-  for (auto _ : state) {
-    const auto start = Clock::now();
-    model->AssembleRightHandSide(factorization, pose, &scratch);
-    seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
-  }
+  const auto seconds =
+      TimeEach(state, [&] { model->AssembleRightHandSide(factorization, pose, &scratch); });
   state.counters["median_ms"] = Median(seconds) * 1e3;
 }
 
