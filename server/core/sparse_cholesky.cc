@@ -303,8 +303,7 @@ std::size_t CholeskyFactor::WorkSize() const {
 }
 
 void CholeskyFactor::Solve3(const double* b, double* x, double* work) const {
-  static const Solve3Function best = Solve3For(BestSolveKernel());
-  best(View(), b, x, work);
+  Solve3(b, x, work, BestSolveKernel());
 }
 
 void CholeskyFactor::Solve3(const double* b, double* x, double* work, SolveKernel kernel) const {

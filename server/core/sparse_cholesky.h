@@ -82,8 +82,8 @@ class CholeskyFactor {
   void Solve3(const double* b, double* x, double* work) const;
   // The same with a chosen kernel, which must be available (for tests and benchmarks).
   void Solve3(const double* b, double* x, double* work, SolveKernel kernel) const;
-  // Doubles of scratch Solve3 needs: 3 * size() plus room for the widest supernode. The same for
-  // every factor of one symbolic analysis.
+  // Doubles of scratch Solve3 needs (SolveWorkSize: a four-double row per unknown plus room for
+  // the widest supernode). The same for every factor of one symbolic analysis.
   std::size_t WorkSize() const;
   // Bytes one triangular pass reads: the supernodes' values, row indices and pointers.
   std::size_t bytes() const;

@@ -113,7 +113,8 @@ inline void ZeroPadding(const Planar& p, int width) {
 }
 
 // sums[4 j + c] = sum over k < n of row_j[k] * p.c[k], for the four rows j and the columns c
-// (sums[4 j + 3] = 0: the layout of four solution rows).
+// (sums[4 j + 3] = 0: the layout of four solution rows). `n` is a multiple of four: the callers
+// pass a tile's start column or a padded width.
 inline void Dot4x3(const double* __restrict r0, const double* __restrict r1,
                    const double* __restrict r2, const double* __restrict r3, const Planar& p,
                    int n, double* __restrict sums) {
@@ -122,8 +123,7 @@ inline void Dot4x3(const double* __restrict r0, const double* __restrict r1,
   const double* __restrict pz = p.z;
   Vec4 a0 = Splat4(0), a1 = a0, a2 = a0, b0 = a0, b1 = a0, b2 = a0;
   Vec4 c0 = a0, c1 = a0, c2 = a0, d0 = a0, d1 = a0, d2 = a0;
-  int k = 0;
-  for (; k + 4 <= n; k += 4) {
+  for (int k = 0; k < n; k += 4) {
     const Vec4 x = Load4(px + k), y = Load4(py + k), z = Load4(pz + k);
     Vec4 r = Load4(r0 + k);
     a0 += r * x;
@@ -143,27 +143,10 @@ inline void Dot4x3(const double* __restrict r0, const double* __restrict r1,
     d2 += r * z;
   }
   const Vec4 zero = Splat4(0);
-  double s[16];
-  Store4(s, Sum4x4(a0, a1, a2, zero));
-  Store4(s + 4, Sum4x4(b0, b1, b2, zero));
-  Store4(s + 8, Sum4x4(c0, c1, c2, zero));
-  Store4(s + 12, Sum4x4(d0, d1, d2, zero));
-  for (; k < n; ++k) {
-    const double x = px[k], y = py[k], z = pz[k];
-    s[0] += r0[k] * x;
-    s[1] += r0[k] * y;
-    s[2] += r0[k] * z;
-    s[4] += r1[k] * x;
-    s[5] += r1[k] * y;
-    s[6] += r1[k] * z;
-    s[8] += r2[k] * x;
-    s[9] += r2[k] * y;
-    s[10] += r2[k] * z;
-    s[12] += r3[k] * x;
-    s[13] += r3[k] * y;
-    s[14] += r3[k] * z;
-  }
-  for (int i = 0; i < 16; ++i) sums[i] = s[i];
+  Store4(sums, Sum4x4(a0, a1, a2, zero));
+  Store4(sums + 4, Sum4x4(b0, b1, b2, zero));
+  Store4(sums + 8, Sum4x4(c0, c1, c2, zero));
+  Store4(sums + 12, Sum4x4(d0, d1, d2, zero));
 }
 
 // sums[c] = sum over k < n of row[k] * p.c[k].
@@ -241,6 +224,9 @@ inline void SubtractRow1x3(const double* __restrict row, const double* __restric
 constexpr int kRowStride = 4;
 
 inline double* Row(double* y, int row) { return y + kRowStride * static_cast<std::ptrdiff_t>(row); }
+inline const double* Row(const double* y, int row) {
+  return y + kRowStride * static_cast<std::ptrdiff_t>(row);
+}
 
 // Forward substitution with a supernode's dense lower-triangular diagonal block (row-major,
 // `width` square): solves for its unknowns, whose right-hand sides are the solution rows from
@@ -407,8 +393,8 @@ inline void BackwardUpdateNarrow(const double* __restrict block, const int* __re
   for (; r + 2 <= num_rows; r += 2) {
     const double* row0 = block + r * kWidth;
     const double* row1 = row0 + kWidth;
-    const Vec4 z0 = Load4(y + kRowStride * static_cast<std::ptrdiff_t>(rows[r]));
-    const Vec4 z1 = Load4(y + kRowStride * static_cast<std::ptrdiff_t>(rows[r + 1]));
+    const Vec4 z0 = Load4(Row(y, rows[r]));
+    const Vec4 z1 = Load4(Row(y, rows[r + 1]));
     for (int k = 0; k < kWidth; ++k) {
       even[k] += Splat4(row0[k]) * z0;
       odd[k] += Splat4(row1[k]) * z1;
@@ -416,7 +402,7 @@ inline void BackwardUpdateNarrow(const double* __restrict block, const int* __re
   }
   if (r < num_rows) {
     const double* row = block + r * kWidth;
-    const Vec4 z = Load4(y + kRowStride * static_cast<std::ptrdiff_t>(rows[r]));
+    const Vec4 z = Load4(Row(y, rows[r]));
     for (int k = 0; k < kWidth; ++k) even[k] += Splat4(row[k]) * z;
   }
   for (int k = 0; k < kWidth; ++k) {
