@@ -175,6 +175,9 @@ StatusOr<std::shared_ptr<const MaterialFactorization>> DeformationModel::Factori
 
   const ColMajorMatrix normal = BuildNormalMatrix(result->row_weights_squared_);
   DEFORM_ASSIGN_OR_RETURN(result->factor_, CholeskyFactor::Factorize(symbolic_, normal));
+  if (options_.rotation_blend == RotationBlend::kLinear) {
+    result->linear_response_ = BuildLinearResponse(*result);
+  }
   result->factor_seconds_ = SecondsSince(start);
   return std::shared_ptr<const MaterialFactorization>(std::move(result));
 }
@@ -218,9 +221,18 @@ DeformScratch DeformationModel::MakeScratch() const {
 void DeformationModel::Deform(const MaterialFactorization& factorization, const Pose& pose,
                               DeformScratch* scratch, DeformTimings* timings) const {
   const auto start = Clock::now();
-  AssembleRightHandSide(factorization, pose, scratch);
+  const LinearPoseResponse* response = factorization.linear_response();
+  if (response != nullptr) {
+    ForwardKinematics(skeleton_, pose, &scratch->bone_transforms);
+  } else {
+    AssembleRightHandSide(factorization, pose, scratch);
+  }
   const auto solve_start = Clock::now();
-  SolveInPlace(factorization, scratch);
+  if (response != nullptr) {
+    response->Evaluate(scratch->bone_transforms, scratch->solution.data());
+  } else {
+    SolveInPlace(factorization, scratch);
+  }
   if (timings != nullptr) {
     timings->right_hand_side = std::chrono::duration<double>(solve_start - start).count();
     timings->solve = SecondsSince(solve_start);
@@ -272,7 +284,7 @@ void DeformationModel::AssembleRightHandSide(const MaterialFactorization& factor
   ForwardKinematics(skeleton_, pose, &scratch->bone_transforms);
   const auto& bones = scratch->bone_transforms;
 
-  // Rotated, weighted differential coordinates r_i = w_i^2 T_i delta_i, T_i the QLERP blend.
+  // Rotated, weighted differential coordinates r_i = w_i^2 T_i delta_i, T_i the rotation blend.
   const auto& bw = bone_weights_;
   const auto& w2 = factorization.row_weights_squared_;
   auto& r = scratch->rotated_deltas;
@@ -284,6 +296,14 @@ void DeformationModel::AssembleRightHandSide(const MaterialFactorization& factor
     const Eigen::Vector3d delta = rest_deltas_.row(i).transpose();
     if (end - begin == 1) {  // most vertices: wholly one bone's
       r.row(i) = w2[i] * (scratch->bone_rotations[bw.bones[begin]] * delta).transpose();
+      continue;
+    }
+    if (options_.rotation_blend == RotationBlend::kLinear) {
+      Eigen::Matrix3d blend = bw.weights[begin] * scratch->bone_rotations[bw.bones[begin]];
+      for (int p = begin + 1; p < end; ++p) {
+        blend += bw.weights[p] * scratch->bone_rotations[bw.bones[p]];
+      }
+      r.row(i) = w2[i] * (blend * delta).transpose();
       continue;
     }
     const Eigen::Quaterniond& first = bones[bw.bones[begin]].rotation;
@@ -317,6 +337,76 @@ void DeformationModel::SolveInPlace(const MaterialFactorization& factorization,
                                     DeformScratch* scratch) const {
   factorization.factor().Solve3(scratch->solution.data(), scratch->solution.data(),
                                 scratch->solve_work.data());
+}
+
+// Column b of U_k solves A u = (the right-hand side of R_k = I, every other transform zero)'s column
+// b, since right-hand side coordinate a is sum_k sum_b R_k[a, b] (that column) + t_k[a] (V_k's);
+// see linear_pose_response.h.
+std::unique_ptr<const LinearPoseResponse> DeformationModel::BuildLinearResponse(
+    const MaterialFactorization& factorization) const {
+  const int n = mesh_.num_vertices();
+  const int num_bones = skeleton_.num_bones();
+  std::vector<int> node_bone(num_nodes_);
+  for (int c = 0; c < num_nodes_; ++c) node_bone[c] = skeleton_.IncomingBone(node_joint_[c]);
+  // Bones that appear in the right-hand side at all: through blend weights, anchors, joint nodes.
+  std::vector<char> appears(num_bones, 0);
+  for (int k : bone_weights_.bones) appears[k] = 1;
+  for (int k : anchor_bone_) appears[k] = 1;
+  for (int k : node_bone) {
+    if (k < 0) return nullptr;  // a node moving with the root transform (inner joints never do)
+    appears[k] = 1;
+  }
+  std::vector<int> bones;
+  for (int k = 0; k < num_bones; ++k) {
+    if (appears[k]) bones.push_back(k);
+  }
+  const std::size_t response_doubles = 4 * bones.size() * static_cast<std::size_t>(n);
+  const CholeskyFactor& factor = factorization.factor();
+  if (response_doubles >= static_cast<std::size_t>(factor.nonzeros())) return nullptr;
+
+  const auto& bw = bone_weights_;
+  const auto& w2 = factorization.row_weights_squared_;
+  const double anchor2 = options_.anchor_weight * options_.anchor_weight;
+  const double node2 = options_.joint_node_weight * options_.joint_node_weight;
+  std::vector<double> columns(response_doubles);
+  Positions weighted_deltas(n, 3);
+  Positions rhs(n + num_nodes_, 3);
+  std::vector<double> work(factor.WorkSize());
+  for (std::size_t slot = 0; slot < bones.size(); ++slot) {
+    const int k = bones[slot];
+    double* response = columns.data() + 4 * slot * static_cast<std::size_t>(n);
+    // U_k: R_k = I, t_k = 0.
+    weighted_deltas.setZero();
+    for (int i = 0; i < n; ++i) {
+      for (int p = bw.offsets[i]; p < bw.offsets[i + 1]; ++p) {
+        if (bw.bones[p] == k) weighted_deltas.row(i) = w2[i] * bw.weights[p] * rest_deltas_.row(i);
+      }
+    }
+    MultiplySparseBy3(laplacian_transpose_, weighted_deltas.data(), rhs.data());
+    for (std::size_t a = 0; a < anchors_.size(); ++a) {
+      if (anchor_bone_[a] == k) rhs.row(anchors_[a]) += anchor2 * anchor_rest_.row(a);
+    }
+    for (int c = 0; c < num_nodes_; ++c) {
+      if (node_bone[c] == k) {
+        rhs.row(n + c) += node2 * skeleton_.joint(node_joint_[c]).rest_position.transpose();
+      }
+    }
+    factor.Solve3(rhs.data(), rhs.data(), work.data());
+    for (int b = 0; b < 3; ++b) {
+      for (int i = 0; i < n; ++i) response[b * static_cast<std::size_t>(n) + i] = rhs(i, b);
+    }
+    // V_k: t_k = 1 (the same scalar response for each coordinate), R_k = 0.
+    rhs.setZero();
+    for (std::size_t a = 0; a < anchors_.size(); ++a) {
+      if (anchor_bone_[a] == k) rhs(anchors_[a], 0) += anchor2;
+    }
+    for (int c = 0; c < num_nodes_; ++c) {
+      if (node_bone[c] == k) rhs(n + c, 0) += node2;
+    }
+    factor.Solve3(rhs.data(), rhs.data(), work.data());
+    for (int i = 0; i < n; ++i) response[3 * static_cast<std::size_t>(n) + i] = rhs(i, 0);
+  }
+  return std::make_unique<LinearPoseResponse>(n, std::move(bones), std::move(columns));
 }
 
 }  // namespace deform

@@ -24,6 +24,7 @@
 
 #include "core/bone_weights.h"
 #include "core/joint_regions.h"
+#include "core/linear_pose_response.h"
 #include "core/mesh.h"
 #include "core/pose.h"
 #include "core/skeleton.h"
@@ -32,6 +33,16 @@
 #include "core/stiffness.h"
 
 namespace deform {
+
+// How a blend-region vertex's rotation T_i mixes the rotations of its bones.
+enum class RotationBlend {
+  // Normalised weighted quaternion sum (QLERP; METHOD.md's slerp for two bones, generalised).
+  kQuaternion,
+  // T_i = sum_k h_ik R_k, not re-normalised. METHOD.md's fast path: the solution is linear in the
+  // bone transforms, so a frame can come from a precomputed response without a solve
+  // (LinearPoseResponse). Cheaper per frame; differs from kQuaternion in the blend regions.
+  kLinear,
+};
 
 struct ModelOptions {
   // Add a joint centre node per inner joint, joined to its region's vertices. Default: true.
@@ -62,6 +73,8 @@ struct ModelOptions {
   // Fill-reducing ordering for the Cholesky factor. Default: kAuto (AMD or METIS, whichever
   // fills less).
   Ordering ordering = Ordering::kAuto;
+  // Default: kQuaternion.
+  RotationBlend rotation_blend = RotationBlend::kQuaternion;
   MeshLimits limits;
 
   static ModelOptions Paper() { return {}; }
@@ -78,6 +91,11 @@ class MaterialFactorization {
   // Per-vertex row weights w_i (n) that this factorisation was built with.
   const Eigen::VectorXd& row_weights() const { return row_weights_; }
   const CholeskyFactor& factor() const { return factor_; }
+  // With RotationBlend::kLinear, the precomputed response that replaces the per-frame solve, when
+  // it is smaller than the factor (4 K n doubles against the factor's non-zeros: a frame reads all
+  // of either); otherwise, and with kQuaternion, null and frames solve.
+  const LinearPoseResponse* linear_response() const { return linear_response_.get(); }
+  // Seconds of the numeric factorisation, including the linear response when there is one.
   double factor_seconds() const { return factor_seconds_; }
 
  private:
@@ -86,6 +104,7 @@ class MaterialFactorization {
   Eigen::VectorXd row_weights_;
   Eigen::VectorXd row_weights_squared_;
   CholeskyFactor factor_;
+  std::unique_ptr<const LinearPoseResponse> linear_response_;
   double factor_seconds_ = 0;
 };
 
@@ -105,7 +124,7 @@ struct DeformScratch {
 // Wall-clock split of one Deform() call, in seconds.
 struct DeformTimings {
   double right_hand_side = 0;  // forward kinematics, rotation blend, A^T b
-  double solve = 0;            // the two triangular solves
+  double solve = 0;            // the two triangular solves, or evaluating the linear response
 };
 
 class DeformationModel {
@@ -129,11 +148,15 @@ class DeformationModel {
 
   // Deforms the mesh into `pose`; result in scratch->positions(). Precondition: pose sized to
   // this skeleton (Pose::Rest / PoseFromTerms do so) and scratch from MakeScratch(). No allocation.
+  // With a linear response (factorization.linear_response()), only the forward kinematics and the
+  // response's evaluation run (right_hand_side times the former), and the joint nodes' rows of
+  // scratch->solution are left as they were.
   void Deform(const MaterialFactorization& factorization, const Pose& pose, DeformScratch* scratch,
               DeformTimings* timings = nullptr) const;
 
-  // The two halves of Deform(), for tests and diagnostics. AssembleRightHandSide writes A^T b
-  // ((n + m) by 3) into scratch->solution; SolveInPlace replaces it by the solution.
+  // The two halves of the solving path of Deform(), for tests and diagnostics (they never use the
+  // linear response). AssembleRightHandSide writes A^T b ((n + m) by 3) into scratch->solution;
+  // SolveInPlace replaces it by the solution.
   void AssembleRightHandSide(const MaterialFactorization& factorization, const Pose& pose,
                              DeformScratch* scratch) const;
   void SolveInPlace(const MaterialFactorization& factorization, DeformScratch* scratch) const;
@@ -159,6 +182,10 @@ class DeformationModel {
   StatusOr<std::shared_ptr<const MaterialFactorization>> FactorizeImpl(
       const Stiffness& stiffness) const;
   Eigen::SparseMatrix<double> BuildNormalMatrix(const Eigen::VectorXd& row_weights_squared) const;
+  // METHOD.md's precomputed response for `factorization` (its factor and row weights set), or null
+  // when it would be larger than the factor.
+  std::unique_ptr<const LinearPoseResponse> BuildLinearResponse(
+      const MaterialFactorization& factorization) const;
 
   TriangleMesh mesh_;
   Skeleton skeleton_;

@@ -21,17 +21,20 @@ double Median(std::vector<double> values) {
 
 StatusOr<Method> MethodFromName(std::string_view name) {
   if (name == "paper") return Method::kPaper;
+  if (name == "paper-linear") return Method::kPaperLinear;
   if (name == "laplacian") return Method::kLaplacian;
   if (name == "lbs") return Method::kLbs;
   if (name == "dqs") return Method::kDqs;
   return Status::InvalidArgument("unknown method '" + std::string(name) +
-                                 "' (known: paper, laplacian, lbs, dqs)");
+                                 "' (known: paper, paper-linear, laplacian, lbs, dqs)");
 }
 
 const char* MethodName(Method method) {
   switch (method) {
     case Method::kPaper:
       return "paper";
+    case Method::kPaperLinear:
+      return "paper-linear";
     case Method::kLaplacian:
       return "laplacian";
     case Method::kLbs:
@@ -56,20 +59,32 @@ StatusOr<MethodRun> RunMethod(const DeformationModel& paper_model, Method method
   std::vector<double> frame_seconds;
   frame_seconds.reserve(repeat);
 
-  if (method == Method::kPaper || method == Method::kLaplacian) {
-    std::shared_ptr<const DeformationModel> plain;
+  if (method == Method::kPaper || method == Method::kPaperLinear ||
+      method == Method::kLaplacian) {
+    // A variant of the paper model when the method needs one: the same regions (so the same
+    // harmonic weights), anchors and ordering.
+    std::shared_ptr<const DeformationModel> variant;
     const DeformationModel* model = &paper_model;
+    ModelOptions variant_options = paper_model.options();
     if (method == Method::kLaplacian) {
-      // The same regions (so the same harmonic weights), anchors and ordering as the paper model.
-      DEFORM_ASSIGN_OR_RETURN(
-          plain, DeformationModel::Build(paper_model.mesh(), paper_model.skeleton(),
-                                         ModelOptions::PlainLaplacian(paper_model.options())));
-      model = plain.get();
+      variant_options = ModelOptions::PlainLaplacian(paper_model.options());
+    } else if (method == Method::kPaperLinear) {
+      variant_options.rotation_blend = RotationBlend::kLinear;
+    }
+    if (method == Method::kLaplacian ||
+        variant_options.rotation_blend != paper_model.options().rotation_blend) {
+      DEFORM_ASSIGN_OR_RETURN(variant, DeformationModel::Build(paper_model.mesh(),
+                                                               paper_model.skeleton(),
+                                                               variant_options));
+      model = variant.get();
       run.precompute_seconds = model->precompute_seconds();
     }
     const auto& factorization = *model->default_factorization();
     run.factor_seconds = factorization.factor_seconds();
     run.factor_bytes = factorization.factor().bytes();
+    if (factorization.linear_response() != nullptr) {
+      run.response_bytes = factorization.linear_response()->bytes();
+    }
     run.joint_nodes = model->num_joint_nodes();
     run.anchors = static_cast<int>(model->anchor_vertices().size());
     DeformScratch scratch = model->MakeScratch();

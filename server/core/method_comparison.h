@@ -12,7 +12,8 @@
 namespace deform {
 
 enum class Method {
-  kPaper,      // joint centre nodes + material weights (METHOD.md)
+  kPaper,        // joint centre nodes + material weights (METHOD.md), quaternion rotation blend
+  kPaperLinear,  // the same with the linear rotation blend: METHOD.md's fast path, no solve
   kLaplacian,  // plain Laplacian: no joint node, W = I
   kLbs,        // linear blend skinning with the harmonic weights
   kDqs,        // dual quaternion skinning with the harmonic weights
@@ -27,9 +28,12 @@ struct MethodRun {
   double precompute_seconds = 0;  // model precomputation (weights, regions, symbolic analysis)
   double factor_seconds = 0;      // numeric factorisation (0 for skinning)
   std::size_t factor_bytes = 0;   // bytes of the stored factor (0 for skinning)
+  std::size_t response_bytes = 0;  // bytes of the linear response (paper-linear only)
   // Medians over `repeat` frames. For paper and laplacian, solve_seconds is the two triangular
   // passes (what the memory-read bound limits) and frame_seconds the whole frame (kinematics,
-  // rotation blend, right-hand side, solve); for the skinning methods both are the whole frame.
+  // rotation blend, right-hand side, solve); for paper-linear, solve_seconds is evaluating the
+  // linear response (or the passes, when the model has none); for the skinning methods both are
+  // the whole frame.
   double solve_seconds = 0;
   double frame_seconds = 0;
   int joint_nodes = 0;

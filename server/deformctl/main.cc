@@ -1,6 +1,6 @@
 // deformctl: the deformation core from the command line.
 //
-//   deformctl deform [--mesh FILE --skeleton FILE] --pose SPEC [--method paper|laplacian|lbs|dqs]
+//   deformctl deform [--mesh FILE --skeleton FILE] --pose SPEC [--method paper|paper-linear|laplacian|lbs|dqs]
 //                    [--out FILE] [--repeat N]
 //   deformctl phantom --out FILE [--skeleton-out FILE] [--vertices N]
 //
@@ -94,6 +94,7 @@ int RunDeform(const DeformArgs& args) {
   out["precompute_ms"] = run->precompute_seconds * 1e3;
   out["factor_ms"] = run->factor_seconds * 1e3;
   out["factor_bytes"] = run->factor_bytes;
+  if (*method == deform::Method::kPaperLinear) out["response_bytes"] = run->response_bytes;
   out["solve_ms"] = run->solve_seconds * 1e3;
   out["frame_ms"] = run->frame_seconds * 1e3;
   out["repeat"] = args.repeat;
@@ -142,7 +143,7 @@ int main(int argc, char** argv) {
       ->add_option("--pose", deform_args.pose,
                    "JOINT:AXIS:DEGREES[,...], e.g. knee:flexion:90 or 1:x:90")
       ->capture_default_str();
-  deform_cmd->add_option("--method", deform_args.method, "paper | laplacian | lbs | dqs")
+  deform_cmd->add_option("--method", deform_args.method, "paper | paper-linear (linear rotation blend, no per-frame solve) | laplacian | lbs | dqs")
       ->capture_default_str();
   deform_cmd->add_option("--out", deform_args.out_path,
                          "Write the deformed mesh (format from the extension)");
