@@ -10,6 +10,7 @@
 //   x_bound        median_ms / bound_ms
 //   cache_bound_ms the same two passes at the bandwidth of a factor-sized buffer (cache-resident
 //                  where the factor fits the last-level cache), and x_cache_bound
+// LinearBlendFrame's bound is one pass over the linear response (response_MB) instead.
 // The Eigen baseline solves the same normal equations with Eigen's SimplicialLLT, whose
 // multi-column solve walks the factor once per coordinate.
 #include <benchmark/benchmark.h>
@@ -43,14 +44,19 @@ struct BenchMesh {
 
 std::map<std::string, std::shared_ptr<const DeformationModel>> g_models;
 
-std::shared_ptr<const DeformationModel> ModelFor(const BenchMesh& mesh) {
-  auto it = g_models.find(mesh.name);
+// The paper's model of `mesh` (built once per rotation blend and kept for the later benchmarks).
+std::shared_ptr<const DeformationModel> ModelFor(
+    const BenchMesh& mesh, RotationBlend blend = RotationBlend::kQuaternion) {
+  const std::string key = mesh.name + (blend == RotationBlend::kLinear ? "/linear" : "");
+  auto it = g_models.find(key);
   if (it != g_models.end()) return it->second;
   auto input = LoadModelInput(mesh.mesh_path, mesh.skeleton_path, kDefaultPhantomVertices);
   if (!input.ok()) return nullptr;
-  auto model = DeformationModel::Build(input->mesh, input->skeleton, ModelOptions::Paper());
+  ModelOptions options = ModelOptions::Paper();
+  options.rotation_blend = blend;
+  auto model = DeformationModel::Build(input->mesh, input->skeleton, options);
   if (!model.ok()) return nullptr;
-  return g_models[mesh.name] = *model;
+  return g_models[key] = *model;
 }
 
 Pose PoseFor(const DeformationModel& model, const BenchMesh& mesh) {
@@ -77,16 +83,20 @@ std::vector<double> TimeEach(benchmark::State& state, Frame&& frame) {
   return seconds;
 }
 
-void ReportAgainstBound(benchmark::State& state, std::size_t factor_bytes,
-                        const std::vector<double>& seconds) {
+// `passes` reads of `bytes` per frame (two over the factor for a solve, one over the linear
+// response), reported as `bytes_counter`.
+void ReportAgainstBound(benchmark::State& state, std::size_t bytes,
+                        const std::vector<double>& seconds, int passes = 2,
+                        const char* bytes_counter = "factor_MB") {
   const double median_ms = Median(seconds) * 1e3;
   // Measured again right after the timed frames, so that bound and frames see the same
   // neighbours on a shared machine.
   const double dram_bandwidth = MeasureReadBandwidth(std::size_t{1} << 30, 2);
-  const double bound_ms = 2.0 * factor_bytes / dram_bandwidth * 1e3;
-  const double cache_bound_ms = 2.0 * factor_bytes / MeasureReadBandwidth(factor_bytes, 3) * 1e3;
+  const double bound_ms = passes * static_cast<double>(bytes) / dram_bandwidth * 1e3;
+  const double cache_bound_ms =
+      passes * static_cast<double>(bytes) / MeasureReadBandwidth(bytes, 3) * 1e3;
   state.counters["median_ms"] = median_ms;
-  state.counters["factor_MB"] = factor_bytes / 1e6;
+  state.counters[bytes_counter] = bytes / 1e6;
   state.counters["bound_ms"] = bound_ms;
   state.counters["x_bound"] = median_ms / bound_ms;
   state.counters["dram_GBps"] = dram_bandwidth / 1e9;
@@ -104,6 +114,20 @@ void BM_Frame(benchmark::State& state, BenchMesh mesh) {
   const auto seconds = TimeEach(state, [&] { model->Deform(factorization, pose, &scratch); });
   ReportAgainstBound(state, factorization.factor().bytes(), seconds);
   state.counters["vertices"] = model->mesh().num_vertices();
+}
+
+// A whole frame of the linear rotation blend (METHOD.md's fast path): kinematics and one pass over
+// the precomputed response, no solve. Compare with Frame/ of the same mesh in the same run.
+void BM_LinearBlendFrame(benchmark::State& state, BenchMesh mesh) {
+  auto model = ModelFor(mesh, RotationBlend::kLinear);
+  if (!model) return state.SkipWithError("mesh could not be loaded");
+  const auto& factorization = *model->default_factorization();
+  const LinearPoseResponse* response = factorization.linear_response();
+  if (response == nullptr) return state.SkipWithError("no linear response (larger than factor)");
+  const Pose pose = PoseFor(*model, mesh);
+  DeformScratch scratch = model->MakeScratch();
+  const auto seconds = TimeEach(state, [&] { model->Deform(factorization, pose, &scratch); });
+  ReportAgainstBound(state, response->bytes(), seconds, 1, "response_MB");
 }
 
 // The two triangular passes alone (what the memory-read bound limits), with the given kernel.
@@ -222,6 +246,9 @@ int main(int argc, char** argv) {
     benchmark::RegisterBenchmark(("Factorize/" + mesh.name).c_str(), BM_Factorize, mesh)
         ->Unit(benchmark::kMillisecond)->Iterations(large ? 2 : 5);
     benchmark::RegisterBenchmark(("Frame/" + mesh.name).c_str(), BM_Frame, mesh)
+        ->Unit(benchmark::kMillisecond)->MinTime(1.0);
+    benchmark::RegisterBenchmark(("LinearBlendFrame/" + mesh.name).c_str(), BM_LinearBlendFrame,
+                                 mesh)
         ->Unit(benchmark::kMillisecond)->MinTime(1.0);
     benchmark::RegisterBenchmark(("RightHandSide/" + mesh.name).c_str(), BM_RightHandSide, mesh)
         ->Unit(benchmark::kMillisecond)->MinTime(0.5);

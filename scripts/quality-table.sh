@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Prints a markdown table of the quality measures of all four methods (paper, laplacian, lbs,
-# dqs) at 45, 90 and 120 degrees of flexion, for the built-in phantom and, where ../shared/data
+# Prints a markdown table of the quality measures of all five methods (paper, its linear-blend
+# fast path paper-linear, laplacian, lbs, dqs) at 45, 90 and 120 degrees of flexion, for the built-in phantom and, where ../shared/data
 # is present, the shared leg and arm. Needs a build (scripts/build.sh) and python3.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -22,7 +22,7 @@ for case in "${CASES[@]}"; do
   [ -n "$mesh" ] && args=(--mesh "$mesh" --skeleton "$skeleton")
   for degrees in 45 90 120; do
     angle=$((degrees * sign))
-    for method in paper laplacian lbs dqs; do
+    for method in paper paper-linear laplacian lbs dqs; do
       "$DEFORMCTL" deform "${args[@]}" --pose "$joint:$angle" --method "$method" |
         python3 -c "import json,sys; d=json.load(sys.stdin); print('| $name | $degrees | $method | %+.4f | %.3f | %.3f | %.4f | %.1e |' % (d['volume_change'], d['clearance_min'], d['clearance_p01'], d['sink_fraction'], d['rigid_zone_error']))"
     done

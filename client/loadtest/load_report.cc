@@ -110,6 +110,7 @@ nlohmann::ordered_json ReportJson(const LoadReport& report) {
   out["mesh"] = report.run.mesh;
   out["vertices"] = report.run.vertices;
   out["triangles"] = report.run.triangles;
+  out["rotation_blend"] = report.run.rotation_blend;
   out["streams"] = plan.streams;
   out["rate_hz"] = plan.rate_hz;
   out["duration_s"] = plan.duration_s;
@@ -158,9 +159,9 @@ std::string ReportText(const LoadReport& report) {
     std::snprintf(line, sizeof(line), format, values...);
     text += line;
   };
-  add("target %s, mesh %s (%s): %u vertices, %u triangles\n", report.run.target.c_str(),
-      report.run.mesh.c_str(), report.run.mesh_id.c_str(), report.run.vertices,
-      report.run.triangles);
+  add("target %s, mesh %s (%s): %u vertices, %u triangles, %s rotation blend\n",
+      report.run.target.c_str(), report.run.mesh.c_str(), report.run.mesh_id.c_str(),
+      report.run.vertices, report.run.triangles, report.run.rotation_blend.c_str());
   add("%d streams x %.1f Hz posing %s:%s, %.1f s measured after %.1f s warm-up\n", plan.streams,
       plan.rate_hz, plan.posed.joint.c_str(), plan.posed.axis.c_str(), plan.duration_s,
       plan.warmup_s);

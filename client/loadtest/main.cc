@@ -13,6 +13,7 @@
 
 #include "lib/deform_client.h"
 #include "lib/joint_choice.h"
+#include "lib/rotation_blend_flag.h"
 #include "lib/status_names.h"
 #include "loadtest/load_plan.h"
 #include "loadtest/load_report.h"
@@ -41,6 +42,7 @@ struct LoadtestArgs {
   double cycle_s = 2.0;
   double drain_s = 2.0;
   int connect_timeout_ms = 5000;
+  deform::v1::RotationBlend rotation_blend = deform::v1::ROTATION_BLEND_QUATERNION;
   bool keep_mesh = false;
   bool json = false;
   bool fail_on_errors = false;
@@ -53,9 +55,10 @@ int Fail(const grpc::Status& status) {
 
 grpc::Status LoadMesh(deform::client::DeformClient& client, const LoadtestArgs& args,
                       deform::v1::MeshSummary* summary) {
-  const deform::v1::MethodOptions defaults;
-  if (args.mesh_path.empty()) return client.LoadPhantom(args.phantom_vertices, defaults, summary);
-  return client.LoadMeshFiles(args.mesh_path, args.skeleton_path, defaults, summary);
+  deform::v1::MethodOptions options;
+  options.set_rotation_blend(args.rotation_blend);
+  if (args.mesh_path.empty()) return client.LoadPhantom(args.phantom_vertices, options, summary);
+  return client.LoadMeshFiles(args.mesh_path, args.skeleton_path, options, summary);
 }
 
 // Runs the plan on a loaded mesh and prints the report; returns the exit code.
@@ -79,6 +82,7 @@ int RunOnMesh(deform::client::DeformClient& client, const LoadtestArgs& args,
   run.mesh_id = summary.mesh_id();
   run.vertices = summary.vertex_count();
   run.triangles = summary.triangle_count();
+  run.rotation_blend = deform::client::RotationBlendName(summary.rotation_blend());
   if (args.stiffness_every_s > 0) {
     run.stiffness_joint = deform::client::ChooseRegionJoint(summary, plan.posed.joint);
     if (run.stiffness_joint.empty()) {
@@ -137,6 +141,7 @@ void AddFlags(CLI::App& app, LoadtestArgs& args) {
   mesh->needs(skeleton);
   skeleton->needs(mesh);
   mesh->excludes(phantom);
+  deform::client::AddRotationBlendFlag(app, &args.rotation_blend);
 
   app.add_option("--streams", args.streams, "Concurrent Deform streams on the mesh")
       ->capture_default_str()

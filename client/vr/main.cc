@@ -17,6 +17,7 @@
 #include "lib/deform_client.h"
 #include "lib/flexion_trajectory.h"
 #include "lib/joint_choice.h"
+#include "lib/rotation_blend_flag.h"
 #include "lib/status_names.h"
 #include "vr/frame_mesh.h"
 #include "vr/mesh_source.h"
@@ -171,6 +172,7 @@ void AddFlags(CLI::App& app, VrArgs& args) {
   skeleton->needs(mesh);
   mesh_id->excludes(mesh)->excludes(skeleton)->excludes(phantom);
   mesh->excludes(phantom);
+  deform::client::AddRotationBlendFlag(app, &args.source.rotation_blend)->excludes(mesh_id);
 
   app.add_option("--joint", args.joint,
                  "Joint the trajectory bends, name or 0-based index (default: knee when the "

@@ -11,11 +11,12 @@ grpc::Status AcquireMesh(client::DeformClient& client, const MeshSource& source,
     if (status.ok()) *summary = info.summary();
     return status;
   }
-  const deform::v1::MethodOptions defaults;
+  deform::v1::MethodOptions options;
+  options.set_rotation_blend(source.rotation_blend);
   grpc::Status status =
       source.mesh_path.empty()
-          ? client.LoadPhantom(source.phantom_vertices, defaults, summary)
-          : client.LoadMeshFiles(source.mesh_path, source.skeleton_path, defaults, summary);
+          ? client.LoadPhantom(source.phantom_vertices, options, summary)
+          : client.LoadMeshFiles(source.mesh_path, source.skeleton_path, options, summary);
   *loaded = status.ok();
   return status;
 }

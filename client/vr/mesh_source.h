@@ -13,6 +13,8 @@ struct MeshSource {
   std::string mesh_path;  // non-empty: upload this file with `skeleton_path`
   std::string skeleton_path;
   int phantom_vertices = 0;  // otherwise: load the phantom at this resolution (0 = default)
+  // When loading: how the server blends bone rotations near a joint.
+  deform::v1::RotationBlend rotation_blend = deform::v1::ROTATION_BLEND_QUATERNION;
 };
 
 // Loads or looks up the mesh and fills `summary`. `loaded` tells whether this call loaded it (and

@@ -28,7 +28,9 @@ std::string MebiBytes(std::size_t bytes) {
 std::size_t EstimateModelBytes(const DeformationModel& model) {
   const std::size_t vertices = static_cast<std::size_t>(model.mesh().num_vertices());
   const std::size_t triangles = static_cast<std::size_t>(model.mesh().num_triangles());
-  return model.default_factorization()->factor().bytes() + vertices * 400 + triangles * 12;
+  const LinearPoseResponse* response = model.default_factorization()->linear_response();
+  return model.default_factorization()->factor().bytes() + (response ? response->bytes() : 0) +
+         vertices * 400 + triangles * 12;
 }
 
 MeshRegistry::Reservation::Reservation(Reservation&& other) noexcept

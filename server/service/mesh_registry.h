@@ -39,9 +39,9 @@ struct MeshEntry {
   mutable std::atomic<int> open_streams{0};
 };
 
-// Bytes a model holds, estimated: the Cholesky factor, plus per vertex its rest and differential
-// coordinates, Laplacian rows (both orientations), bone weights and region data (about 400 bytes
-// in all), plus 12 bytes per triangle.
+// Bytes a model holds, estimated: the Cholesky factor and the linear response if any, plus per
+// vertex its rest and differential coordinates, Laplacian rows (both orientations), bone weights
+// and region data (about 400 bytes in all), plus 12 bytes per triangle.
 std::size_t EstimateModelBytes(const DeformationModel& model);
 
 class MeshRegistry {

@@ -83,6 +83,17 @@ StatusOr<ModelOptions> ModelOptionsFromProto(const v1::MethodOptions& proto,
         options.default_material,
         MaterialFromProto(proto.default_material(), JointMaterial{}, "default material"));
   }
+  switch (proto.rotation_blend()) {
+    case v1::ROTATION_BLEND_QUATERNION:
+      options.rotation_blend = RotationBlend::kQuaternion;
+      break;
+    case v1::ROTATION_BLEND_LINEAR:
+      options.rotation_blend = RotationBlend::kLinear;
+      break;
+    default:
+      return Status::InvalidArgument("unknown rotation_blend " +
+                                     std::to_string(proto.rotation_blend()));
+  }
   return options;
 }
 
@@ -137,6 +148,11 @@ void FillMeshSummary(const MeshEntry& entry, v1::MeshSummary* summary) {
   summary->set_precompute_ms(entry.precompute_ms);
   summary->set_factor_ms(entry.factor_ms);
   summary->set_open_streams(static_cast<std::uint32_t>(entry.open_streams.load()));
+  summary->set_rotation_blend(model.options().rotation_blend == RotationBlend::kLinear
+                                  ? v1::ROTATION_BLEND_LINEAR
+                                  : v1::ROTATION_BLEND_QUATERNION);
+  const LinearPoseResponse* response = model.default_factorization()->linear_response();
+  summary->set_linear_response_bytes(response != nullptr ? response->bytes() : 0);
   summary->clear_joints();
   for (int j = 0; j < skeleton.num_joints(); ++j) {
     const Joint& joint = skeleton.joint(j);

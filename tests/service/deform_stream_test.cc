@@ -29,11 +29,12 @@ struct CoreResult {
   int clamped = 0;
 };
 
-CoreResult CoreDeform(int vertices, const std::string& spec) {
+CoreResult CoreDeform(int vertices, const std::string& spec,
+                      const ModelOptions& options = ModelOptions::Paper()) {
   CoreResult result;
   auto phantom = MakeKneePhantom(vertices);
   EXPECT_TRUE(phantom.ok());
-  auto model = DeformationModel::Build(phantom->mesh, phantom->skeleton, ModelOptions::Paper());
+  auto model = DeformationModel::Build(phantom->mesh, phantom->skeleton, options);
   EXPECT_TRUE(model.ok()) << model.status().ToString();
   auto terms = ParsePoseSpec(spec, (*model)->skeleton());
   EXPECT_TRUE(terms.ok()) << terms.status().ToString();
@@ -95,6 +96,48 @@ TEST_F(DeformStreamTest, FrameEqualsTheCoreResultForTheSamePose) {
     EXPECT_LE(worst, 1e-6 * core.diagonal) << spec;
   }
   EXPECT_EQ(CoreDeform(kVertices, "knee:flexion:200").clamped, 1);
+  stream->Close();
+  EXPECT_TRUE(stream->Wait().ok());
+  ExpectBackgroundStreamAlive();
+}
+
+// The linear rotation blend reaches the core: the frame is the core's linear-blend result (from its
+// precomputed response), not the quaternion blend's.
+TEST_F(DeformStreamTest, LinearBlendFrameEqualsTheCoreResult) {
+  StartServer();
+  constexpr int kVertices = 1500;
+  v1::MethodOptions options;
+  options.set_rotation_blend(v1::ROTATION_BLEND_LINEAR);
+  v1::MeshSummary summary;
+  const std::string mesh_id = LoadPhantom(kVertices, options, &summary);
+  EXPECT_EQ(summary.rotation_blend(), v1::ROTATION_BLEND_LINEAR);
+  EXPECT_GT(summary.linear_response_bytes(), 0u);
+  StreamRecorder recorder(/*keep_positions=*/true);
+  auto stream = client_->OpenStream(mesh_id, recorder.Callbacks());
+  const std::string spec = "knee:flexion:90,knee:rotation:10";
+  v1::PoseUpdate pose;
+  std::string error;
+  ASSERT_TRUE(client::ParsePoseAngles(spec, &pose, &error)) << error;
+  pose.set_sequence(1);
+  ASSERT_TRUE(stream->SendPose(pose));
+  ASSERT_TRUE(recorder.WaitForFrameWithSequence(1));
+  const std::vector<float> positions = client::DecodePositions(recorder.last_frame().positions());
+
+  ModelOptions linear = ModelOptions::Paper();
+  linear.rotation_blend = RotationBlend::kLinear;
+  const CoreResult core = CoreDeform(kVertices, spec, linear);
+  const CoreResult quaternion = CoreDeform(kVertices, spec);
+  ASSERT_EQ(positions.size(), static_cast<std::size_t>(core.positions.size()));
+  double from_linear = 0, from_quaternion = 0;
+  for (Eigen::Index i = 0; i < core.positions.rows(); ++i) {
+    for (int c = 0; c < 3; ++c) {
+      from_linear = std::max(from_linear, std::abs(positions[3 * i + c] - core.positions(i, c)));
+      from_quaternion =
+          std::max(from_quaternion, std::abs(positions[3 * i + c] - quaternion.positions(i, c)));
+    }
+  }
+  EXPECT_LE(from_linear, 1e-6 * core.diagonal);
+  EXPECT_GT(from_quaternion, 1e-4 * core.diagonal);
   stream->Close();
   EXPECT_TRUE(stream->Wait().ok());
   ExpectBackgroundStreamAlive();

@@ -271,6 +271,11 @@ TEST_F(LoadMeshTest, BadSkeletonOrOptionsAreInvalidArgument) {
             grpc::StatusCode::INVALID_ARGUMENT);
   EXPECT_EQ(client_->LoadPhantom(-5, {}, &summary).error_code(),
             grpc::StatusCode::INVALID_ARGUMENT);
+  v1::MethodOptions unknown_blend;
+  unknown_blend.set_rotation_blend(static_cast<v1::RotationBlend>(7));
+  const grpc::Status blend = client_->LoadPhantom(400, unknown_blend, &summary);
+  EXPECT_EQ(blend.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(blend.error_message(), HasSubstr("rotation_blend"));
   ExpectBackgroundStreamAlive();
 }
 

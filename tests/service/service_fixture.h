@@ -62,9 +62,11 @@ class ServiceTest : public ::testing::Test {
   }
 
   // Loads a phantom through the test's client; its id.
-  std::string LoadPhantom(int vertices) {
+  std::string LoadPhantom(int vertices, const v1::MethodOptions& options = {},
+                          v1::MeshSummary* summary_out = nullptr) {
     v1::MeshSummary summary;
-    const grpc::Status status = client_->LoadPhantom(vertices, {}, &summary);
+    const grpc::Status status = client_->LoadPhantom(vertices, options, &summary);
+    if (summary_out != nullptr) *summary_out = summary;
     EXPECT_TRUE(status.ok()) << status.error_message();
     return summary.mesh_id();
   }

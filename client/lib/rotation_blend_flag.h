@@ -1,0 +1,37 @@
+// The --rotation-blend flag shared by the command-line clients: how the server blends bone
+// rotations near a joint (deform.v1.RotationBlend). Header-only; the clients link CLI11.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <map>
+#include <string>
+
+#include "deform/v1/deform.pb.h"
+
+namespace deform::client {
+
+inline const std::map<std::string, deform::v1::RotationBlend>& RotationBlendNames() {
+  static const std::map<std::string, deform::v1::RotationBlend> names = {
+      {"quaternion", deform::v1::ROTATION_BLEND_QUATERNION},
+      {"linear", deform::v1::ROTATION_BLEND_LINEAR}};
+  return names;
+}
+
+inline std::string RotationBlendName(deform::v1::RotationBlend blend) {
+  for (const auto& [name, value] : RotationBlendNames()) {
+    if (value == blend) return name;
+  }
+  return "unknown";
+}
+
+inline CLI::Option* AddRotationBlendFlag(CLI::App& app, deform::v1::RotationBlend* blend) {
+  return app
+      .add_option("--rotation-blend", *blend,
+                  "How the mesh loaded blends bone rotations near a joint: quaternion (the "
+                  "method's default) or linear (a precomputed response, no solve per frame; the "
+                  "skin thins more at a bent joint)")
+      ->transform(CLI::CheckedTransformer(RotationBlendNames(), CLI::ignore_case))
+      ->default_str("quaternion");
+}
+
+}  // namespace deform::client
