@@ -5,8 +5,11 @@
 #include <algorithm>
 #include <chrono>
 #include <limits>
+#include <map>
+#include <utility>
 
 #include "core/mesh_topology.h"
+#include "core/rotation_blend.h"
 #include "core/skeleton_geometry.h"
 
 namespace deform {
@@ -299,11 +302,7 @@ void DeformationModel::AssembleRightHandSide(const MaterialFactorization& factor
       continue;
     }
     if (options_.rotation_blend == RotationBlend::kLinear) {
-      Eigen::Matrix3d blend = bw.weights[begin] * scratch->bone_rotations[bw.bones[begin]];
-      for (int p = begin + 1; p < end; ++p) {
-        blend += bw.weights[p] * scratch->bone_rotations[bw.bones[p]];
-      }
-      r.row(i) = w2[i] * (blend * delta).transpose();
+      r.row(i) = w2[i] * (LinearBlend(i, bones, scratch->bone_rotations) * delta).transpose();
       continue;
     }
     const Eigen::Quaterniond& first = bones[bw.bones[begin]].rotation;
@@ -333,38 +332,114 @@ void DeformationModel::AssembleRightHandSide(const MaterialFactorization& factor
   }
 }
 
+int DeformationModel::LinearBlendSegments() const {
+  return std::max(1, options_.linear_blend_segments);
+}
+
+Eigen::Matrix3d DeformationModel::LinearBlend(
+    int vertex, const std::vector<RigidTransform>& bones,
+    const std::vector<Eigen::Matrix3d>& bone_rotations) const {
+  const auto& bw = bone_weights_;
+  const int begin = bw.offsets[vertex], end = bw.offsets[vertex + 1];
+  const int segments = LinearBlendSegments();
+  if (end - begin == 2 && segments > 1) {
+    // The pair's knots (ordered by bone index, as the response numbers them) around h_b.
+    int a = bw.bones[begin], b = bw.bones[begin + 1];
+    double h = bw.weights[begin + 1];
+    if (a > b) {
+      std::swap(a, b);
+      h = bw.weights[begin];
+    }
+    const PairSegment segment = SegmentOf(h, segments);
+    const auto knot = [&](int j) -> Eigen::Matrix3d {
+      if (j == 0) return bone_rotations[a];
+      if (j == segments) return bone_rotations[b];
+      return PairKnot(bones[a].rotation, bones[b].rotation, static_cast<double>(j) / segments)
+          .toRotationMatrix();
+    };
+    return (1 - segment.upper_weight) * knot(segment.lower) +
+           segment.upper_weight * knot(segment.lower + 1);
+  }
+  Eigen::Matrix3d blend = bw.weights[begin] * bone_rotations[bw.bones[begin]];
+  for (int p = begin + 1; p < end; ++p) blend += bw.weights[p] * bone_rotations[bw.bones[p]];
+  return blend;
+}
+
 void DeformationModel::SolveInPlace(const MaterialFactorization& factorization,
                                     DeformScratch* scratch) const {
   factorization.factor().Solve3(scratch->solution.data(), scratch->solution.data(),
                                 scratch->solve_work.data());
 }
 
-// Column b of U_k solves A u = (the right-hand side of R_k = I, every other transform zero)'s column
-// b, since right-hand side coordinate a is sum_k sum_b R_k[a, b] (that column) + t_k[a] (V_k's);
-// see linear_pose_response.h.
+// A slot is a rotation the response is linear in: a bone (with its translation) or a knot of a
+// pair blend. Column b of a slot's U solves A u = (the right-hand side of that rotation = I, every
+// other transform zero)'s column b, since right-hand side coordinate a is
+// sum over slots sum_b R[a, b] (that column) + sum over bones t_k[a] (V_k's); see
+// linear_pose_response.h.
 std::unique_ptr<const LinearPoseResponse> DeformationModel::BuildLinearResponse(
     const MaterialFactorization& factorization) const {
   const int n = mesh_.num_vertices();
   const int num_bones = skeleton_.num_bones();
+  const auto& bw = bone_weights_;
   std::vector<int> node_bone(num_nodes_);
   for (int c = 0; c < num_nodes_; ++c) node_bone[c] = skeleton_.IncomingBone(node_joint_[c]);
   // Bones that appear in the right-hand side at all: through blend weights, anchors, joint nodes.
   std::vector<char> appears(num_bones, 0);
-  for (int k : bone_weights_.bones) appears[k] = 1;
+  for (int k : bw.bones) appears[k] = 1;
   for (int k : anchor_bone_) appears[k] = 1;
   for (int k : node_bone) {
     if (k < 0) return nullptr;  // a node moving with the root transform (inner joints never do)
     appears[k] = 1;
   }
   std::vector<int> bones;
+  std::vector<int> bone_slot(num_bones, -1);
   for (int k = 0; k < num_bones; ++k) {
-    if (appears[k]) bones.push_back(k);
+    if (!appears[k]) continue;
+    bone_slot[k] = static_cast<int>(bones.size());
+    bones.push_back(k);
   }
-  const std::size_t response_doubles = 4 * bones.size() * static_cast<std::size_t>(n);
-  const CholeskyFactor& factor = factorization.factor();
-  if (response_doubles >= static_cast<std::size_t>(factor.nonzeros())) return nullptr;
+  const int num_bone_slots = static_cast<int>(bones.size());
 
-  const auto& bw = bone_weights_;
+  // The knots of every bone pair some vertex blends, and each vertex's (slot, coefficient) terms:
+  // T_i = sum of coefficient * (the slot's rotation).
+  const int segments = LinearBlendSegments();
+  std::vector<LinearPoseResponse::Knot> knots;
+  std::map<std::pair<int, int>, int> first_knot;
+  std::vector<std::vector<std::pair<int, double>>> terms(n);
+  for (int i = 0; i < n; ++i) {
+    const int begin = bw.offsets[i], end = bw.offsets[i + 1];
+    if (end - begin == 2 && segments > 1) {
+      int a = bw.bones[begin], b = bw.bones[begin + 1];
+      double h = bw.weights[begin + 1];
+      if (a > b) {
+        std::swap(a, b);
+        h = bw.weights[begin];
+      }
+      auto [it, inserted] = first_knot.emplace(std::make_pair(a, b), static_cast<int>(knots.size()));
+      if (inserted) {
+        for (int j = 1; j < segments; ++j) {
+          knots.push_back({a, b, static_cast<double>(j) / segments});
+        }
+      }
+      const auto slot_of_knot = [&](int j) {
+        if (j == 0) return bone_slot[a];
+        if (j == segments) return bone_slot[b];
+        return num_bone_slots + it->second + j - 1;
+      };
+      const PairSegment segment = SegmentOf(h, segments);
+      terms[i] = {{slot_of_knot(segment.lower), 1 - segment.upper_weight},
+                  {slot_of_knot(segment.lower + 1), segment.upper_weight}};
+    } else {
+      for (int p = begin; p < end; ++p) terms[i].emplace_back(bone_slot[bw.bones[p]], bw.weights[p]);
+    }
+  }
+
+  const std::size_t response_doubles =
+      (4 * bones.size() + 3 * knots.size()) * static_cast<std::size_t>(n);
+  // A frame reads the response once, a solve reads the factor twice: build it when it reads less.
+  const CholeskyFactor& factor = factorization.factor();
+  if (response_doubles >= 2 * static_cast<std::size_t>(factor.nonzeros())) return nullptr;
+
   const auto& w2 = factorization.row_weights_squared_;
   const double anchor2 = options_.anchor_weight * options_.anchor_weight;
   const double node2 = options_.joint_node_weight * options_.joint_node_weight;
@@ -372,14 +447,19 @@ std::unique_ptr<const LinearPoseResponse> DeformationModel::BuildLinearResponse(
   Positions weighted_deltas(n, 3);
   Positions rhs(n + num_nodes_, 3);
   std::vector<double> work(factor.WorkSize());
-  for (std::size_t slot = 0; slot < bones.size(); ++slot) {
-    const int k = bones[slot];
-    double* response = columns.data() + 4 * slot * static_cast<std::size_t>(n);
-    // U_k: R_k = I, t_k = 0.
+  const int num_slots = num_bone_slots + static_cast<int>(knots.size());
+  for (int slot = 0; slot < num_slots; ++slot) {
+    const bool is_bone = slot < num_bone_slots;
+    const int k = is_bone ? bones[slot] : -1;
+    double* response =
+        columns.data() + (is_bone ? 4 * static_cast<std::size_t>(slot)
+                                  : 4 * bones.size() + 3 * static_cast<std::size_t>(slot - num_bone_slots)) *
+                             static_cast<std::size_t>(n);
+    // U: this slot's rotation = I, every other transform zero.
     weighted_deltas.setZero();
     for (int i = 0; i < n; ++i) {
-      for (int p = bw.offsets[i]; p < bw.offsets[i + 1]; ++p) {
-        if (bw.bones[p] == k) weighted_deltas.row(i) = w2[i] * bw.weights[p] * rest_deltas_.row(i);
+      for (const auto& [term_slot, coefficient] : terms[i]) {
+        if (term_slot == slot) weighted_deltas.row(i) += w2[i] * coefficient * rest_deltas_.row(i);
       }
     }
     MultiplySparseBy3(laplacian_transpose_, weighted_deltas.data(), rhs.data());
@@ -395,7 +475,8 @@ std::unique_ptr<const LinearPoseResponse> DeformationModel::BuildLinearResponse(
     for (int b = 0; b < 3; ++b) {
       for (int i = 0; i < n; ++i) response[b * static_cast<std::size_t>(n) + i] = rhs(i, b);
     }
-    // V_k: t_k = 1 (the same scalar response for each coordinate), R_k = 0.
+    if (!is_bone) continue;
+    // V_k: t_k = 1 (the same scalar response for each coordinate), every rotation zero.
     rhs.setZero();
     for (std::size_t a = 0; a < anchors_.size(); ++a) {
       if (anchor_bone_[a] == k) rhs(anchors_[a], 0) += anchor2;
@@ -406,7 +487,8 @@ std::unique_ptr<const LinearPoseResponse> DeformationModel::BuildLinearResponse(
     factor.Solve3(rhs.data(), rhs.data(), work.data());
     for (int i = 0; i < n; ++i) response[3 * static_cast<std::size_t>(n) + i] = rhs(i, 0);
   }
-  return std::make_unique<LinearPoseResponse>(n, std::move(bones), std::move(columns));
+  return std::make_unique<LinearPoseResponse>(n, std::move(bones), std::move(knots),
+                                              std::move(columns));
 }
 
 }  // namespace deform

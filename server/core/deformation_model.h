@@ -75,6 +75,11 @@ struct ModelOptions {
   Ordering ordering = Ordering::kAuto;
   // Default: kQuaternion.
   RotationBlend rotation_blend = RotationBlend::kQuaternion;
+  // With kLinear: a vertex blending two bones interpolates linearly between this many + 1 samples
+  // of the pair's quaternion blend (rotation_blend.h); 1 is METHOD.md's plain linear blend, more
+  // segments approach the quaternion blend at 3 more response vectors per pair and segment.
+  // Vertices blending three or more bones take the plain linear blend. Default: 4.
+  int linear_blend_segments = 4;
   MeshLimits limits;
 
   static ModelOptions Paper() { return {}; }
@@ -92,8 +97,9 @@ class MaterialFactorization {
   const Eigen::VectorXd& row_weights() const { return row_weights_; }
   const CholeskyFactor& factor() const { return factor_; }
   // With RotationBlend::kLinear, the precomputed response that replaces the per-frame solve, when
-  // it is smaller than the factor (4 K n doubles against the factor's non-zeros: a frame reads all
-  // of either); otherwise, and with kQuaternion, null and frames solve.
+  // a frame reads less from it than a solve reads from the factor (its doubles against twice the
+  // factor's non-zeros: two triangular passes); otherwise, and with kQuaternion, null and frames
+  // solve.
   const LinearPoseResponse* linear_response() const { return linear_response_.get(); }
   // Seconds of the numeric factorisation, including the linear response when there is one.
   double factor_seconds() const { return factor_seconds_; }
@@ -182,6 +188,10 @@ class DeformationModel {
   StatusOr<std::shared_ptr<const MaterialFactorization>> FactorizeImpl(
       const Stiffness& stiffness) const;
   Eigen::SparseMatrix<double> BuildNormalMatrix(const Eigen::VectorXd& row_weights_squared) const;
+  // The linear blend T_i of vertex i (piecewise along pairs; rotation_blend.h).
+  Eigen::Matrix3d LinearBlend(int vertex, const std::vector<RigidTransform>& bones,
+                              const std::vector<Eigen::Matrix3d>& bone_rotations) const;
+  int LinearBlendSegments() const;
   // METHOD.md's precomputed response for `factorization` (its factor and row weights set), or null
   // when it would be larger than the factor.
   std::unique_ptr<const LinearPoseResponse> BuildLinearResponse(

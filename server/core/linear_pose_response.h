@@ -12,6 +12,10 @@
 // with the solve) and differs from the quaternion blend in the blend regions (measured in
 // METHOD-comparison tests and the quality table).
 //
+// Piecewise-linear pair blends (rotation_blend.h) add knots: a knot is the quaternion blend of two
+// bones at a fixed s, computed per frame, and enters like one more rotation with three response
+// vectors (the translations only reach the right-hand side through the bones themselves).
+//
 // Immutable after construction; Evaluate() is const, allocation-free and may run on any number of
 // threads at once.
 #pragma once
@@ -25,10 +29,19 @@ namespace deform {
 
 class LinearPoseResponse {
  public:
+  // An interior knot of a bone pair's blend: QLERP(q_bone_a, q_bone_b; s).
+  struct Knot {
+    int bone_a = 0;
+    int bone_b = 0;
+    double s = 0;
+  };
+
   // `bones`: the bones with a non-zero response, ascending. `columns`: for each of them, in that
-  // order, the four response vectors U_k0, U_k1, U_k2, V_k of `num_vertices` doubles each.
-  // Precondition: columns.size() == 4 * bones.size() * num_vertices.
-  LinearPoseResponse(int num_vertices, std::vector<int> bones, std::vector<double> columns);
+  // order, the four response vectors U_k0, U_k1, U_k2, V_k of `num_vertices` doubles each; then
+  // for each knot its three vectors U_0, U_1, U_2.
+  // Precondition: columns.size() == (4 * bones.size() + 3 * knots.size()) * num_vertices.
+  LinearPoseResponse(int num_vertices, std::vector<int> bones, std::vector<Knot> knots,
+                     std::vector<double> columns);
 
   // positions (n by 3, row-major) = the solution for these bone transforms (one per skeleton bone,
   // as ForwardKinematics gives them). No allocation.
@@ -36,12 +49,14 @@ class LinearPoseResponse {
 
   int num_vertices() const { return num_vertices_; }
   const std::vector<int>& bones() const { return bones_; }
+  const std::vector<Knot>& knots() const { return knots_; }
   // Bytes of the stored response vectors: what each frame reads.
   std::size_t bytes() const { return columns_.size() * sizeof(double); }
 
  private:
   int num_vertices_ = 0;
   std::vector<int> bones_;
+  std::vector<Knot> knots_;
   std::vector<double> columns_;
 };
 

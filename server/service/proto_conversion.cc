@@ -94,6 +94,15 @@ StatusOr<ModelOptions> ModelOptionsFromProto(const v1::MethodOptions& proto,
       return Status::InvalidArgument("unknown rotation_blend " +
                                      std::to_string(proto.rotation_blend()));
   }
+  constexpr std::uint32_t kMaxSegments = 64;
+  if (proto.linear_blend_segments() > kMaxSegments) {
+    return Status::InvalidArgument("linear_blend_segments must be at most " +
+                                   std::to_string(kMaxSegments) + ", got " +
+                                   std::to_string(proto.linear_blend_segments()));
+  }
+  if (proto.linear_blend_segments() != 0) {
+    options.linear_blend_segments = static_cast<int>(proto.linear_blend_segments());
+  }
   return options;
 }
 

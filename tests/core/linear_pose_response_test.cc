@@ -74,7 +74,10 @@ TEST(LinearPoseResponse, OnlyTheLinearBlendHasOne) {
   ASSERT_NE(response, nullptr);
   EXPECT_EQ(response->num_vertices(), model->mesh().num_vertices());
   EXPECT_EQ(response->bones().size(), 2u);  // thigh and shank
-  EXPECT_EQ(response->bytes(), 4 * 2 * sizeof(double) * model->mesh().num_vertices());
+  ASSERT_EQ(response->knots().size(), 3u);  // the knee's pair blend in 4 segments
+  EXPECT_DOUBLE_EQ(response->knots()[1].s, 0.5);
+  // 4 vectors per bone, 3 per knot.
+  EXPECT_EQ(response->bytes(), (4 * 2 + 3 * 3) * sizeof(double) * model->mesh().num_vertices());
 }
 
 TEST(LinearPoseResponse, EqualsTheSolveWithTheLinearBlend) {
@@ -121,11 +124,14 @@ TEST(LinearPoseResponse, RestAndRigidMotionsAreExact) {
   EXPECT_LT(MaxDistance(Frame(*model, factorization, moved), expected), 1e-9 * diagonal);
 }
 
-// The linear blend is not the quaternion blend: where bones blend, T_i = sum h R_k shrinks
-// (at 90 degrees and h = 1/2 its scale is cos 45 = 0.71), so the two methods part there and agree
-// far from the knee.
-TEST(LinearPoseResponse, DiffersFromTheQuaternionBlendOnlyNearTheJoint) {
-  auto linear = BuildPhantomModel(LinearBlend());
+// METHOD.md's plain linear blend is not the quaternion blend: where bones blend, T_i = sum h R_k
+// shrinks (at 90 degrees and h = 1/2 its scale is cos 45 = 0.71), so the two methods part there
+// and agree far from the knee.
+TEST(LinearPoseResponse, PlainLinearBlendDiffersFromTheQuaternionBlendOnlyNearTheJoint) {
+  ModelOptions plain = LinearBlend();
+  plain.linear_blend_segments = 1;
+  auto linear = BuildPhantomModel(plain);
+  ASSERT_TRUE(linear->default_factorization()->linear_response()->knots().empty());
   auto quaternion = BuildPhantomModel(ModelOptions::Paper());
   const Pose pose = PoseFromSpec(linear->skeleton(), "knee:flexion:90");
   const Positions a = Frame(*linear, *linear->default_factorization(), pose);
@@ -137,6 +143,31 @@ TEST(LinearPoseResponse, DiffersFromTheQuaternionBlendOnlyNearTheJoint) {
     anchors_apart = std::max(anchors_apart, (a.row(i) - b.row(i)).norm());
   }
   EXPECT_LT(anchors_apart, 1e-3 * diagonal);
+}
+
+// More segments along each pair's quaternion blend bring the frame closer to the quaternion
+// blend's: the blended matrix's shrink, 1 - cos(90 / 2 S degrees), falls about four times per
+// doubling.
+TEST(LinearPoseResponse, MoreSegmentsApproachTheQuaternionBlend) {
+  auto quaternion = BuildPhantomModel(ModelOptions::Paper());
+  const Pose pose = PoseFromSpec(quaternion->skeleton(), "knee:flexion:90");
+  const Positions reference = Frame(*quaternion, *quaternion->default_factorization(), pose);
+  std::vector<double> distances;
+  for (int segments : {1, 2, 4, 8}) {
+    ModelOptions options = LinearBlend();
+    options.linear_blend_segments = segments;
+    auto model = BuildPhantomModel(options);
+    const auto& factorization = *model->default_factorization();
+    ASSERT_NE(factorization.linear_response(), nullptr);
+    const Positions fast = Frame(*model, factorization, pose);
+    EXPECT_LT(MaxDistance(fast, SolvedFrame(*model, factorization, pose)),
+              1e-10 * model->bounding_box_diagonal());
+    distances.push_back(MaxDistance(fast, reference));
+  }
+  for (std::size_t k = 1; k < distances.size(); ++k) {
+    EXPECT_LT(distances[k], 0.5 * distances[k - 1]) << "segments " << (1 << k);
+  }
+  EXPECT_LT(distances.back(), 0.05 * distances.front());
 }
 
 TEST(LinearPoseResponse, AFrameAllocatesNothing) {

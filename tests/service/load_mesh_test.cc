@@ -276,6 +276,12 @@ TEST_F(LoadMeshTest, BadSkeletonOrOptionsAreInvalidArgument) {
   const grpc::Status blend = client_->LoadPhantom(400, unknown_blend, &summary);
   EXPECT_EQ(blend.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
   EXPECT_THAT(blend.error_message(), HasSubstr("rotation_blend"));
+  v1::MethodOptions absurd_segments;
+  absurd_segments.set_rotation_blend(v1::ROTATION_BLEND_LINEAR);
+  absurd_segments.set_linear_blend_segments(1u << 30);
+  const grpc::Status segments = client_->LoadPhantom(400, absurd_segments, &summary);
+  EXPECT_EQ(segments.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(segments.error_message(), HasSubstr("linear_blend_segments"));
   ExpectBackgroundStreamAlive();
 }
 
