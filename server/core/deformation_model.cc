@@ -344,12 +344,8 @@ Eigen::Matrix3d DeformationModel::LinearBlend(
   const int segments = LinearBlendSegments();
   if (end - begin == 2 && segments > 1) {
     // The pair's knots (ordered by bone index, as the response numbers them) around h_b.
-    int a = bw.bones[begin], b = bw.bones[begin + 1];
-    double h = bw.weights[begin + 1];
-    if (a > b) {
-      std::swap(a, b);
-      h = bw.weights[begin];
-    }
+    const auto [a, b, h] =
+        OrderedPair(bw.bones[begin], bw.weights[begin], bw.bones[begin + 1], bw.weights[begin + 1]);
     const PairSegment segment = SegmentOf(h, segments);
     const auto knot = [&](int j) -> Eigen::Matrix3d {
       if (j == 0) return bone_rotations[a];
@@ -409,12 +405,8 @@ std::unique_ptr<const LinearPoseResponse> DeformationModel::BuildLinearResponse(
   for (int i = 0; i < n; ++i) {
     const int begin = bw.offsets[i], end = bw.offsets[i + 1];
     if (end - begin == 2 && segments > 1) {
-      int a = bw.bones[begin], b = bw.bones[begin + 1];
-      double h = bw.weights[begin + 1];
-      if (a > b) {
-        std::swap(a, b);
-        h = bw.weights[begin];
-      }
+      const auto [a, b, h] = OrderedPair(bw.bones[begin], bw.weights[begin], bw.bones[begin + 1],
+                                         bw.weights[begin + 1]);
       auto [it, inserted] = first_knot.emplace(std::make_pair(a, b), static_cast<int>(knots.size()));
       if (inserted) {
         for (int j = 1; j < segments; ++j) {

@@ -16,6 +16,18 @@
 
 namespace deform {
 
+// A vertex's two bones ordered by index (the order knots are numbered in) and the weight of the
+// second.
+struct BonePair {
+  int a = 0;
+  int b = 0;
+  double h = 0;  // weight of b
+};
+
+inline BonePair OrderedPair(int bone0, double weight0, int bone1, double weight1) {
+  return bone0 < bone1 ? BonePair{bone0, bone1, weight1} : BonePair{bone1, bone0, weight0};
+}
+
 // The two knots around weight h in [0, 1] and the weight of the upper one.
 struct PairSegment {
   int lower = 0;    // knot index j in [0, S - 1]; the upper knot is j + 1

@@ -8,38 +8,22 @@
 #include "core/mesh_io.h"
 #include "core/phantom.h"
 #include "tests/allocation_counter.h"
+#include "tests/core/model_test_util.h"
 #include "tests/core/shared_leg_model.h"
 #include "tests/shared_data.h"
 
 namespace deform {
 namespace {
 
-std::shared_ptr<const DeformationModel> BuildPhantomModel(
-    int vertices = 2000, ModelOptions options = ModelOptions::Paper()) {
-  auto phantom = MakeKneePhantom(vertices);
-  EXPECT_TRUE(phantom.ok());
-  auto model = DeformationModel::Build(phantom->mesh, phantom->skeleton, options);
-  EXPECT_TRUE(model.ok()) << model.status().ToString();
-  return model.ok() ? *model : nullptr;
-}
-
-Pose PoseFromSpec(const Skeleton& skeleton, const std::string& spec) {
-  Pose pose;
-  auto terms = ParsePoseSpec(spec, skeleton);
-  EXPECT_TRUE(terms.ok()) << terms.status().ToString();
-  EXPECT_TRUE(PoseFromTerms(skeleton, *terms, &pose).ok());
-  return pose;
-}
+using testing::BuildPhantomModel;
+using testing::MaxDistance;
+using testing::PoseFromSpec;
 
 Positions DeformOnce(const DeformationModel& model, const Pose& pose,
                      const MaterialFactorization* factorization = nullptr) {
   DeformScratch scratch = model.MakeScratch();
   model.Deform(factorization ? *factorization : *model.default_factorization(), pose, &scratch);
   return scratch.positions();
-}
-
-double MaxDistance(const Positions& a, const Positions& b) {
-  return (a - b).rowwise().norm().maxCoeff();
 }
 
 TEST(DeformationModel, RestPoseReproducesThePhantom) {

@@ -7,6 +7,7 @@
 #include "core/method_comparison.h"
 #include "core/phantom.h"
 #include "tests/allocation_counter.h"
+#include "tests/core/model_test_util.h"
 #include "tests/core/shared_leg_model.h"
 #include "tests/shared_data.h"
 
@@ -19,21 +20,12 @@ ModelOptions LinearBlend() {
   return options;
 }
 
+using testing::MaxDistance;
+using testing::PoseFromSpec;
+
 std::shared_ptr<const DeformationModel> BuildPhantomModel(const ModelOptions& options,
                                                           int vertices = 2000) {
-  auto phantom = MakeKneePhantom(vertices);
-  EXPECT_TRUE(phantom.ok());
-  auto model = DeformationModel::Build(phantom->mesh, phantom->skeleton, options);
-  EXPECT_TRUE(model.ok()) << model.status().ToString();
-  return model.ok() ? *model : nullptr;
-}
-
-Pose PoseFromSpec(const Skeleton& skeleton, const std::string& spec) {
-  Pose pose;
-  auto terms = ParsePoseSpec(spec, skeleton);
-  EXPECT_TRUE(terms.ok()) << terms.status().ToString();
-  EXPECT_TRUE(PoseFromTerms(skeleton, *terms, &pose).ok());
-  return pose;
+  return testing::BuildPhantomModel(vertices, options);
 }
 
 // The frame Deform() gives (from the response when the factorisation has one).
@@ -51,10 +43,6 @@ Positions SolvedFrame(const DeformationModel& model, const MaterialFactorization
   model.AssembleRightHandSide(factorization, pose, &scratch);
   model.SolveInPlace(factorization, &scratch);
   return scratch.positions();
-}
-
-double MaxDistance(const Positions& a, const Positions& b) {
-  return (a - b).rowwise().norm().maxCoeff();
 }
 
 // A pose that bends and twists the knee and moves the whole limb.
