@@ -6,6 +6,7 @@
 #include <chrono>
 #include <limits>
 #include <map>
+#include <string>
 #include <utility>
 
 #include "core/mesh_topology.h"
@@ -64,6 +65,13 @@ StatusOr<std::shared_ptr<const DeformationModel>> DeformationModel::Build(
       !std::isfinite(options.joint_node_weight) || !std::isfinite(options.anchor_weight) ||
       !(options.anchor_distance_factor >= 0)) {
     return Status::InvalidArgument("joint node and anchor weights must be positive and finite");
+  }
+  if (options.linear_blend_segments < 1 ||
+      options.linear_blend_segments > ModelOptions::kMaxLinearBlendSegments) {
+    return Status::InvalidArgument(
+        "linear_blend_segments must be in [1, " +
+        std::to_string(ModelOptions::kMaxLinearBlendSegments) + "], got " +
+        std::to_string(options.linear_blend_segments));
   }
   std::shared_ptr<DeformationModel> model(new DeformationModel());
   model->mesh_ = std::move(mesh);
@@ -224,16 +232,14 @@ DeformScratch DeformationModel::MakeScratch() const {
 void DeformationModel::Deform(const MaterialFactorization& factorization, const Pose& pose,
                               DeformScratch* scratch, DeformTimings* timings) const {
   const auto start = Clock::now();
-  const LinearPoseResponse* response = factorization.linear_response();
-  if (response != nullptr) {
+  Clock::time_point solve_start;
+  if (const LinearPoseResponse* response = factorization.linear_response()) {
     ForwardKinematics(skeleton_, pose, &scratch->bone_transforms);
-  } else {
-    AssembleRightHandSide(factorization, pose, scratch);
-  }
-  const auto solve_start = Clock::now();
-  if (response != nullptr) {
+    solve_start = Clock::now();
     response->Evaluate(scratch->bone_transforms, scratch->solution.data());
   } else {
+    AssembleRightHandSide(factorization, pose, scratch);
+    solve_start = Clock::now();
     SolveInPlace(factorization, scratch);
   }
   if (timings != nullptr) {
@@ -332,16 +338,12 @@ void DeformationModel::AssembleRightHandSide(const MaterialFactorization& factor
   }
 }
 
-int DeformationModel::LinearBlendSegments() const {
-  return std::max(1, options_.linear_blend_segments);
-}
-
 Eigen::Matrix3d DeformationModel::LinearBlend(
     int vertex, const std::vector<RigidTransform>& bones,
     const std::vector<Eigen::Matrix3d>& bone_rotations) const {
   const auto& bw = bone_weights_;
   const int begin = bw.offsets[vertex], end = bw.offsets[vertex + 1];
-  const int segments = LinearBlendSegments();
+  const int segments = options_.linear_blend_segments;
   if (end - begin == 2 && segments > 1) {
     // The pair's knots (ordered by bone index, as the response numbers them) around h_b.
     const auto [a, b, h] =
@@ -398,7 +400,7 @@ std::unique_ptr<const LinearPoseResponse> DeformationModel::BuildLinearResponse(
 
   // The knots of every bone pair some vertex blends, and each vertex's (slot, coefficient) terms:
   // T_i = sum of coefficient * (the slot's rotation).
-  const int segments = LinearBlendSegments();
+  const int segments = options_.linear_blend_segments;
   std::vector<LinearPoseResponse::Knot> knots;
   std::map<std::pair<int, int>, int> first_knot;
   std::vector<std::vector<std::pair<int, double>>> terms(n);
@@ -407,7 +409,8 @@ std::unique_ptr<const LinearPoseResponse> DeformationModel::BuildLinearResponse(
     if (end - begin == 2 && segments > 1) {
       const auto [a, b, h] = OrderedPair(bw.bones[begin], bw.weights[begin], bw.bones[begin + 1],
                                          bw.weights[begin + 1]);
-      auto [it, inserted] = first_knot.emplace(std::make_pair(a, b), static_cast<int>(knots.size()));
+      const auto [it, inserted] =
+          first_knot.emplace(std::make_pair(a, b), static_cast<int>(knots.size()));
       if (inserted) {
         for (int j = 1; j < segments; ++j) {
           knots.push_back({a, b, static_cast<double>(j) / segments});
@@ -439,14 +442,28 @@ std::unique_ptr<const LinearPoseResponse> DeformationModel::BuildLinearResponse(
   Positions weighted_deltas(n, 3);
   Positions rhs(n + num_nodes_, 3);
   std::vector<double> work(factor.WorkSize());
+  // rhs rows of the anchors and joint nodes that follow bone k += their weight^2 * target(their
+  // rest position): the rest position itself for U, (1, 0, 0) for V.
+  const auto add_constraints = [&](int k, const auto& target) {
+    for (std::size_t a = 0; a < anchors_.size(); ++a) {
+      if (anchor_bone_[a] == k) rhs.row(anchors_[a]) += anchor2 * target(anchor_rest_.row(a));
+    }
+    for (int c = 0; c < num_nodes_; ++c) {
+      if (node_bone[c] == k) {
+        rhs.row(n + c) +=
+            node2 * target(skeleton_.joint(node_joint_[c]).rest_position.transpose());
+      }
+    }
+  };
+  const std::size_t stride = static_cast<std::size_t>(n);
   const int num_slots = num_bone_slots + static_cast<int>(knots.size());
   for (int slot = 0; slot < num_slots; ++slot) {
     const bool is_bone = slot < num_bone_slots;
     const int k = is_bone ? bones[slot] : -1;
-    double* response =
-        columns.data() + (is_bone ? 4 * static_cast<std::size_t>(slot)
-                                  : 4 * bones.size() + 3 * static_cast<std::size_t>(slot - num_bone_slots)) *
-                             static_cast<std::size_t>(n);
+    // Bones' four vectors first, then the knots' three (linear_pose_response.h).
+    double* response = columns.data() + (is_bone ? 4 * slot * stride
+                                                 : (4 * bones.size() +
+                                                    3 * (slot - num_bone_slots)) * stride);
     // U: this slot's rotation = I, every other transform zero.
     weighted_deltas.setZero();
     for (int i = 0; i < n; ++i) {
@@ -455,29 +472,17 @@ std::unique_ptr<const LinearPoseResponse> DeformationModel::BuildLinearResponse(
       }
     }
     MultiplySparseBy3(laplacian_transpose_, weighted_deltas.data(), rhs.data());
-    for (std::size_t a = 0; a < anchors_.size(); ++a) {
-      if (anchor_bone_[a] == k) rhs.row(anchors_[a]) += anchor2 * anchor_rest_.row(a);
-    }
-    for (int c = 0; c < num_nodes_; ++c) {
-      if (node_bone[c] == k) {
-        rhs.row(n + c) += node2 * skeleton_.joint(node_joint_[c]).rest_position.transpose();
-      }
-    }
+    add_constraints(k, [](const Eigen::RowVector3d& rest) { return rest; });
     factor.Solve3(rhs.data(), rhs.data(), work.data());
     for (int b = 0; b < 3; ++b) {
-      for (int i = 0; i < n; ++i) response[b * static_cast<std::size_t>(n) + i] = rhs(i, b);
+      for (int i = 0; i < n; ++i) response[b * stride + i] = rhs(i, b);
     }
     if (!is_bone) continue;
     // V_k: t_k = 1 (the same scalar response for each coordinate), every rotation zero.
     rhs.setZero();
-    for (std::size_t a = 0; a < anchors_.size(); ++a) {
-      if (anchor_bone_[a] == k) rhs(anchors_[a], 0) += anchor2;
-    }
-    for (int c = 0; c < num_nodes_; ++c) {
-      if (node_bone[c] == k) rhs(n + c, 0) += node2;
-    }
+    add_constraints(k, [](const Eigen::RowVector3d&) { return Eigen::RowVector3d(1, 0, 0); });
     factor.Solve3(rhs.data(), rhs.data(), work.data());
-    for (int i = 0; i < n; ++i) response[3 * static_cast<std::size_t>(n) + i] = rhs(i, 0);
+    for (int i = 0; i < n; ++i) response[3 * stride + i] = rhs(i, 0);
   }
   return std::make_unique<LinearPoseResponse>(n, std::move(bones), std::move(knots),
                                               std::move(columns));

@@ -78,8 +78,10 @@ struct ModelOptions {
   // With kLinear: a vertex blending two bones interpolates linearly between this many + 1 samples
   // of the pair's quaternion blend (rotation_blend.h); 1 is METHOD.md's plain linear blend, more
   // segments approach the quaternion blend at 3 more response vectors per pair and segment.
-  // Vertices blending three or more bones take the plain linear blend. Default: 4.
+  // Vertices blending three or more bones take the plain linear blend. Default: 4; at most
+  // kMaxLinearBlendSegments.
   int linear_blend_segments = 4;
+  static constexpr int kMaxLinearBlendSegments = 64;
   MeshLimits limits;
 
   static ModelOptions Paper() { return {}; }
@@ -191,7 +193,6 @@ class DeformationModel {
   // The linear blend T_i of vertex i (piecewise along pairs; rotation_blend.h).
   Eigen::Matrix3d LinearBlend(int vertex, const std::vector<RigidTransform>& bones,
                               const std::vector<Eigen::Matrix3d>& bone_rotations) const;
-  int LinearBlendSegments() const;
   // METHOD.md's precomputed response for `factorization` (its factor and row weights set), or null
   // when it would be larger than the factor.
   std::unique_ptr<const LinearPoseResponse> BuildLinearResponse(

@@ -1,10 +1,10 @@
 #include "core/linear_pose_response.h"
 
-#include "core/rotation_blend.h"
-
 #include <algorithm>
 #include <cassert>
 #include <utility>
+
+#include "core/rotation_blend.h"
 
 namespace deform {
 namespace {
@@ -21,9 +21,9 @@ constexpr int kBlock = 256;
 #endif
 
 // x, y, z[0, count) += (cx, cy, cz) * column[0, count). Vectorised by the compiler.
-DEFORM_ALWAYS_INLINE void AddScaledColumn(const double* __restrict column, int count, double cx, double cy,
-                            double cz, double* __restrict x, double* __restrict y,
-                            double* __restrict z) {
+DEFORM_ALWAYS_INLINE void AddScaledColumn(const double* __restrict column, int count, double cx,
+                                          double cy, double cz, double* __restrict x,
+                                          double* __restrict y, double* __restrict z) {
   for (int i = 0; i < count; ++i) {
     x[i] += cx * column[i];
     y[i] += cy * column[i];
@@ -31,8 +31,6 @@ DEFORM_ALWAYS_INLINE void AddScaledColumn(const double* __restrict column, int c
   }
 }
 
-// The whole evaluation, written once and compiled for AVX2 + FMA and for any x86-64 (or other)
-// CPU; Evaluate() picks one at run time.
 using Knot = LinearPoseResponse::Knot;
 
 // x, y, z[0, count) += r * (the three response vectors at u, one column of r each).
@@ -43,6 +41,8 @@ DEFORM_ALWAYS_INLINE void AddRotated(const Eigen::Matrix3d& r, const double* u, 
   }
 }
 
+// The whole evaluation, written once and compiled for AVX2 + FMA and for any x86-64 (or other)
+// CPU; Evaluate() picks one at run time.
 DEFORM_ALWAYS_INLINE void EvaluateBlocks(int n, const std::vector<int>& bones,
                                          const std::vector<Knot>& knots, const double* columns,
                                          const std::vector<RigidTransform>& transforms,

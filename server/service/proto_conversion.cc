@@ -1,8 +1,10 @@
 #include "service/proto_conversion.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <string>
 
 namespace deform::service {
@@ -94,14 +96,10 @@ StatusOr<ModelOptions> ModelOptionsFromProto(const v1::MethodOptions& proto,
       return Status::InvalidArgument("unknown rotation_blend " +
                                      std::to_string(proto.rotation_blend()));
   }
-  constexpr std::uint32_t kMaxSegments = 64;
-  if (proto.linear_blend_segments() > kMaxSegments) {
-    return Status::InvalidArgument("linear_blend_segments must be at most " +
-                                   std::to_string(kMaxSegments) + ", got " +
-                                   std::to_string(proto.linear_blend_segments()));
-  }
+  // 0 keeps the default; DeformationModel::Build checks the range.
   if (proto.linear_blend_segments() != 0) {
-    options.linear_blend_segments = static_cast<int>(proto.linear_blend_segments());
+    options.linear_blend_segments = static_cast<int>(
+        std::min<std::uint32_t>(proto.linear_blend_segments(), std::numeric_limits<int>::max()));
   }
   return options;
 }

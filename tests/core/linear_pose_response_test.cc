@@ -174,32 +174,40 @@ TEST(LinearPoseResponse, AFrameAllocatesNothing) {
 TEST(LinearPoseResponse, EqualsTheSolveOnTheSharedLeg) {
   DEFORM_REQUIRE_SHARED_FILE(mesh_path, "leg/leg_1633.obj");
   DEFORM_REQUIRE_SHARED_FILE(skeleton_path, "leg/leg.tgf");
-  auto mesh = ReadMeshFile(mesh_path);
-  auto skeleton = ReadSkeletonFile(skeleton_path);
-  ASSERT_TRUE(mesh.ok() && skeleton.ok());
-  auto model = DeformationModel::Build(*mesh, *skeleton, LinearBlend());
+  auto model = testing::BuildModelFromFiles(mesh_path, skeleton_path, LinearBlend());
   ASSERT_TRUE(model.ok()) << model.status().ToString();
   const auto& factorization = *(*model)->default_factorization();
   ASSERT_NE(factorization.linear_response(), nullptr);
-  const Pose pose = PoseFromSpec(*skeleton, "1:x:120,2:x:-20");
+  const Pose pose = PoseFromSpec((*model)->skeleton(), "1:x:120,2:x:-20");
   EXPECT_LT(MaxDistance(Frame(**model, factorization, pose),
                         SolvedFrame(**model, factorization, pose)),
             1e-10 * (*model)->bounding_box_diagonal());
 }
 
-// Where 4 K n doubles would exceed the factor (many bones on few vertices), frames solve instead.
+// Where the response would hold at least twice the factor's non-zeros (many bones on few
+// vertices), frames solve instead.
 TEST(LinearPoseResponse, ManyBonesSolveInstead) {
   DEFORM_REQUIRE_SHARED_FILE(mesh_path, "body/body_13380.obj");
   DEFORM_REQUIRE_SHARED_FILE(skeleton_path, "body/body.tgf");
-  auto mesh = ReadMeshFile(mesh_path);
-  auto skeleton = ReadSkeletonFile(skeleton_path);
-  ASSERT_TRUE(mesh.ok() && skeleton.ok());
-  auto model = DeformationModel::Build(*mesh, *skeleton, LinearBlend());
+  auto model = testing::BuildModelFromFiles(mesh_path, skeleton_path, LinearBlend());
   ASSERT_TRUE(model.ok()) << model.status().ToString();
   EXPECT_EQ((*model)->default_factorization()->linear_response(), nullptr);
   const Positions rest = Frame(**model, *(*model)->default_factorization(),
-                               Pose::Rest(*skeleton));
+                               Pose::Rest((*model)->skeleton()));
   EXPECT_LT(MaxDistance(rest, (*model)->mesh().vertices), 1e-6 * (*model)->bounding_box_diagonal());
+}
+
+TEST(LinearPoseResponse, RefusesSegmentsOutOfRange) {
+  auto phantom = MakeKneePhantom(400);
+  ASSERT_TRUE(phantom.ok());
+  for (int segments : {0, -3, ModelOptions::kMaxLinearBlendSegments + 1}) {
+    ModelOptions options = LinearBlend();
+    options.linear_blend_segments = segments;
+    auto model = DeformationModel::Build(phantom->mesh, phantom->skeleton, options);
+    ASSERT_FALSE(model.ok()) << segments;
+    EXPECT_EQ(model.status().code(), StatusCode::kInvalidArgument);
+    EXPECT_NE(model.status().message().find("linear_blend_segments"), std::string::npos);
+  }
 }
 
 TEST(LinearPoseResponse, PaperLinearIsAMethodOfTheComparison) {

@@ -14,10 +14,11 @@
 namespace deform::testing {
 
 inline StatusOr<std::shared_ptr<const DeformationModel>> BuildModelFromFiles(
-    const std::string& mesh_path, const std::string& skeleton_path) {
+    const std::string& mesh_path, const std::string& skeleton_path,
+    const ModelOptions& options = ModelOptions::Paper()) {
   DEFORM_ASSIGN_OR_RETURN(TriangleMesh mesh, ReadMeshFile(mesh_path));
   DEFORM_ASSIGN_OR_RETURN(Skeleton skeleton, ReadSkeletonFile(skeleton_path));
-  return DeformationModel::Build(std::move(mesh), std::move(skeleton), ModelOptions::Paper());
+  return DeformationModel::Build(std::move(mesh), std::move(skeleton), options);
 }
 
 }  // namespace deform::testing
