@@ -26,9 +26,9 @@
 #include <vector>
 
 #include "bench/memory_bandwidth.h"
-#include "core/deformation_model.h"
-#include "core/model_input.h"
-#include "core/phantom.h"
+#include "core/io/model_input.h"
+#include "core/io/phantom.h"
+#include "core/model/deformation_model.h"
 
 namespace deform::bench {
 namespace {
@@ -37,7 +37,7 @@ using Clock = std::chrono::steady_clock;
 
 struct BenchMesh {
   std::string name;
-  std::string mesh_path;      // empty: the phantom
+  std::string mesh_path;  // empty: the phantom
   std::string skeleton_path;
   std::string pose_spec;
 };
@@ -45,8 +45,8 @@ struct BenchMesh {
 std::map<std::string, std::shared_ptr<const DeformationModel>> g_models;
 
 // The paper's model of `mesh` (built once per rotation blend and kept for the later benchmarks).
-std::shared_ptr<const DeformationModel> ModelFor(
-    const BenchMesh& mesh, RotationBlend blend = RotationBlend::kQuaternion) {
+std::shared_ptr<const DeformationModel> ModelFor(const BenchMesh& mesh,
+                                                 RotationBlend blend = RotationBlend::kQuaternion) {
   const std::string key = mesh.name + (blend == RotationBlend::kLinear ? "/linear" : "");
   auto it = g_models.find(key);
   if (it != g_models.end()) return it->second;
@@ -175,9 +175,8 @@ void BM_EigenBaselineSolve(benchmark::State& state, BenchMesh mesh) {
     benchmark::DoNotOptimize(x.data());
   });
   const auto& l = llt.matrixL().nestedExpression();
-  ReportAgainstBound(state,
-                     l.nonZeros() * (sizeof(double) + sizeof(int)) + (l.cols() + 1) * sizeof(int),
-                     seconds);
+  ReportAgainstBound(
+      state, l.nonZeros() * (sizeof(double) + sizeof(int)) + (l.cols() + 1) * sizeof(int), seconds);
 }
 
 // A numeric refactorisation (as after a stiffness change), reusing the symbolic analysis.
@@ -242,27 +241,35 @@ int main(int argc, char** argv) {
   for (const BenchMesh& mesh : AvailableMeshes()) {
     const bool large = mesh.name == "arm_132946";
     benchmark::RegisterBenchmark(("Precompute/" + mesh.name).c_str(), BM_Precompute, mesh)
-        ->Unit(benchmark::kMillisecond)->Iterations(large ? 1 : 3);
+        ->Unit(benchmark::kMillisecond)
+        ->Iterations(large ? 1 : 3);
     benchmark::RegisterBenchmark(("Factorize/" + mesh.name).c_str(), BM_Factorize, mesh)
-        ->Unit(benchmark::kMillisecond)->Iterations(large ? 2 : 5);
+        ->Unit(benchmark::kMillisecond)
+        ->Iterations(large ? 2 : 5);
     benchmark::RegisterBenchmark(("Frame/" + mesh.name).c_str(), BM_Frame, mesh)
-        ->Unit(benchmark::kMillisecond)->MinTime(1.0);
+        ->Unit(benchmark::kMillisecond)
+        ->MinTime(1.0);
     benchmark::RegisterBenchmark(("LinearBlendFrame/" + mesh.name).c_str(), BM_LinearBlendFrame,
                                  mesh)
-        ->Unit(benchmark::kMillisecond)->MinTime(1.0);
+        ->Unit(benchmark::kMillisecond)
+        ->MinTime(1.0);
     benchmark::RegisterBenchmark(("RightHandSide/" + mesh.name).c_str(), BM_RightHandSide, mesh)
-        ->Unit(benchmark::kMillisecond)->MinTime(0.5);
+        ->Unit(benchmark::kMillisecond)
+        ->MinTime(0.5);
     benchmark::RegisterBenchmark(("TriangularSolve/" + mesh.name).c_str(), BM_TriangularSolve, mesh,
                                  deform::BestSolveKernel())
-        ->Unit(benchmark::kMillisecond)->MinTime(1.0);
+        ->Unit(benchmark::kMillisecond)
+        ->MinTime(1.0);
     if (deform::BestSolveKernel() != deform::SolveKernel::kBaseline) {
       benchmark::RegisterBenchmark(("TriangularSolveBaselineKernel/" + mesh.name).c_str(),
                                    BM_TriangularSolve, mesh, deform::SolveKernel::kBaseline)
-          ->Unit(benchmark::kMillisecond)->MinTime(1.0);
+          ->Unit(benchmark::kMillisecond)
+          ->MinTime(1.0);
     }
     benchmark::RegisterBenchmark(("EigenBaselineSolve/" + mesh.name).c_str(), BM_EigenBaselineSolve,
                                  mesh)
-        ->Unit(benchmark::kMillisecond)->MinTime(1.0);
+        ->Unit(benchmark::kMillisecond)
+        ->MinTime(1.0);
   }
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();

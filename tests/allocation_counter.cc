@@ -8,9 +8,9 @@ namespace {
 std::atomic<long> g_allocations{0};
 }  // namespace
 
-namespace deform::testing {
+namespace deform::test_support {
 long AllocationCount() { return g_allocations.load(std::memory_order_relaxed); }
-}  // namespace deform::testing
+}  // namespace deform::test_support
 
 void* operator new(std::size_t size) {
   g_allocations.fetch_add(1, std::memory_order_relaxed);

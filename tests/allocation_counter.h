@@ -2,8 +2,8 @@
 // allocation_counter.cc (which replaces the global operator new/delete).
 #pragma once
 
-namespace deform::testing {
+namespace deform::test_support {
 
 long AllocationCount();
 
-}  // namespace deform::testing
+}  // namespace deform::test_support

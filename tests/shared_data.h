@@ -9,7 +9,7 @@
 #include <filesystem>
 #include <string>
 
-namespace deform::testing {
+namespace deform::test_support {
 
 inline std::string SharedDataDir() {
   if (const char* env = std::getenv("DEFORM_SHARED_DATA")) return env;
@@ -20,10 +20,10 @@ inline std::string SharedDataFile(const std::string& relative) {
   return (std::filesystem::path(SharedDataDir()) / relative).string();
 }
 
-}  // namespace deform::testing
+}  // namespace deform::test_support
 
-#define DEFORM_REQUIRE_SHARED_FILE(var, relative)                                      \
-  const std::string var = ::deform::testing::SharedDataFile(relative);                 \
-  if (!std::filesystem::exists(var)) {                                                 \
+#define DEFORM_REQUIRE_SHARED_FILE(var, relative)                                         \
+  const std::string var = ::deform::test_support::SharedDataFile(relative);               \
+  if (!std::filesystem::exists(var)) {                                                    \
     GTEST_SKIP() << "shared data absent (" << var << "); skipping this shared-mesh test"; \
   }

@@ -43,14 +43,16 @@ class DeformClient {
                            deform::v1::MeshSummary* summary, const ProgressCallback& progress = {},
                            const std::string& name = "phantom");
   // Uploads a mesh file and a skeleton file (formats from the extensions: .obj .ply .stl .off;
-  // .tgf or JSON). Reading a file that does not exist gives NOT_FOUND without contacting the server.
+  // .tgf or JSON). Reading a file that does not exist gives NOT_FOUND without contacting the
+  // server.
   grpc::Status LoadMeshFiles(const std::string& mesh_path, const std::string& skeleton_path,
                              const deform::v1::MethodOptions& options,
                              deform::v1::MeshSummary* summary,
                              const ProgressCallback& progress = {});
   // Uploads mesh bytes already in memory.
   grpc::Status LoadMeshBytes(const std::string& name, deform::v1::MeshFormat format,
-                             const std::string& mesh_bytes, deform::v1::SkeletonFormat skeleton_format,
+                             const std::string& mesh_bytes,
+                             deform::v1::SkeletonFormat skeleton_format,
                              const std::string& skeleton_bytes,
                              const deform::v1::MethodOptions& options,
                              deform::v1::MeshSummary* summary,

@@ -175,7 +175,8 @@ std::string ReportText(const LoadReport& report) {
   add("server ms (median): queue %.3f  rhs %.3f  solve %.3f  encode %.3f\n",
       report.server_p50.queue_ms, report.server_p50.rhs_ms, report.server_p50.solve_ms,
       report.server_p50.encode_ms);
-  add("server total ms: p50 %.3f  p99 %.3f; outside the server (gRPC, wake-ups): p50 %.3f  p99 %.3f\n",
+  add("server total ms: p50 %.3f  p99 %.3f; outside the server (gRPC, wake-ups): p50 %.3f  p99 "
+      "%.3f\n",
       report.server_total.p50, report.server_total.p99, report.outside_server.p50,
       report.outside_server.p99);
   if (plan.stiffness_every_s > 0) {

@@ -20,7 +20,7 @@ struct RunDescription {
   std::string mesh_id;
   unsigned vertices = 0;
   unsigned triangles = 0;
-  std::string rotation_blend;  // as the server reports the mesh loaded
+  std::string rotation_blend;   // as the server reports the mesh loaded
   std::string stiffness_joint;  // empty without stiffness updates
 };
 

@@ -3,8 +3,8 @@
 
 #include <string>
 
-#include "core/mesh.h"
-#include "core/status.h"
+#include "core/base/status.h"
+#include "core/geometry/mesh.h"
 
 namespace deform::vr {
 

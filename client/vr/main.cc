@@ -13,7 +13,7 @@
 #include <iostream>
 #include <string>
 
-#include "core/mesh_io.h"
+#include "core/io/mesh_io.h"
 #include "lib/deform_client.h"
 #include "lib/flexion_trajectory.h"
 #include "lib/joint_choice.h"

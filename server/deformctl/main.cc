@@ -1,6 +1,7 @@
 // deformctl: the deformation core from the command line.
 //
-//   deformctl deform [--mesh FILE --skeleton FILE] --pose SPEC [--method paper|paper-linear|laplacian|lbs|dqs]
+//   deformctl deform [--mesh FILE --skeleton FILE] --pose SPEC [--method
+//   paper|paper-linear|laplacian|lbs|dqs]
 //                    [--out FILE] [--repeat N]
 //   deformctl phantom --out FILE [--skeleton-out FILE] [--vertices N]
 //
@@ -13,10 +14,11 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "core/mesh_io.h"
-#include "core/method_comparison.h"
-#include "core/model_input.h"
-#include "core/phantom.h"
+#include "core/eval/method_comparison.h"
+#include "core/io/mesh_io.h"
+#include "core/io/model_input.h"
+#include "core/io/phantom.h"
+#include "core/io/skeleton_io.h"
 
 namespace {
 
@@ -143,11 +145,17 @@ int main(int argc, char** argv) {
       ->add_option("--pose", deform_args.pose,
                    "JOINT:AXIS:DEGREES[,...], e.g. knee:flexion:90 or 1:x:90")
       ->capture_default_str();
-  deform_cmd->add_option("--method", deform_args.method, "paper | paper-linear (linear rotation blend, no per-frame solve) | laplacian | lbs | dqs")
+  deform_cmd
+      ->add_option("--method", deform_args.method,
+                   "paper | paper-linear (linear rotation blend, no per-frame solve) | laplacian | "
+                   "lbs | dqs")
       ->capture_default_str();
   deform_cmd->add_option("--out", deform_args.out_path,
                          "Write the deformed mesh (format from the extension)");
-  deform_cmd->add_option("--repeat", deform_args.repeat, "Frames to time; solve_ms (the triangular solve) and frame_ms (the whole frame) are their medians")
+  deform_cmd
+      ->add_option("--repeat", deform_args.repeat,
+                   "Frames to time; solve_ms (the triangular solve) and frame_ms (the whole frame) "
+                   "are their medians")
       ->capture_default_str()
       ->check(CLI::Range(1, 100000));
   deform_cmd

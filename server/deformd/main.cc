@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "core/model_input.h"
+#include "core/io/model_input.h"
 #include "service/deform_server.h"
 #include "service/service_options.h"
 

@@ -11,8 +11,8 @@
 #include <memory>
 #include <string>
 
-#include "core/model_input.h"
-#include "core/status.h"
+#include "core/base/status.h"
+#include "core/io/model_input.h"
 #include "service/mesh_registry.h"
 #include "service/service_options.h"
 

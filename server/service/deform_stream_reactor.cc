@@ -11,8 +11,8 @@
 #include <string>
 #include <utility>
 
-#include "core/deformation_model.h"
-#include "core/pose.h"
+#include "core/geometry/pose.h"
+#include "core/model/deformation_model.h"
 #include "service/pose_input.h"
 #include "service/proto_conversion.h"
 #include "service/status_mapping.h"

@@ -10,9 +10,10 @@
 #include <string>
 #include <utility>
 
-#include "core/mesh_io.h"
-#include "core/phantom.h"
-#include "core/skeleton.h"
+#include "core/geometry/skeleton.h"
+#include "core/io/mesh_io.h"
+#include "core/io/phantom.h"
+#include "core/io/skeleton_io.h"
 #include "service/mesh_loader.h"
 #include "service/proto_conversion.h"
 #include "service/status_mapping.h"

@@ -10,10 +10,10 @@
 #include <memory>
 #include <string>
 
-#include "core/deformation_model.h"
-#include "core/mesh.h"
-#include "core/skeleton.h"
-#include "core/status.h"
+#include "core/base/status.h"
+#include "core/geometry/mesh.h"
+#include "core/geometry/skeleton.h"
+#include "core/model/deformation_model.h"
 #include "service/mesh_registry.h"
 
 namespace deform::service {

@@ -20,8 +20,8 @@
 #include <string>
 #include <vector>
 
-#include "core/deformation_model.h"
-#include "core/status.h"
+#include "core/base/status.h"
+#include "core/model/deformation_model.h"
 #include "service/service_options.h"
 
 namespace deform::service {

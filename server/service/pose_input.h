@@ -11,9 +11,9 @@
 #include <utility>
 #include <vector>
 
-#include "core/pose.h"
-#include "core/skeleton.h"
-#include "core/status.h"
+#include "core/base/status.h"
+#include "core/geometry/pose.h"
+#include "core/geometry/skeleton.h"
 #include "deform/v1/deform.pb.h"
 
 namespace deform::service {

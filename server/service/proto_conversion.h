@@ -6,10 +6,10 @@
 
 #include <cstddef>
 
-#include "core/deformation_model.h"
-#include "core/skeleton.h"
-#include "core/status.h"
-#include "core/stiffness.h"
+#include "core/base/status.h"
+#include "core/geometry/skeleton.h"
+#include "core/model/deformation_model.h"
+#include "core/model/stiffness.h"
 #include "deform/v1/deform.pb.h"
 #include "service/mesh_registry.h"
 

@@ -12,12 +12,12 @@
 #include <thread>
 #include <vector>
 
-#include "core/deformation_model.h"
-#include "core/phantom.h"
-#include "core/pose.h"
+#include "core/geometry/pose.h"
+#include "core/io/phantom.h"
+#include "core/model/deformation_model.h"
 #include "tests/service/service_fixture.h"
 
-namespace deform::testing {
+namespace deform::test_support {
 namespace {
 
 using ::testing::HasSubstr;
@@ -452,4 +452,4 @@ TEST(DeformServerShutdownTest, ShutdownEndsOpenStreamsPromptly) {
 }
 
 }  // namespace
-}  // namespace deform::testing
+}  // namespace deform::test_support

@@ -9,7 +9,7 @@
 
 #include "tests/service/test_server.h"
 
-namespace deform::testing {
+namespace deform::test_support {
 namespace {
 
 // grpc.health.v1.Health/Check through a generic stub (the health protos are not compiled here):
@@ -33,8 +33,8 @@ grpc::Status CheckHealth(const std::string& target, const std::string& service,
   std::condition_variable done_cv;
   bool done = false;
   grpc::Status result;
-  stub.UnaryCall(&context, "/grpc.health.v1.Health/Check", grpc::StubOptions(), &request,
-                 &response, [&](grpc::Status status) {
+  stub.UnaryCall(&context, "/grpc.health.v1.Health/Check", grpc::StubOptions(), &request, &response,
+                 [&](grpc::Status status) {
                    std::lock_guard<std::mutex> lock(mutex);
                    result = std::move(status);
                    done = true;
@@ -68,4 +68,4 @@ TEST(HealthTest, ServerAndServiceAreServing) {
 }
 
 }  // namespace
-}  // namespace deform::testing
+}  // namespace deform::test_support

@@ -10,13 +10,14 @@
 #include <string>
 #include <vector>
 
-#include "core/mesh_io.h"
-#include "core/phantom.h"
-#include "core/skeleton.h"
+#include "core/geometry/skeleton.h"
+#include "core/io/mesh_io.h"
+#include "core/io/phantom.h"
+#include "core/io/skeleton_io.h"
 #include "tests/service/service_fixture.h"
 #include "tests/shared_data.h"
 
-namespace deform::testing {
+namespace deform::test_support {
 namespace {
 
 using ::testing::ElementsAre;
@@ -340,4 +341,4 @@ TEST_F(LoadMeshTest, UploadLimitIsResourceExhausted) {
 }
 
 }  // namespace
-}  // namespace deform::testing
+}  // namespace deform::test_support

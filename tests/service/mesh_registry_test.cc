@@ -3,7 +3,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "core/phantom.h"
+#include "core/io/phantom.h"
 #include "service/status_mapping.h"
 
 namespace deform::service {

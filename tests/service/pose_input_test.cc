@@ -6,8 +6,8 @@
 #include <cmath>
 #include <limits>
 
-#include "core/deformation_model.h"
-#include "core/phantom.h"
+#include "core/io/phantom.h"
+#include "core/model/deformation_model.h"
 #include "service/proto_conversion.h"
 #include "tests/allocation_counter.h"
 
@@ -117,11 +117,11 @@ TEST_F(PoseInputTest, FramePathIsAllocationFreeOnceWarm) {
   };
   frame();  // warm-up sizes the buffers
   constexpr int kFrames = 200;
-  const long before = deform::testing::AllocationCount();
+  const long before = deform::test_support::AllocationCount();
   for (int i = 0; i < kFrames; ++i) frame();
   // Other threads of the test binary (gRPC's) may allocate now and then; a per-frame allocation
   // would add at least kFrames.
-  EXPECT_LT(deform::testing::AllocationCount() - before, kFrames / 4);
+  EXPECT_LT(deform::test_support::AllocationCount() - before, kFrames / 4);
 }
 
 }  // namespace

@@ -12,7 +12,7 @@
 #include "tests/service/stream_recorder.h"
 #include "tests/service/test_server.h"
 
-namespace deform::testing {
+namespace deform::test_support {
 
 class ServiceTest : public ::testing::Test {
  protected:
@@ -81,4 +81,4 @@ class ServiceTest : public ::testing::Test {
   bool expect_background_ok_at_end_ = true;
 };
 
-}  // namespace deform::testing
+}  // namespace deform::test_support

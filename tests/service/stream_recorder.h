@@ -18,7 +18,7 @@
 
 #include "deform_client.h"
 
-namespace deform::testing {
+namespace deform::test_support {
 
 // Long enough for a loaded 2-core machine; tests only wait this long when something is broken.
 constexpr std::chrono::seconds kWaitTimeout{60};
@@ -160,4 +160,4 @@ class PosePacer {
   std::thread thread_;
 };
 
-}  // namespace deform::testing
+}  // namespace deform::test_support

@@ -11,7 +11,7 @@
 #include "service/deform_server.h"
 #include "service/service_options.h"
 
-namespace deform::testing {
+namespace deform::test_support {
 
 inline service::ServerOptions TestServerOptions() {
   service::ServerOptions options;
@@ -41,4 +41,4 @@ class TestServer {
   std::string target_;
 };
 
-}  // namespace deform::testing
+}  // namespace deform::test_support

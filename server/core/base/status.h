@@ -1,0 +1,102 @@
+// Error values for the numerical core.
+//
+// Fallible calls return a Status (or a StatusOr<T>) built by the named factories below; the core
+// never throws across its API and never asserts on untrusted input. The codes mirror the canonical
+// gRPC codes so that the service maps them one to one (see server/service/status_mapping.h).
+#pragma once
+
+#include <cassert>
+#include <string>
+#include <utility>
+#include <variant>
+
+namespace deform {
+
+enum class StatusCode {
+  kOk = 0,
+  kInvalidArgument,     // the input (mesh, skeleton, pose, request) is malformed
+  kNotFound,            // a named thing (file, joint, mesh id) does not exist
+  kOutOfRange,          // a value lies outside its allowed range
+  kResourceExhausted,   // a configured limit would be exceeded
+  kFailedPrecondition,  // the operation does not apply in the current state
+  kInternal,            // a numerical or programming failure (e.g. factorisation broke down)
+};
+
+const char* StatusCodeName(StatusCode code);
+
+class [[nodiscard]] Status {
+ public:
+  Status() = default;  // OK
+
+  static Status Ok() { return Status(); }
+  static Status InvalidArgument(std::string msg) {
+    return {StatusCode::kInvalidArgument, std::move(msg)};
+  }
+  static Status NotFound(std::string msg) { return {StatusCode::kNotFound, std::move(msg)}; }
+  static Status OutOfRange(std::string msg) { return {StatusCode::kOutOfRange, std::move(msg)}; }
+  static Status ResourceExhausted(std::string msg) {
+    return {StatusCode::kResourceExhausted, std::move(msg)};
+  }
+  static Status FailedPrecondition(std::string msg) {
+    return {StatusCode::kFailedPrecondition, std::move(msg)};
+  }
+  static Status Internal(std::string msg) { return {StatusCode::kInternal, std::move(msg)}; }
+
+  bool ok() const { return code_ == StatusCode::kOk; }
+  StatusCode code() const { return code_; }
+  const std::string& message() const { return message_; }
+  // "INVALID_ARGUMENT: message", or "OK".
+  std::string ToString() const;
+
+  // Returns a copy with `context + ": "` prepended to the message (the code is kept).
+  Status WithContext(const std::string& context) const;
+
+ private:
+  Status(StatusCode code, std::string msg) : code_(code), message_(std::move(msg)) {}
+  StatusCode code_ = StatusCode::kOk;
+  std::string message_;
+};
+
+// Either a value or a non-OK Status.
+template <typename T>
+class [[nodiscard]] StatusOr {
+ public:
+  StatusOr(T value) : value_(std::move(value)) {}        // NOLINT: implicit by design
+  StatusOr(Status status) : value_(std::move(status)) {  // NOLINT: implicit by design
+    assert(!std::get<Status>(value_).ok() && "StatusOr built from an OK status");
+  }
+
+  bool ok() const { return std::holds_alternative<T>(value_); }
+  Status status() const { return ok() ? Status::Ok() : std::get<Status>(value_); }
+
+  // Precondition: ok().
+  T& value() & { return std::get<T>(value_); }
+  const T& value() const& { return std::get<T>(value_); }
+  T&& value() && { return std::get<T>(std::move(value_)); }
+  T& operator*() & { return value(); }
+  const T& operator*() const& { return value(); }
+  T* operator->() { return &value(); }
+  const T* operator->() const { return &value(); }
+
+ private:
+  std::variant<T, Status> value_;
+};
+
+}  // namespace deform
+
+// Returns early from the enclosing function when `expr` (a Status) is not OK.
+#define DEFORM_RETURN_IF_ERROR(expr)                 \
+  do {                                               \
+    ::deform::Status deform_status_ = (expr);        \
+    if (!deform_status_.ok()) return deform_status_; \
+  } while (0)
+
+#define DEFORM_CONCAT_INNER_(a, b) a##b
+#define DEFORM_CONCAT_(a, b) DEFORM_CONCAT_INNER_(a, b)
+// Declares `lhs` from a StatusOr expression, returning early with its status on error.
+#define DEFORM_ASSIGN_OR_RETURN(lhs, expr) \
+  DEFORM_ASSIGN_OR_RETURN_IMPL_(DEFORM_CONCAT_(deform_statusor_, __LINE__), lhs, expr)
+#define DEFORM_ASSIGN_OR_RETURN_IMPL_(tmp, lhs, expr) \
+  auto tmp = (expr);                                  \
+  if (!tmp.ok()) return tmp.status();                 \
+  lhs = std::move(tmp).value()

@@ -1,0 +1,42 @@
+// Quality measures of a deformation (METHOD.md, "What to measure").
+#pragma once
+
+#include <vector>
+
+#include "core/geometry/enclosed_volume.h"
+#include "core/geometry/mesh.h"
+#include "core/geometry/pose.h"
+#include "core/geometry/skeleton.h"
+
+namespace deform {
+
+struct ClearanceStats {
+  double min = 0;            // smallest ratio
+  double p01 = 0;            // 1st percentile
+  double sink_fraction = 0;  // fraction of vertices with ratio < 0.5
+};
+
+// Skin-to-bone clearance: per vertex, its distance to the nearest posed bone segment over the same
+// distance at rest. Vertices closer than 1e-9 of the bounding-box diagonal to a bone at rest are
+// skipped (their ratio is undefined).
+ClearanceStats SkinClearance(const Positions& rest, const Positions& posed,
+                             const Skeleton& skeleton, const std::vector<RigidTransform>& bones);
+
+struct QualityReport {
+  double volume_change = 0;  // (V_posed - V_rest) / V_rest, signed
+  ClearanceStats clearance;
+  // max over the `rigid_vertices` of |x_i - (R_k v_i + t_k)| / bounding-box diagonal, k being the
+  // vertex's bone; 0 when no vertices are given.
+  double rigid_zone_error = 0;
+  // max over all vertices of |x_i - v_i| / bounding-box diagonal (meaningful for the rest pose).
+  double max_displacement = 0;
+};
+
+// All measures at once. `rigid_vertices` / `rigid_bones`: vertices far from every joint and the
+// bone each should follow.
+QualityReport MeasureQuality(const TriangleMesh& rest_mesh, const Positions& posed,
+                             const Skeleton& skeleton, const std::vector<RigidTransform>& bones,
+                             const std::vector<int>& rigid_vertices,
+                             const std::vector<int>& rigid_bones);
+
+}  // namespace deform

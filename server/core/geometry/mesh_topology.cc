@@ -1,0 +1,55 @@
+#include "core/geometry/mesh_topology.h"
+
+#include <algorithm>
+
+namespace deform {
+
+VertexAdjacency BuildVertexAdjacency(const Triangles& triangles, int num_vertices) {
+  std::vector<std::vector<int>> lists(num_vertices);
+  for (int f = 0; f < triangles.rows(); ++f) {
+    for (int c = 0; c < 3; ++c) {
+      const int a = triangles(f, c), b = triangles(f, (c + 1) % 3);
+      lists[a].push_back(b);
+      lists[b].push_back(a);
+    }
+  }
+  VertexAdjacency adjacency;
+  adjacency.offsets.assign(num_vertices + 1, 0);
+  for (int i = 0; i < num_vertices; ++i) {
+    std::sort(lists[i].begin(), lists[i].end());
+    lists[i].erase(std::unique(lists[i].begin(), lists[i].end()), lists[i].end());
+    adjacency.offsets[i + 1] = adjacency.offsets[i] + static_cast<int>(lists[i].size());
+  }
+  adjacency.neighbors.reserve(adjacency.offsets.back());
+  for (const auto& list : lists) {
+    adjacency.neighbors.insert(adjacency.neighbors.end(), list.begin(), list.end());
+  }
+  return adjacency;
+}
+
+int ConnectedComponents(const VertexAdjacency& adjacency, std::vector<int>* component) {
+  const int n = static_cast<int>(adjacency.offsets.size()) - 1;
+  component->assign(n, -1);
+  std::vector<int> stack;
+  int count = 0;
+  for (int seed = 0; seed < n; ++seed) {
+    if ((*component)[seed] >= 0) continue;
+    (*component)[seed] = count;
+    stack.push_back(seed);
+    while (!stack.empty()) {
+      const int v = stack.back();
+      stack.pop_back();
+      for (int p = adjacency.offsets[v]; p < adjacency.offsets[v + 1]; ++p) {
+        const int u = adjacency.neighbors[p];
+        if ((*component)[u] < 0) {
+          (*component)[u] = count;
+          stack.push_back(u);
+        }
+      }
+    }
+    ++count;
+  }
+  return count;
+}
+
+}  // namespace deform

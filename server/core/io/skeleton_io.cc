@@ -1,0 +1,179 @@
+#include "core/io/skeleton_io.h"
+
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+namespace deform {
+
+StatusOr<Skeleton> ParseTgf(std::string_view text) {
+  std::istringstream in{std::string(text)};
+  std::string line;
+  std::vector<Joint> joints;
+  std::vector<std::pair<int, int>> bones;
+  int section = 0;  // 0 joints, 1 bones, 2 done
+  int line_number = 0;
+  while (std::getline(in, line) && section < 2) {
+    ++line_number;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.find_first_not_of(" \t") == std::string::npos) continue;
+    if (line[line.find_first_not_of(" \t")] == '#') {
+      ++section;
+      continue;
+    }
+    std::istringstream fields(line);
+    const std::string where = "TGF line " + std::to_string(line_number);
+    if (section == 0) {
+      std::string index;
+      Joint joint;
+      double x, y, z;
+      if (!(fields >> index >> x >> y >> z)) {
+        return Status::InvalidArgument(where + ": expected 'index x y z'");
+      }
+      joint.rest_position = {x, y, z};
+      if (!joint.rest_position.allFinite()) {
+        return Status::InvalidArgument(where + ": non-finite joint position");
+      }
+      joint.name = "joint" + std::to_string(joints.size());
+      joints.push_back(std::move(joint));
+    } else {
+      long long a, b;
+      if (!(fields >> a >> b)) return Status::InvalidArgument(where + ": expected 'a b'");
+      if (a < 1 || b < 1 || a > static_cast<long long>(joints.size()) ||
+          b > static_cast<long long>(joints.size())) {
+        return Status::InvalidArgument(where + ": bone joint index out of range 1.." +
+                                       std::to_string(joints.size()));
+      }
+      bones.emplace_back(static_cast<int>(a - 1), static_cast<int>(b - 1));
+    }
+  }
+  if (section == 0) return Status::InvalidArgument("TGF has no '#' line after the joints");
+  return Skeleton::Create(std::move(joints), std::move(bones));
+}
+
+namespace {
+
+StatusOr<Eigen::Vector3d> JsonVector(const nlohmann::json& value, const std::string& what) {
+  if (!value.is_array() || value.size() != 3) {
+    return Status::InvalidArgument(what + " must be an array of 3 numbers");
+  }
+  Eigen::Vector3d v;
+  for (int c = 0; c < 3; ++c) {
+    if (!value[c].is_number()) return Status::InvalidArgument(what + " must hold numbers");
+    v[c] = value[c].get<double>();
+  }
+  return v;
+}
+
+StatusOr<int> JsonJointReference(const nlohmann::json& value, const std::vector<Joint>& joints) {
+  if (value.is_number_integer()) {
+    const long long j = value.get<long long>();
+    if (j >= 0 && j < static_cast<long long>(joints.size())) return static_cast<int>(j);
+  } else if (value.is_string()) {
+    const std::string name = value.get<std::string>();
+    for (size_t j = 0; j < joints.size(); ++j) {
+      if (joints[j].name == name) return static_cast<int>(j);
+    }
+  }
+  return Status::InvalidArgument("bone references unknown joint " + value.dump());
+}
+
+StatusOr<Skeleton> ParseSkeletonJsonValue(const nlohmann::json& doc) {
+  if (!doc.is_object() || !doc.contains("joints") || !doc["joints"].is_array() ||
+      !doc.contains("bones") || !doc["bones"].is_array()) {
+    return Status::InvalidArgument("skeleton JSON needs arrays 'joints' and 'bones'");
+  }
+  std::vector<Joint> joints;
+  for (const auto& j : doc["joints"]) {
+    const std::string where = "joint " + std::to_string(joints.size());
+    if (!j.is_object() || !j.contains("name") || !j["name"].is_string() ||
+        !j.contains("position")) {
+      return Status::InvalidArgument(where + " needs 'name' (string) and 'position'");
+    }
+    Joint joint;
+    joint.name = j["name"].get<std::string>();
+    DEFORM_ASSIGN_OR_RETURN(joint.rest_position, JsonVector(j["position"], where + " position"));
+    if (j.contains("dofs")) {
+      if (!j["dofs"].is_array()) return Status::InvalidArgument(where + " 'dofs' must be an array");
+      for (const auto& d : j["dofs"]) {
+        if (!d.is_object() || !d.contains("name") || !d["name"].is_string() ||
+            !d.contains("axis")) {
+          return Status::InvalidArgument(where + ": each dof needs 'name' and 'axis'");
+        }
+        DegreeOfFreedom dof;
+        dof.name = d["name"].get<std::string>();
+        DEFORM_ASSIGN_OR_RETURN(dof.axis, JsonVector(d["axis"], where + " dof axis"));
+        if (d.contains("min")) {
+          if (!d["min"].is_number())
+            return Status::InvalidArgument(where + ": dof 'min' not a number");
+          dof.min_degrees = d["min"].get<double>();
+        }
+        if (d.contains("max")) {
+          if (!d["max"].is_number())
+            return Status::InvalidArgument(where + ": dof 'max' not a number");
+          dof.max_degrees = d["max"].get<double>();
+        }
+        joint.dofs.push_back(std::move(dof));
+      }
+    }
+    joints.push_back(std::move(joint));
+  }
+  std::vector<std::pair<int, int>> bones;
+  for (const auto& b : doc["bones"]) {
+    if (!b.is_array() || b.size() != 2) {
+      return Status::InvalidArgument("each bone must be [head, tail]");
+    }
+    DEFORM_ASSIGN_OR_RETURN(const int head, JsonJointReference(b[0], joints));
+    DEFORM_ASSIGN_OR_RETURN(const int tail, JsonJointReference(b[1], joints));
+    bones.emplace_back(head, tail);
+  }
+  return Skeleton::Create(std::move(joints), std::move(bones));
+}
+
+}  // namespace
+
+StatusOr<Skeleton> ParseSkeletonJson(std::string_view text) {
+  nlohmann::json doc = nlohmann::json::parse(text.begin(), text.end(), nullptr,
+                                             /*allow_exceptions=*/false);
+  if (doc.is_discarded()) return Status::InvalidArgument("skeleton JSON does not parse");
+  return ParseSkeletonJsonValue(doc);
+}
+
+std::string SkeletonToJson(const Skeleton& skeleton) {
+  nlohmann::json doc;
+  doc["joints"] = nlohmann::json::array();
+  for (const Joint& j : skeleton.joints()) {
+    nlohmann::json joint;
+    joint["name"] = j.name;
+    joint["position"] = {j.rest_position.x(), j.rest_position.y(), j.rest_position.z()};
+    joint["dofs"] = nlohmann::json::array();
+    for (const DegreeOfFreedom& d : j.dofs) {
+      joint["dofs"].push_back({{"name", d.name},
+                               {"axis", {d.axis.x(), d.axis.y(), d.axis.z()}},
+                               {"min", d.min_degrees},
+                               {"max", d.max_degrees}});
+    }
+    doc["joints"].push_back(joint);
+  }
+  doc["bones"] = nlohmann::json::array();
+  for (const Bone& b : skeleton.bones()) {
+    doc["bones"].push_back({skeleton.joint(b.head_joint).name, skeleton.joint(b.tail_joint).name});
+  }
+  return doc.dump(2);
+}
+
+StatusOr<Skeleton> ReadSkeletonFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Status::NotFound("cannot open skeleton file '" + path + "'");
+  std::ostringstream buffer;
+  buffer << in.rdbuf();
+  const std::string text = buffer.str();
+  const bool is_tgf = path.size() >= 4 && (path.compare(path.size() - 4, 4, ".tgf") == 0 ||
+                                           path.compare(path.size() - 4, 4, ".TGF") == 0);
+  auto skeleton = is_tgf ? ParseTgf(text) : ParseSkeletonJson(text);
+  if (!skeleton.ok()) return skeleton.status().WithContext(path);
+  return skeleton;
+}
+
+}  // namespace deform

@@ -1,0 +1,111 @@
+#include "core/model/bone_weights.h"
+
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+#include <algorithm>
+#include <numeric>
+#include <string>
+
+namespace deform {
+namespace {
+
+Status CheckEveryComponentHasFixedVertex(const VertexAdjacency& adjacency,
+                                         const std::vector<int>& fixed_bone) {
+  std::vector<int> component;
+  const int count = ConnectedComponents(adjacency, &component);
+  std::vector<int> first_vertex(count, -1), size(count, 0);
+  std::vector<char> has_fixed(count, 0);
+  for (int i = 0; i < static_cast<int>(component.size()); ++i) {
+    const int c = component[i];
+    if (first_vertex[c] < 0) first_vertex[c] = i;
+    ++size[c];
+    if (fixed_bone[i] >= 0) has_fixed[c] = 1;
+  }
+  for (int c = 0; c < count; ++c) {
+    if (!has_fixed[c]) {
+      return Status::InvalidArgument(
+          "connected component containing vertex " + std::to_string(first_vertex[c]) + " (" +
+          std::to_string(size[c]) +
+          " vertices) has no vertex in any bone's rigid zone, so it cannot be anchored to the "
+          "skeleton");
+    }
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+StatusOr<BoneWeights> HarmonicBoneWeights(const VertexAdjacency& adjacency,
+                                          const std::vector<int>& fixed_bone, int num_bones) {
+  const int n = static_cast<int>(fixed_bone.size());
+  DEFORM_RETURN_IF_ERROR(CheckEveryComponentHasFixedVertex(adjacency, fixed_bone));
+
+  // Number the free vertices.
+  std::vector<int> free_index(n, -1);
+  int num_free = 0;
+  for (int i = 0; i < n; ++i) {
+    if (fixed_bone[i] < 0) free_index[i] = num_free++;
+  }
+
+  BoneWeights result;
+  result.num_bones = num_bones;
+  result.dense = Eigen::MatrixXd::Zero(n, num_bones);
+  for (int i = 0; i < n; ++i) {
+    if (fixed_bone[i] >= 0) result.dense(i, fixed_bone[i]) = 1.0;
+  }
+
+  if (num_free > 0) {
+    // Graph Laplacian restricted to the free vertices: L_ff h_f = -L_fb h_b = sum of fixed
+    // neighbours' values.
+    std::vector<Eigen::Triplet<double>> triplets;
+    Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(num_free, num_bones);
+    for (int i = 0; i < n; ++i) {
+      const int fi = free_index[i];
+      if (fi < 0) continue;
+      triplets.emplace_back(fi, fi, adjacency.degree(i));
+      for (int p = adjacency.offsets[i]; p < adjacency.offsets[i + 1]; ++p) {
+        const int u = adjacency.neighbors[p];
+        if (free_index[u] >= 0) {
+          triplets.emplace_back(fi, free_index[u], -1.0);
+        } else {
+          rhs(fi, fixed_bone[u]) += 1.0;
+        }
+      }
+    }
+    Eigen::SparseMatrix<double> laplacian(num_free, num_free);
+    laplacian.setFromTriplets(triplets.begin(), triplets.end());
+    Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> llt(
+        laplacian);
+    if (llt.info() != Eigen::Success) {
+      return Status::Internal("harmonic weight system could not be factorised");
+    }
+    const Eigen::MatrixXd solution = llt.solve(rhs);
+    for (int i = 0; i < n; ++i) {
+      if (free_index[i] >= 0) result.dense.row(i) = solution.row(free_index[i]);
+    }
+    // Round-off can leave tiny negatives; the exact solution lies in [0, 1].
+    result.dense = result.dense.cwiseMax(0.0).cwiseMin(1.0);
+  }
+
+  // Compress, dropping negligible weights and renormalising.
+  result.offsets.assign(n + 1, 0);
+  std::vector<std::pair<double, int>> entries;
+  for (int i = 0; i < n; ++i) {
+    entries.clear();
+    for (int k = 0; k < num_bones; ++k) {
+      if (result.dense(i, k) >= BoneWeights::kDropBelow)
+        entries.emplace_back(result.dense(i, k), k);
+    }
+    std::sort(entries.begin(), entries.end(), std::greater<>());
+    double sum = 0;
+    for (const auto& e : entries) sum += e.first;
+    for (const auto& e : entries) {
+      result.bones.push_back(e.second);
+      result.weights.push_back(e.first / sum);
+    }
+    result.offsets[i + 1] = static_cast<int>(result.bones.size());
+  }
+  return result;
+}
+
+}  // namespace deform

@@ -1,0 +1,33 @@
+// Harmonic bone weights (the harmonic guidance field of METHOD.md).
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "core/base/status.h"
+#include "core/geometry/mesh_topology.h"
+
+namespace deform {
+
+// Per-vertex bone weights h_ik: non-negative, summing to 1 over k for every vertex.
+struct BoneWeights {
+  int num_bones = 0;
+  Eigen::MatrixXd dense;  // #V by K, the harmonic field as solved (in [0, 1], rows sum to 1)
+  // Compressed per vertex for blending: weights below kDropBelow are dropped and the rest
+  // renormalised. Vertex i's entries are [offsets[i], offsets[i + 1]), largest weight first.
+  std::vector<int> offsets;
+  std::vector<int> bones;
+  std::vector<double> weights;
+  static constexpr double kDropBelow = 1e-4;
+
+  int num_vertices() const { return static_cast<int>(offsets.size()) - 1; }
+};
+
+// Solves the discrete Laplace equation L h_k = 0 (uniform graph weights, so the maximum principle
+// holds and h stays in [0, 1]) with Dirichlet conditions h_k = 1, h_j = 0 (j != k) at every vertex
+// whose fixed_bone[i] = k >= 0; vertices with fixed_bone[i] = -1 are free. INVALID_ARGUMENT when a
+// connected component has free vertices but no fixed one (its weights would be undetermined).
+StatusOr<BoneWeights> HarmonicBoneWeights(const VertexAdjacency& adjacency,
+                                          const std::vector<int>& fixed_bone, int num_bones);
+
+}  // namespace deform

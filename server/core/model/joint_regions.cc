@@ -1,0 +1,134 @@
+#include "core/model/joint_regions.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+namespace deform {
+namespace {
+
+bool BoneTouchesJoint(const Skeleton& skeleton, int bone, int joint) {
+  return skeleton.bone(bone).head_joint == joint || skeleton.bone(bone).tail_joint == joint;
+}
+
+double ShortestAdjacentBone(const Skeleton& skeleton, int joint) {
+  double shortest = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < skeleton.num_bones(); ++k) {
+    if (!BoneTouchesJoint(skeleton, k, joint)) continue;
+    const Bone& b = skeleton.bone(k);
+    shortest = std::min(shortest, (skeleton.joint(b.tail_joint).rest_position -
+                                   skeleton.joint(b.head_joint).rest_position)
+                                      .norm());
+  }
+  return shortest;
+}
+
+double Median(std::vector<double> values) {
+  if (values.empty()) return 0;
+  const auto middle = values.begin() + values.size() / 2;
+  std::nth_element(values.begin(), middle, values.end());
+  return *middle;
+}
+
+// Median distance from the joint centre to the vertices whose closest skeleton point is within a
+// band around the joint; the band widens until enough vertices fall in it.
+double LimbRadius(const TriangleMesh& mesh, const Skeleton& skeleton,
+                  const std::vector<NearestBone>& nearest, int joint) {
+  const Eigen::Vector3d centre = skeleton.joint(joint).rest_position;
+  const double shortest = ShortestAdjacentBone(skeleton, joint);
+  constexpr int kMinimumSamples = 8;
+  std::vector<double> distances;
+  for (double band = 0.1 * shortest; band <= 2 * shortest; band *= 2) {
+    distances.clear();
+    for (int i = 0; i < mesh.num_vertices(); ++i) {
+      const NearestBone& nb = nearest[i];
+      if (!BoneTouchesJoint(skeleton, nb.bone, joint)) continue;
+      const Bone& b = skeleton.bone(nb.bone);
+      const Eigen::Vector3d a = skeleton.joint(b.head_joint).rest_position;
+      const Eigen::Vector3d closest =
+          a + nb.parameter * (skeleton.joint(b.tail_joint).rest_position - a);
+      if ((closest - centre).norm() <= band) {
+        distances.push_back((mesh.vertices.row(i).transpose() - centre).norm());
+      }
+    }
+    if (static_cast<int>(distances.size()) >= kMinimumSamples) break;
+  }
+  return Median(distances);
+}
+
+}  // namespace
+
+StatusOr<JointRegions> ComputeJointRegions(const TriangleMesh& mesh, const Skeleton& skeleton,
+                                           const VertexAdjacency& adjacency,
+                                           const std::vector<NearestBone>& nearest,
+                                           const JointRegionOptions& options) {
+  const int n = mesh.num_vertices();
+  const std::vector<int> inner = skeleton.InnerJoints();
+  for (const auto& [joint, radius] : options.explicit_radius) {
+    if (joint < 0 || joint >= skeleton.num_joints()) {
+      return Status::InvalidArgument("joint region radius given for unknown joint " +
+                                     std::to_string(joint));
+    }
+    if (std::find(inner.begin(), inner.end(), joint) == inner.end()) {
+      return Status::InvalidArgument("joint '" + skeleton.joint(joint).name +
+                                     "' is not an inner joint, so it has no region");
+    }
+    if (!std::isfinite(radius) || radius <= 0) {
+      return Status::InvalidArgument("joint region radius of '" + skeleton.joint(joint).name +
+                                     "' must be positive and finite");
+    }
+  }
+  if (!std::isfinite(options.radius_factor) || options.radius_factor <= 0) {
+    return Status::InvalidArgument("joint region radius factor must be positive and finite");
+  }
+
+  JointRegions result;
+  result.relative_distance.assign(n, std::numeric_limits<double>::infinity());
+  result.nearest_region.assign(n, -1);
+  std::vector<std::vector<int>> memberships(n);
+  std::vector<char> in_region(n, 0);
+  for (int joint : inner) {
+    JointRegion region;
+    region.joint = joint;
+    region.centre = skeleton.joint(joint).rest_position;
+    region.limb_radius = LimbRadius(mesh, skeleton, nearest, joint);
+    region.radius = options.radius_factor * region.limb_radius;
+    for (const auto& [j, radius] : options.explicit_radius) {
+      if (j == joint) region.radius = radius;
+    }
+    const int index = static_cast<int>(result.regions.size());
+    for (int i = 0; i < n; ++i) {
+      const double d = (mesh.vertices.row(i).transpose() - region.centre).norm();
+      if (region.radius > 0 && d / region.radius < result.relative_distance[i]) {
+        result.relative_distance[i] = d / region.radius;
+        result.nearest_region[i] = index;
+      }
+      if (d <= region.radius && BoneTouchesJoint(skeleton, nearest[i].bone, joint)) {
+        region.vertices.push_back(i);
+        memberships[i].push_back(index);
+        in_region[i] = 1;
+      }
+    }
+    for (int i : region.vertices) {
+      for (int p = adjacency.offsets[i]; p < adjacency.offsets[i + 1]; ++p) {
+        const int u = adjacency.neighbors[p];
+        const auto& m = memberships[u];
+        if (std::find(m.begin(), m.end(), index) == m.end()) {
+          region.seam_vertices.push_back(i);
+          break;
+        }
+      }
+    }
+    result.regions.push_back(std::move(region));
+  }
+  result.membership_offsets.assign(n + 1, 0);
+  for (int i = 0; i < n; ++i) {
+    result.membership_offsets[i + 1] =
+        result.membership_offsets[i] + static_cast<int>(memberships[i].size());
+    result.membership.insert(result.membership.end(), memberships[i].begin(), memberships[i].end());
+  }
+  return result;
+}
+
+}  // namespace deform

@@ -1,0 +1,63 @@
+// METHOD.md's fast path: a frame without a solve, for the linear rotation blend.
+//
+// With T_i = sum_k h_ik R_k, the right-hand side of the normal equations is linear in the entries
+// of the bone transforms (R_k, t_k), and so is the solution:
+//
+//   x_i = sum_k ( R_k (U_k0[i], U_k1[i], U_k2[i])^T + t_k V_k[i] )
+//
+// U_kb = A^-1 (the right-hand side with R_k = the unit matrix's column b, every other transform
+// zero), V_k = A^-1 (the right-hand side of t_k = 1). Four vectors of length n per bone, computed
+// once per factorisation with 2 K three-column solves; a frame then costs 12 K multiply-adds per
+// vertex and reads 32 K bytes per vertex. It is exact for the linear blend (a test compares it
+// with the solve) and differs from the quaternion blend in the blend regions (measured in
+// METHOD-comparison tests and the quality table).
+//
+// Piecewise-linear pair blends (rotation_blend.h) add knots: a knot is the quaternion blend of two
+// bones at a fixed s, computed per frame, and enters like one more rotation with three response
+// vectors (the translations only reach the right-hand side through the bones themselves).
+//
+// Immutable after construction; Evaluate() is const, allocation-free and may run on any number of
+// threads at once.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "core/geometry/pose.h"
+
+namespace deform {
+
+class LinearPoseResponse {
+ public:
+  // An interior knot of a bone pair's blend: QLERP(q_bone_a, q_bone_b; s).
+  struct Knot {
+    int bone_a = 0;
+    int bone_b = 0;
+    double s = 0;
+  };
+
+  // `bones`: the bones with a non-zero response, ascending. `columns`: for each of them, in that
+  // order, the four response vectors U_k0, U_k1, U_k2, V_k of `num_vertices` doubles each; then
+  // for each knot its three vectors U_0, U_1, U_2.
+  // Precondition: columns.size() == (4 * bones.size() + 3 * knots.size()) * num_vertices.
+  LinearPoseResponse(int num_vertices, std::vector<int> bones, std::vector<Knot> knots,
+                     std::vector<double> columns);
+
+  // positions (n by 3, row-major) = the solution for these bone transforms (one per skeleton bone,
+  // as ForwardKinematics gives them). No allocation.
+  void Evaluate(const std::vector<RigidTransform>& bone_transforms, double* positions) const;
+
+  int num_vertices() const { return num_vertices_; }
+  const std::vector<int>& bones() const { return bones_; }
+  const std::vector<Knot>& knots() const { return knots_; }
+  // Bytes of the stored response vectors: what each frame reads.
+  std::size_t bytes() const { return columns_.size() * sizeof(double); }
+
+ private:
+  int num_vertices_ = 0;
+  std::vector<int> bones_;
+  std::vector<Knot> knots_;
+  std::vector<double> columns_;
+};
+
+}  // namespace deform

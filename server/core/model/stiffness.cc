@@ -1,0 +1,80 @@
+#include "core/model/stiffness.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace deform {
+namespace {
+
+Status CheckWeight(double w, const std::string& what) {
+  if (!std::isfinite(w) || w <= 0 || w > kMaxMaterialWeight) {
+    return Status::InvalidArgument(what + " must be finite and in (0, " +
+                                   std::to_string(kMaxMaterialWeight) + "], got " +
+                                   std::to_string(w));
+  }
+  return Status::Ok();
+}
+
+Status CheckMaterial(const JointMaterial& m, const std::string& where) {
+  DEFORM_RETURN_IF_ERROR(CheckWeight(m.rigid, where + " rigid weight"));
+  DEFORM_RETURN_IF_ERROR(CheckWeight(m.soft, where + " soft weight"));
+  DEFORM_RETURN_IF_ERROR(CheckWeight(m.seam, where + " seam weight"));
+  return Status::Ok();
+}
+
+StatusOr<int> RegionOfJoint(const JointRegions& regions, int joint) {
+  for (int r = 0; r < static_cast<int>(regions.regions.size()); ++r) {
+    if (regions.regions[r].joint == joint) return r;
+  }
+  return Status::InvalidArgument("joint " + std::to_string(joint) +
+                                 " has no joint region (only inner joints do)");
+}
+
+}  // namespace
+
+StatusOr<Eigen::VectorXd> MaterialRowWeights(const JointRegions& regions, int num_vertices,
+                                             const JointMaterial& default_material,
+                                             const Stiffness& stiffness) {
+  DEFORM_RETURN_IF_ERROR(CheckMaterial(default_material, "default material"));
+  std::vector<JointMaterial> materials(regions.regions.size(), default_material);
+  for (const auto& [joint, material] : stiffness.joint_materials) {
+    DEFORM_ASSIGN_OR_RETURN(const int r, RegionOfJoint(regions, joint));
+    DEFORM_RETURN_IF_ERROR(CheckMaterial(material, "joint " + std::to_string(joint)));
+    materials[r] = material;
+  }
+
+  Eigen::VectorXd w(num_vertices);
+  for (int i = 0; i < num_vertices; ++i) {
+    const int nearest = regions.nearest_region[i];
+    w[i] = nearest >= 0 ? materials[nearest].rigid : default_material.rigid;
+  }
+  std::vector<double> inside(num_vertices, 0.0);
+  for (int r = 0; r < static_cast<int>(regions.regions.size()); ++r) {
+    for (int i : regions.regions[r].vertices) inside[i] = std::max(inside[i], materials[r].soft);
+    for (int i : regions.regions[r].seam_vertices) {
+      inside[i] = std::max(inside[i], materials[r].seam);
+    }
+  }
+  for (int i = 0; i < num_vertices; ++i) {
+    if (inside[i] > 0) w[i] = inside[i];
+  }
+
+  for (const auto& [joint, weight] : stiffness.region_weights) {
+    DEFORM_ASSIGN_OR_RETURN(const int r, RegionOfJoint(regions, joint));
+    DEFORM_RETURN_IF_ERROR(CheckWeight(weight, "region weight of joint " + std::to_string(joint)));
+    for (int i : regions.regions[r].vertices) w[i] = weight;
+  }
+  for (const auto& [vertex, weight] : stiffness.vertex_weights) {
+    if (vertex < 0 || vertex >= num_vertices) {
+      return Status::InvalidArgument("stiffness for vertex " + std::to_string(vertex) +
+                                     " but the mesh has " + std::to_string(num_vertices) +
+                                     " vertices");
+    }
+    DEFORM_RETURN_IF_ERROR(CheckWeight(weight, "weight of vertex " + std::to_string(vertex)));
+    w[vertex] = weight;
+  }
+  return w;
+}
+
+}  // namespace deform

@@ -1,0 +1,11 @@
+// The triangular passes compiled with -mavx2 -mfma (see CMakeLists.txt); called only after the CPU
+// has been checked for both.
+#include "supernodal_solve_impl.h"
+
+namespace deform {
+
+void Solve3Avx2Fma(const SupernodalFactorView& factor, const double* b, double* x, double* work) {
+  Solve3Impl(factor, b, x, work);
+}
+
+}  // namespace deform

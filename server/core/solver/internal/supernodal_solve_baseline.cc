@@ -1,0 +1,10 @@
+// The triangular passes for any CPU the project builds for.
+#include "supernodal_solve_impl.h"
+
+namespace deform {
+
+void Solve3Baseline(const SupernodalFactorView& factor, const double* b, double* x, double* work) {
+  Solve3Impl(factor, b, x, work);
+}
+
+}  // namespace deform

@@ -1,0 +1,510 @@
+// The supernodal triangular passes, written once and compiled once per instruction set: included
+// by supernodal_solve_baseline.cc and supernodal_solve_avx2.cc (built with -mavx2 -mfma), each of
+// which exports Solve3Impl under its own name. Include it in exactly one place per variant.
+//
+// Everything here is in an anonymous namespace and no library header is included, so the variants
+// never meet at link time: an inline function with external linkage compiled with AVX2 could
+// otherwise become the copy the linker keeps for the whole program, and fault on an older CPU.
+//
+// A supernode's own unknowns are kept planar (all x, then y, then z) in a small buffer while its
+// block is applied, so every inner loop is a dot product or an axpy along a contiguous row of the
+// block. Rows go four at a time, so each load of the unknowns serves four rows and the sums run as
+// twelve independent chains; the loops over a row are written with four-wide vectors (one AVX
+// register, or two SSE2 registers on the baseline).
+#include <cstddef>
+#include <cstdint>
+
+#include "core/solver/supernodal_solve.h"
+
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"  // the vector helpers are internal and always inlined
+
+namespace deform {
+namespace {
+
+// A width fixed at compile time, for the dispatch of the narrow supernodes.
+template <int kWidth>
+struct Width {
+  static constexpr int value = kWidth;
+};
+
+#if defined(__AVX__)
+// Four doubles: one AVX register.
+typedef double Vec4 __attribute__((vector_size(32)));
+typedef double Vec4Unaligned __attribute__((vector_size(32), aligned(8), may_alias));
+
+inline Vec4 Load4(const double* p) { return *reinterpret_cast<const Vec4Unaligned*>(p); }
+inline void Store4(double* p, Vec4 v) { *reinterpret_cast<Vec4Unaligned*>(p) = v; }
+inline Vec4 MakeVec4(double a, double b, double c, double d) { return Vec4{a, b, c, d}; }
+inline double Lane(Vec4 v, int i) { return v[i]; }
+inline double Sum4(Vec4 v) { return (v[0] + v[2]) + (v[1] + v[3]); }
+
+// (sum of a, sum of b, sum of c, sum of d) in two rounds of shuffles and adds.
+inline Vec4 Sum4x4(Vec4 a, Vec4 b, Vec4 c, Vec4 d) {
+#if defined(__clang__)
+  const Vec4 ab =
+      __builtin_shufflevector(a, b, 0, 4, 2, 6) + __builtin_shufflevector(a, b, 1, 5, 3, 7);
+  const Vec4 cd =
+      __builtin_shufflevector(c, d, 0, 4, 2, 6) + __builtin_shufflevector(c, d, 1, 5, 3, 7);
+  return __builtin_shufflevector(ab, cd, 0, 1, 4, 5) + __builtin_shufflevector(ab, cd, 2, 3, 6, 7);
+#else
+  typedef long long Index4 __attribute__((vector_size(32)));
+  const Vec4 ab =
+      __builtin_shuffle(a, b, Index4{0, 4, 2, 6}) + __builtin_shuffle(a, b, Index4{1, 5, 3, 7});
+  const Vec4 cd =
+      __builtin_shuffle(c, d, Index4{0, 4, 2, 6}) + __builtin_shuffle(c, d, Index4{1, 5, 3, 7});
+  return __builtin_shuffle(ab, cd, Index4{0, 1, 4, 5}) +
+         __builtin_shuffle(ab, cd, Index4{2, 3, 6, 7});
+#endif
+}
+#else
+// Four doubles without AVX: two SSE2 registers (a 32-byte vector type would be emulated through
+// memory).
+typedef double Vec2 __attribute__((vector_size(16)));
+typedef double Vec2Unaligned __attribute__((vector_size(16), aligned(8), may_alias));
+
+struct Vec4 {
+  Vec2 lo, hi;
+};
+
+inline Vec4 operator+(Vec4 a, Vec4 b) { return Vec4{a.lo + b.lo, a.hi + b.hi}; }
+inline Vec4 operator-(Vec4 a, Vec4 b) { return Vec4{a.lo - b.lo, a.hi - b.hi}; }
+inline Vec4 operator*(Vec4 a, Vec4 b) { return Vec4{a.lo * b.lo, a.hi * b.hi}; }
+inline Vec4& operator+=(Vec4& a, Vec4 b) { return a = a + b; }
+inline Vec4& operator-=(Vec4& a, Vec4 b) { return a = a - b; }
+
+inline Vec4 Load4(const double* p) {
+  return Vec4{*reinterpret_cast<const Vec2Unaligned*>(p),
+              *reinterpret_cast<const Vec2Unaligned*>(p + 2)};
+}
+inline void Store4(double* p, Vec4 v) {
+  *reinterpret_cast<Vec2Unaligned*>(p) = v.lo;
+  *reinterpret_cast<Vec2Unaligned*>(p + 2) = v.hi;
+}
+inline Vec4 MakeVec4(double a, double b, double c, double d) {
+  return Vec4{Vec2{a, b}, Vec2{c, d}};
+}
+inline double Lane(Vec4 v, int i) { return i < 2 ? v.lo[i] : v.hi[i - 2]; }
+inline double Sum4(Vec4 v) {
+  const Vec2 s = v.lo + v.hi;
+  return s[0] + s[1];
+}
+inline Vec4 Sum4x4(Vec4 a, Vec4 b, Vec4 c, Vec4 d) {
+  return MakeVec4(Sum4(a), Sum4(b), Sum4(c), Sum4(d));
+}
+#endif
+
+inline Vec4 Splat4(double v) { return MakeVec4(v, v, v, v); }
+
+// The three planar columns of a supernode's unknowns (or right-hand side), `width` long each.
+struct Planar {
+  double* x;
+  double* y;
+  double* z;
+};
+
+inline int RoundUp4(int n) { return (n + 3) & ~3; }
+
+// Each column is padded to a multiple of four, so the loops over a whole row need no scalar tail:
+// the padding is zero while it multiplies rows (ZeroPadding), and a row read past its end reads
+// the next row or the zeros that follow the factor's values, times zero.
+inline Planar PlanarOf(double* buffer, int width) {
+  const int stride = RoundUp4(width);
+  return Planar{buffer, buffer + stride, buffer + 2 * stride};
+}
+
+inline void ZeroPadding(const Planar& p, int width) {
+  for (int k = width; k < RoundUp4(width); ++k) p.x[k] = p.y[k] = p.z[k] = 0;
+}
+
+// sums[4 j + c] = sum over k < n of row_j[k] * p.c[k], for the four rows j and the columns c
+// (sums[4 j + 3] = 0: the layout of four solution rows). `n` is a multiple of four: the callers
+// pass a tile's start column or a padded width.
+inline void Dot4x3(const double* __restrict r0, const double* __restrict r1,
+                   const double* __restrict r2, const double* __restrict r3, const Planar& p, int n,
+                   double* __restrict sums) {
+  const double* __restrict px = p.x;
+  const double* __restrict py = p.y;
+  const double* __restrict pz = p.z;
+  Vec4 a0 = Splat4(0), a1 = a0, a2 = a0, b0 = a0, b1 = a0, b2 = a0;
+  Vec4 c0 = a0, c1 = a0, c2 = a0, d0 = a0, d1 = a0, d2 = a0;
+  for (int k = 0; k < n; k += 4) {
+    const Vec4 x = Load4(px + k), y = Load4(py + k), z = Load4(pz + k);
+    Vec4 r = Load4(r0 + k);
+    a0 += r * x;
+    a1 += r * y;
+    a2 += r * z;
+    r = Load4(r1 + k);
+    b0 += r * x;
+    b1 += r * y;
+    b2 += r * z;
+    r = Load4(r2 + k);
+    c0 += r * x;
+    c1 += r * y;
+    c2 += r * z;
+    r = Load4(r3 + k);
+    d0 += r * x;
+    d1 += r * y;
+    d2 += r * z;
+  }
+  const Vec4 zero = Splat4(0);
+  Store4(sums, Sum4x4(a0, a1, a2, zero));
+  Store4(sums + 4, Sum4x4(b0, b1, b2, zero));
+  Store4(sums + 8, Sum4x4(c0, c1, c2, zero));
+  Store4(sums + 12, Sum4x4(d0, d1, d2, zero));
+}
+
+// sums[c] = sum over k < n of row[k] * p.c[k].
+inline void Dot1x3(const double* __restrict row, const Planar& p, int n, double* __restrict sums) {
+  Vec4 a0 = Splat4(0), a1 = a0, a2 = a0;
+  int k = 0;
+  for (; k + 4 <= n; k += 4) {
+    const Vec4 r = Load4(row + k);
+    a0 += r * Load4(p.x + k);
+    a1 += r * Load4(p.y + k);
+    a2 += r * Load4(p.z + k);
+  }
+  double s0 = Sum4(a0), s1 = Sum4(a1), s2 = Sum4(a2);
+  for (; k < n; ++k) {
+    s0 += row[k] * p.x[k];
+    s1 += row[k] * p.y[k];
+    s2 += row[k] * p.z[k];
+  }
+  sums[0] = s0;
+  sums[1] = s1;
+  sums[2] = s2;
+}
+
+// p.c[k] -= sum over the four rows j of row_j[k] * coefficients[3 j + c], for k < n.
+inline void SubtractRows4x3(const double* __restrict r0, const double* __restrict r1,
+                            const double* __restrict r2, const double* __restrict r3,
+                            const double* __restrict coefficients, const Planar& p, int n) {
+  double* __restrict px = p.x;
+  double* __restrict py = p.y;
+  double* __restrict pz = p.z;
+  const double* q = coefficients;
+  int k = 0;
+  {
+    const Vec4 a0 = Splat4(q[0]), a1 = Splat4(q[1]), a2 = Splat4(q[2]);
+    const Vec4 b0 = Splat4(q[3]), b1 = Splat4(q[4]), b2 = Splat4(q[5]);
+    const Vec4 c0 = Splat4(q[6]), c1 = Splat4(q[7]), c2 = Splat4(q[8]);
+    const Vec4 d0 = Splat4(q[9]), d1 = Splat4(q[10]), d2 = Splat4(q[11]);
+    for (; k + 4 <= n; k += 4) {
+      const Vec4 w0 = Load4(r0 + k), w1 = Load4(r1 + k), w2 = Load4(r2 + k), w3 = Load4(r3 + k);
+      Store4(px + k, Load4(px + k) - (w0 * a0 + w1 * b0 + w2 * c0 + w3 * d0));
+      Store4(py + k, Load4(py + k) - (w0 * a1 + w1 * b1 + w2 * c1 + w3 * d1));
+      Store4(pz + k, Load4(pz + k) - (w0 * a2 + w1 * b2 + w2 * c2 + w3 * d2));
+    }
+  }
+  for (; k < n; ++k) {
+    px[k] -= r0[k] * q[0] + r1[k] * q[3] + r2[k] * q[6] + r3[k] * q[9];
+    py[k] -= r0[k] * q[1] + r1[k] * q[4] + r2[k] * q[7] + r3[k] * q[10];
+    pz[k] -= r0[k] * q[2] + r1[k] * q[5] + r2[k] * q[8] + r3[k] * q[11];
+  }
+}
+
+// p.c[k] -= row[k] * coefficients[c], for k < n.
+inline void SubtractRow1x3(const double* __restrict row, const double* __restrict coefficients,
+                           const Planar& p, int n) {
+  const double q0 = coefficients[0], q1 = coefficients[1], q2 = coefficients[2];
+  int k = 0;
+  {
+    const Vec4 a0 = Splat4(q0), a1 = Splat4(q1), a2 = Splat4(q2);
+    for (; k + 4 <= n; k += 4) {
+      const Vec4 w = Load4(row + k);
+      Store4(p.x + k, Load4(p.x + k) - w * a0);
+      Store4(p.y + k, Load4(p.y + k) - w * a1);
+      Store4(p.z + k, Load4(p.z + k) - w * a2);
+    }
+  }
+  for (; k < n; ++k) {
+    p.x[k] -= row[k] * q0;
+    p.y[k] -= row[k] * q1;
+    p.z[k] -= row[k] * q2;
+  }
+}
+
+// The solution during the solve: one row of four doubles per unknown (x, y, z and a zero), so a
+// row is one aligned four-wide load or store wherever the narrow supernodes scatter or gather.
+constexpr int kRowStride = 4;
+
+inline double* Row(double* y, int row) { return y + kRowStride * static_cast<std::ptrdiff_t>(row); }
+inline const double* Row(const double* y, int row) {
+  return y + kRowStride * static_cast<std::ptrdiff_t>(row);
+}
+
+// Forward substitution with a supernode's dense lower-triangular diagonal block (row-major,
+// `width` square): solves for its unknowns, whose right-hand sides are the solution rows from
+// `ys` on, writing them back there and planar into `p`.
+inline void ForwardDiagonal(const double* __restrict block, int width, double* __restrict ys,
+                            const Planar& p) {
+  int c = 0;
+  for (; c + 4 <= width; c += 4) {
+    const double* r0 = block + static_cast<std::ptrdiff_t>(c) * width;
+    const double* r1 = r0 + width;
+    const double* r2 = r1 + width;
+    const double* r3 = r2 + width;
+    double s[16];
+    Dot4x3(r0, r1, r2, r3, p, c, s);
+    const double* t = Row(ys, c);
+    for (int i = 0; i < 16; ++i) s[i] = t[i] - s[i];
+    // The 4 by 4 triangle at the tile's corner, one column (x, y, z) at a time.
+    double* out[3] = {p.x + c, p.y + c, p.z + c};
+    for (int d = 0; d < 3; ++d) {
+      const double u0 = s[d] / r0[c];
+      const double u1 = (s[4 + d] - r1[c] * u0) / r1[c + 1];
+      const double u2 = (s[8 + d] - r2[c] * u0 - r2[c + 1] * u1) / r2[c + 2];
+      const double u3 = (s[12 + d] - r3[c] * u0 - r3[c + 1] * u1 - r3[c + 2] * u2) / r3[c + 3];
+      out[d][0] = u0;
+      out[d][1] = u1;
+      out[d][2] = u2;
+      out[d][3] = u3;
+    }
+  }
+  for (; c < width; ++c) {
+    const double* row = block + static_cast<std::ptrdiff_t>(c) * width;
+    double s[3];
+    Dot1x3(row, p, c, s);
+    const double* t = Row(ys, c);
+    p.x[c] = (t[0] - s[0]) / row[c];
+    p.y[c] = (t[1] - s[1]) / row[c];
+    p.z[c] = (t[2] - s[2]) / row[c];
+  }
+  for (int k = 0; k < width; ++k) {
+    double* t = Row(ys, k);
+    t[0] = p.x[k];
+    t[1] = p.y[k];
+    t[2] = p.z[k];
+  }
+}
+
+// Back substitution with the transpose of the diagonal block: `p` holds the right-hand side on
+// entry (and is consumed); the solution goes to the solution rows from `ys` on. Rows of the block
+// are taken four at a time from the bottom: their corner triangle is solved, then they update the
+// rows above together.
+inline void BackwardDiagonal(const double* __restrict block, int width, double* __restrict ys,
+                             const Planar& p) {
+  int c = width;  // rows [0, c) are still to solve
+  for (; c >= 4; c -= 4) {
+    const int f = c - 4;
+    const double* r0 = block + static_cast<std::ptrdiff_t>(f) * width;
+    const double* r1 = r0 + width;
+    const double* r2 = r1 + width;
+    const double* r3 = r2 + width;
+    double* in[3] = {p.x + f, p.y + f, p.z + f};
+    double solved[12];  // solved[3 j + d]: unknown f + j, column d
+    for (int d = 0; d < 3; ++d) {
+      const double* v = in[d];
+      const double u3 = v[3] / r3[f + 3];
+      const double u2 = (v[2] - r3[f + 2] * u3) / r2[f + 2];
+      const double u1 = (v[1] - r3[f + 1] * u3 - r2[f + 1] * u2) / r1[f + 1];
+      const double u0 = (v[0] - r3[f] * u3 - r2[f] * u2 - r1[f] * u1) / r0[f];
+      solved[d] = u0;
+      solved[3 + d] = u1;
+      solved[6 + d] = u2;
+      solved[9 + d] = u3;
+    }
+    for (int j = 0; j < 4; ++j) {
+      double* t = Row(ys, f + j);
+      t[0] = solved[3 * j];
+      t[1] = solved[3 * j + 1];
+      t[2] = solved[3 * j + 2];
+    }
+    SubtractRows4x3(r0, r1, r2, r3, solved, p, f);
+  }
+  for (; c > 0; --c) {
+    const int f = c - 1;
+    const double* row = block + static_cast<std::ptrdiff_t>(f) * width;
+    const double solved[3] = {p.x[f] / row[f], p.y[f] / row[f], p.z[f] / row[f]};
+    double* t = Row(ys, f);
+    t[0] = solved[0];
+    t[1] = solved[1];
+    t[2] = solved[2];
+    SubtractRow1x3(row, solved, p, f);
+  }
+}
+
+// y[rows[r]] -= (block row r) . p for the rows below the diagonal block (r >= width).
+inline void ForwardUpdate(const double* __restrict block, const int* __restrict rows, int width,
+                          std::int64_t num_rows, const Planar& p, double* __restrict y) {
+  ZeroPadding(p, width);
+  const int padded = RoundUp4(width);
+  std::int64_t r = width;
+  for (; r + 4 <= num_rows; r += 4) {
+    const double* r0 = block + r * width;
+    double s[16];
+    Dot4x3(r0, r0 + width, r0 + 2 * width, r0 + 3 * width, p, padded, s);
+    for (int j = 0; j < 4; ++j) {
+      double* t = Row(y, rows[r + j]);
+      Store4(t, Load4(t) - Load4(s + 4 * j));
+    }
+  }
+  for (; r < num_rows; ++r) {
+    double s[3];
+    Dot1x3(block + r * width, p, padded, s);
+    double* t = Row(y, rows[r]);
+    t[0] -= s[0];
+    t[1] -= s[1];
+    t[2] -= s[2];
+  }
+}
+
+// p -= sum over the rows below the diagonal block of (block row r) * y[rows[r]].
+inline void BackwardUpdate(const double* __restrict block, const int* __restrict rows, int width,
+                           std::int64_t num_rows, const Planar& p, double* __restrict y) {
+  ZeroPadding(p, width);  // not read back, but kept finite
+  const int padded = RoundUp4(width);
+  std::int64_t r = width;
+  for (; r + 4 <= num_rows; r += 4) {
+    const double* r0 = block + r * width;
+    double q[12];
+    for (int j = 0; j < 4; ++j) {
+      const double* source = Row(y, rows[r + j]);
+      q[3 * j] = source[0];
+      q[3 * j + 1] = source[1];
+      q[3 * j + 2] = source[2];
+    }
+    SubtractRows4x3(r0, r0 + width, r0 + 2 * width, r0 + 3 * width, q, p, padded);
+  }
+  for (; r < num_rows; ++r) {
+    SubtractRow1x3(block + r * width, Row(y, rows[r]), p, padded);
+  }
+}
+
+// The narrow supernodes (most of them, holding few of the values) with the width fixed at
+// compile time: each block row updates or reads one whole solution row.
+template <int kWidth>
+inline void ForwardUpdateNarrow(const double* __restrict block, const int* __restrict rows,
+                                std::int64_t num_rows, const Planar& p, double* __restrict y) {
+  Vec4 unknowns[kWidth];
+  for (int k = 0; k < kWidth; ++k) unknowns[k] = MakeVec4(p.x[k], p.y[k], p.z[k], 0);
+  for (std::int64_t r = kWidth; r < num_rows; ++r) {
+    const double* row = block + r * kWidth;
+    double* t = Row(y, rows[r]);
+    Vec4 v = Load4(t);
+    for (int k = 0; k < kWidth; ++k) v -= Splat4(row[k]) * unknowns[k];
+    Store4(t, v);
+  }
+}
+
+// Two rows at a time into separate sums, so consecutive rows do not wait on each other's adds.
+template <int kWidth>
+inline void BackwardUpdateNarrow(const double* __restrict block, const int* __restrict rows,
+                                 std::int64_t num_rows, const Planar& p,
+                                 const double* __restrict y) {
+  Vec4 even[kWidth], odd[kWidth];
+  for (int k = 0; k < kWidth; ++k) even[k] = odd[k] = Splat4(0);
+  std::int64_t r = kWidth;
+  for (; r + 2 <= num_rows; r += 2) {
+    const double* row0 = block + r * kWidth;
+    const double* row1 = row0 + kWidth;
+    const Vec4 z0 = Load4(Row(y, rows[r]));
+    const Vec4 z1 = Load4(Row(y, rows[r + 1]));
+    for (int k = 0; k < kWidth; ++k) {
+      even[k] += Splat4(row0[k]) * z0;
+      odd[k] += Splat4(row1[k]) * z1;
+    }
+  }
+  if (r < num_rows) {
+    const double* row = block + r * kWidth;
+    const Vec4 z = Load4(Row(y, rows[r]));
+    for (int k = 0; k < kWidth; ++k) even[k] += Splat4(row[k]) * z;
+  }
+  for (int k = 0; k < kWidth; ++k) {
+    const Vec4 sum = even[k] + odd[k];
+    p.x[k] -= Lane(sum, 0);
+    p.y[k] -= Lane(sum, 1);
+    p.z[k] -= Lane(sum, 2);
+  }
+}
+
+template <typename Kernel>
+inline void DispatchNarrow(int width, Kernel&& kernel) {
+  switch (width) {
+    case 1:
+      kernel(Width<1>());
+      break;
+    case 2:
+      kernel(Width<2>());
+      break;
+    case 3:
+      kernel(Width<3>());
+      break;
+    default:
+      kernel(Width<4>());
+      break;
+  }
+}
+
+void Solve3Impl(const SupernodalFactorView& f, const double* b, double* x, double* work) {
+  const int n = f.size;
+  // The solution rows start at the first 32-byte boundary of `work`.
+  const std::uintptr_t misalignment = reinterpret_cast<std::uintptr_t>(work) % 32;
+  double* __restrict y = work + (misalignment ? (32 - misalignment) / sizeof(double) : 0);
+  double* const planar_buffer = y + kRowStride * static_cast<std::ptrdiff_t>(n);
+
+  for (int i = 0; i < n; ++i) {
+    const double* source = b + 3 * static_cast<std::ptrdiff_t>(f.permutation[i]);
+    double* t = Row(y, i);
+    t[0] = source[0];
+    t[1] = source[1];
+    t[2] = source[2];
+    t[3] = 0;
+  }
+
+  // L y = P b, one pass over the factor.
+  for (int sn = 0; sn < f.num_supernodes; ++sn) {
+    const int first = f.supernode_columns[sn];
+    const int width = f.supernode_columns[sn + 1] - first;
+    const int* rows = f.row_indices + f.row_pointers[sn];
+    const std::int64_t num_rows = f.row_pointers[sn + 1] - f.row_pointers[sn];
+    const double* block = f.values + f.value_pointers[sn];
+    const Planar p = PlanarOf(planar_buffer, width);
+    ForwardDiagonal(block, width, Row(y, first), p);
+    if (width > 4) {
+      ForwardUpdate(block, rows, width, num_rows, p, y);
+    } else {
+      DispatchNarrow(width, [&](auto w) {
+        ForwardUpdateNarrow<decltype(w)::value>(block, rows, num_rows, p, y);
+      });
+    }
+  }
+
+  // L^T z = y, one pass over the factor backwards.
+  for (int sn = f.num_supernodes - 1; sn >= 0; --sn) {
+    const int first = f.supernode_columns[sn];
+    const int width = f.supernode_columns[sn + 1] - first;
+    const int* rows = f.row_indices + f.row_pointers[sn];
+    const std::int64_t num_rows = f.row_pointers[sn + 1] - f.row_pointers[sn];
+    const double* block = f.values + f.value_pointers[sn];
+    const Planar p = PlanarOf(planar_buffer, width);
+    double* ys = Row(y, first);
+    for (int k = 0; k < width; ++k) {
+      const double* t = Row(ys, k);
+      p.x[k] = t[0];
+      p.y[k] = t[1];
+      p.z[k] = t[2];
+    }
+    if (width > 4) {
+      BackwardUpdate(block, rows, width, num_rows, p, y);
+    } else {
+      DispatchNarrow(width, [&](auto w) {
+        BackwardUpdateNarrow<decltype(w)::value>(block, rows, num_rows, p, y);
+      });
+    }
+    BackwardDiagonal(block, width, ys, p);
+  }
+
+  for (int i = 0; i < n; ++i) {
+    double* target = x + 3 * static_cast<std::ptrdiff_t>(f.permutation[i]);
+    const double* t = Row(y, i);
+    target[0] = t[0];
+    target[1] = t[1];
+    target[2] = t[2];
+  }
+}
+
+}  // namespace
+}  // namespace deform
+
+#pragma GCC diagnostic pop

@@ -1,0 +1,54 @@
+// The two triangular passes of CholeskyFactor::Solve3, behind a plain view of the factor so they
+// can be compiled once per instruction set (supernodal_solve_impl.h) and picked at run time.
+// Internal to the core: CholeskyFactor is the interface; tests use this header to check that every
+// compiled variant gives the same answer.
+#pragma once
+
+#include <cstdint>
+
+namespace deform {
+
+// The supernodal factor as CholeskyFactor stores it (see sparse_cholesky.h): supernode s holds
+// columns [supernode_columns[s], supernode_columns[s + 1]); its rows are
+// row_indices[row_pointers[s] .. row_pointers[s + 1]) (its own columns first, then the rows below,
+// ascending), and its values a dense row-major (#rows) x (width) block at
+// values[value_pointers[s]], zero above the diagonal, and `values` is followed by at least
+// kSolveValuePadding readable zeros. permutation[new] = old.
+inline constexpr int kSolveValuePadding = 3;
+
+struct SupernodalFactorView {
+  int size = 0;
+  int num_supernodes = 0;
+  const int* supernode_columns = nullptr;
+  const int* permutation = nullptr;
+  const std::int64_t* row_pointers = nullptr;
+  const std::int64_t* value_pointers = nullptr;
+  const int* row_indices = nullptr;
+  const double* values = nullptr;
+};
+
+// Solves P^T L L^T P x = b for three right-hand sides stored interleaved (b[3 i + c]). `x` may
+// equal `b`; `work` holds SolveWorkSize() doubles. Reads the factor once per pass and allocates
+// nothing. Doubles of `work` a solve needs: a four-double row per unknown, three padded columns for
+// the widest supernode, and slack to align the rows to 32 bytes.
+inline std::int64_t SolveWorkSize(int size, int widest_supernode) {
+  return 4 * static_cast<std::int64_t>(size) + 3 * ((widest_supernode + 3) & ~3) + 4;
+}
+
+using Solve3Function = void (*)(const SupernodalFactorView& factor, const double* b, double* x,
+                                double* work);
+
+enum class SolveKernel {
+  kBaseline,  // any CPU the project builds for
+  kAvx2Fma,   // x86-64 with AVX2 and FMA (checked at run time)
+};
+
+const char* SolveKernelName(SolveKernel kernel);
+// Whether this build has the kernel and this CPU can run it.
+bool SolveKernelAvailable(SolveKernel kernel);
+// The fastest available kernel, chosen once per process.
+SolveKernel BestSolveKernel();
+// The kernel's function; it must be available.
+Solve3Function Solve3For(SolveKernel kernel);
+
+}  // namespace deform

@@ -1,0 +1,238 @@
+#include "core/model/deformation_model.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <thread>
+
+#include "core/io/mesh_io.h"
+#include "core/io/phantom.h"
+#include "tests/allocation_counter.h"
+#include "tests/core/model/model_test_util.h"
+#include "tests/core/model/shared_leg_model.h"
+#include "tests/shared_data.h"
+
+namespace deform {
+namespace {
+
+using test_support::BuildPhantomModel;
+using test_support::MaxDistance;
+using test_support::PoseFromSpec;
+
+Positions DeformOnce(const DeformationModel& model, const Pose& pose,
+                     const MaterialFactorization* factorization = nullptr) {
+  DeformScratch scratch = model.MakeScratch();
+  model.Deform(factorization ? *factorization : *model.default_factorization(), pose, &scratch);
+  return scratch.positions();
+}
+
+TEST(DeformationModel, RestPoseReproducesThePhantom) {
+  auto model = BuildPhantomModel();
+  const Positions posed = DeformOnce(*model, Pose::Rest(model->skeleton()));
+  EXPECT_LT(MaxDistance(posed, model->mesh().vertices), 1e-9 * model->bounding_box_diagonal());
+}
+
+TEST(DeformationModel, RestPoseReproducesTheSharedLeg) {
+  DEFORM_SHARED_LEG_MODEL(model);
+  EXPECT_EQ(model->num_joint_nodes(), 3);  // knee, ankle, ball
+  const Positions posed = DeformOnce(*model, Pose::Rest(model->skeleton()));
+  EXPECT_LT(MaxDistance(posed, model->mesh().vertices), 1e-5 * model->bounding_box_diagonal());
+}
+
+TEST(DeformationModel, RigidMotionOfTheSkeletonMovesTheMeshRigidly) {
+  auto model = BuildPhantomModel();
+  Pose pose = Pose::Rest(model->skeleton());
+  pose.root.rotation =
+      Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()));
+  pose.root.translation = Eigen::Vector3d(0.5, -2, 3);
+  const Positions posed = DeformOnce(*model, pose);
+  Positions expected(model->mesh().num_vertices(), 3);
+  for (int i = 0; i < expected.rows(); ++i) {
+    expected.row(i) = pose.root.Apply(model->mesh().vertices.row(i).transpose()).transpose();
+  }
+  EXPECT_LT(MaxDistance(posed, expected), 1e-9 * model->bounding_box_diagonal());
+}
+
+TEST(DeformationModel, FarFromTheKneeTheSkinFollowsItsBone) {
+  auto model = BuildPhantomModel();
+  const Pose pose = PoseFromSpec(model->skeleton(), "knee:flexion:90");
+  const Positions posed = DeformOnce(*model, pose);
+  std::vector<RigidTransform> bones;
+  ForwardKinematics(model->skeleton(), pose, &bones);
+  double worst = 0;
+  for (size_t a = 0; a < model->anchor_vertices().size(); ++a) {
+    const int i = model->anchor_vertices()[a];
+    const Eigen::Vector3d target =
+        bones[model->anchor_bones()[a]].Apply(model->mesh().vertices.row(i).transpose());
+    worst = std::max(worst, (posed.row(i).transpose() - target).norm());
+  }
+  EXPECT_LT(worst, 1e-3 * model->bounding_box_diagonal());
+}
+
+TEST(DeformationModel, SparseSolveMatchesADenseSolve) {
+  auto model = BuildPhantomModel(300);
+  const auto& factorization = *model->default_factorization();
+  const Pose pose = PoseFromSpec(model->skeleton(), "knee:flexion:70,knee:rotation:10");
+  DeformScratch scratch = model->MakeScratch();
+  model->AssembleRightHandSide(factorization, pose, &scratch);
+  const Eigen::MatrixXd rhs = scratch.solution;
+  model->SolveInPlace(factorization, &scratch);
+
+  const Eigen::MatrixXd dense = Eigen::MatrixXd(model->NormalMatrix(factorization));
+  ASSERT_LT((dense - dense.transpose()).norm(), 1e-9 * dense.norm());
+  const Eigen::MatrixXd expected = dense.llt().solve(rhs);
+  EXPECT_LT((Eigen::MatrixXd(scratch.solution) - expected).norm(), 1e-9 * expected.norm());
+}
+
+TEST(DeformationModel, RefactorisationAfterAStiffnessChangeEqualsAFreshFactorisation) {
+  const JointMaterial stiff{9.0, 2.5, 6.0};
+  auto model = BuildPhantomModel();
+  Stiffness stiffness;
+  stiffness.joint_materials.push_back({1, stiff});  // the knee
+  auto refactored = model->Factorize(stiffness);
+  ASSERT_TRUE(refactored.ok()) << refactored.status().ToString();
+
+  ModelOptions options = ModelOptions::Paper();
+  options.default_material = stiff;
+  auto fresh = BuildPhantomModel(2000, options);
+
+  const Pose pose = PoseFromSpec(model->skeleton(), "knee:flexion:100");
+  const Positions a = DeformOnce(*model, pose, refactored->get());
+  const Positions b = DeformOnce(*fresh, pose);
+  EXPECT_LT(MaxDistance(a, b), 1e-10 * model->bounding_box_diagonal());
+  // And the stiffness matters: the default factorisation gives another shape.
+  EXPECT_GT(MaxDistance(a, DeformOnce(*model, pose)), 1e-6 * model->bounding_box_diagonal());
+}
+
+TEST(DeformationModel, AFrameAllocatesNothing) {
+  auto model = BuildPhantomModel();
+  const Pose pose = PoseFromSpec(model->skeleton(), "knee:flexion:45");
+  DeformScratch scratch = model->MakeScratch();
+  DeformTimings timings;
+  model->Deform(*model->default_factorization(), pose, &scratch, &timings);  // warm
+  const long before = test_support::AllocationCount();
+  for (int frame = 0; frame < 10; ++frame) {
+    model->Deform(*model->default_factorization(), pose, &scratch, &timings);
+  }
+  EXPECT_EQ(test_support::AllocationCount() - before, 0);
+}
+
+TEST(DeformationModel, ThreadsShareOneModelAndFactorisation) {
+  auto model = BuildPhantomModel();
+  const Pose pose = PoseFromSpec(model->skeleton(), "knee:flexion:60");
+  const Positions expected = DeformOnce(*model, pose);
+  std::vector<Positions> results(4);
+  std::vector<std::thread> threads;
+  for (auto& result : results) {
+    threads.emplace_back([&] {
+      DeformScratch scratch = model->MakeScratch();
+      for (int frame = 0; frame < 20; ++frame) {
+        model->Deform(*model->default_factorization(), pose, &scratch);
+      }
+      result = scratch.positions();
+    });
+  }
+  for (auto& t : threads) t.join();
+  for (const auto& result : results) EXPECT_EQ(result, expected);
+}
+
+TEST(DeformationModel, RefusesAComponentThatCannotBeAnchored) {
+  // A small tetrahedron floating at the knee centre lies wholly inside the knee's joint region:
+  // no vertex of it is in a bone's rigid zone.
+  auto phantom = MakeKneePhantom(600);
+  TriangleMesh mesh = phantom->mesh;
+  const int n = mesh.num_vertices();
+  const Eigen::Vector3d knee = phantom->skeleton.joint(1).rest_position;
+  mesh.vertices.conservativeResize(n + 4, 3);
+  mesh.vertices.row(n) = (knee + Eigen::Vector3d(0.05, 0, 0)).transpose();
+  mesh.vertices.row(n + 1) = (knee + Eigen::Vector3d(0, 0.05, 0)).transpose();
+  mesh.vertices.row(n + 2) = (knee + Eigen::Vector3d(0, 0, 0.05)).transpose();
+  mesh.vertices.row(n + 3) = knee.transpose();
+  const int f = mesh.num_triangles();
+  mesh.triangles.conservativeResize(f + 4, 3);
+  mesh.triangles.row(f) << n, n + 1, n + 2;
+  mesh.triangles.row(f + 1) << n, n + 3, n + 1;
+  mesh.triangles.row(f + 2) << n + 1, n + 3, n + 2;
+  mesh.triangles.row(f + 3) << n + 2, n + 3, n;
+  auto model = DeformationModel::Build(mesh, phantom->skeleton, ModelOptions::Paper());
+  ASSERT_FALSE(model.ok());
+  EXPECT_EQ(model.status().code(), StatusCode::kInvalidArgument);
+  EXPECT_NE(model.status().message().find("component"), std::string::npos)
+      << model.status().message();
+}
+
+TEST(DeformationModel, RefusesBadMeshesAndOptions) {
+  auto phantom = MakeKneePhantom(600);
+  TriangleMesh nan_mesh = phantom->mesh;
+  nan_mesh.vertices(5, 1) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(DeformationModel::Build(nan_mesh, phantom->skeleton, {}).status().code(),
+            StatusCode::kInvalidArgument);
+
+  ModelOptions limited;
+  limited.limits.max_vertices = 100;
+  EXPECT_EQ(DeformationModel::Build(phantom->mesh, phantom->skeleton, limited).status().code(),
+            StatusCode::kResourceExhausted);
+
+  ModelOptions bad_radius;
+  bad_radius.regions.explicit_radius = {{1, -2.0}};
+  EXPECT_EQ(DeformationModel::Build(phantom->mesh, phantom->skeleton, bad_radius).status().code(),
+            StatusCode::kInvalidArgument);
+  bad_radius.regions.explicit_radius = {{0, 1.0}};  // the hip is a root: it has no region
+  EXPECT_EQ(DeformationModel::Build(phantom->mesh, phantom->skeleton, bad_radius).status().code(),
+            StatusCode::kInvalidArgument);
+}
+
+TEST(DeformationModel, RefusesBadStiffness) {
+  auto model = BuildPhantomModel(600);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::vector<Stiffness> bad(5);
+  bad[0].joint_materials = {{1, {nan, 1, 1}}};
+  bad[1].joint_materials = {{0, {1, 1, 1}}};  // the hip has no region
+  bad[2].vertex_weights = {{1 << 20, 1.0}};   // no such vertex
+  bad[3].vertex_weights = {{3, -1.0}};        // negative
+  bad[4].region_weights = {{1, 1e9}};         // absurdly stiff
+  for (const Stiffness& s : bad) {
+    auto f = model->Factorize(s);
+    ASSERT_FALSE(f.ok());
+    EXPECT_EQ(f.status().code(), StatusCode::kInvalidArgument) << f.status().ToString();
+  }
+  Stiffness good;
+  good.vertex_weights = {{3, 20.0}};
+  good.region_weights = {{1, 0.5}};
+  EXPECT_TRUE(model->Factorize(good).ok());
+}
+
+TEST(DeformationModel, ReportsThePrecomputationBeforeFactorising) {
+  auto phantom = MakeKneePhantom(600);
+  int calls = 0;
+  auto model = DeformationModel::Build(phantom->mesh, phantom->skeleton, ModelOptions::Paper(),
+                                       [&] { ++calls; });
+  ASSERT_TRUE(model.ok());
+  EXPECT_EQ(calls, 1);
+  auto refused = DeformationModel::Build(
+      phantom->mesh, phantom->skeleton,
+      [] {
+        ModelOptions o;
+        o.limits.max_vertices = 10;
+        return o;
+      }(),
+      [&] { ++calls; });
+  EXPECT_FALSE(refused.ok());
+  EXPECT_EQ(calls, 1);  // not reached for input refused by validation
+}
+
+TEST(DeformationModel, ExplicitRegionRadiusIsUsed) {
+  ModelOptions options = ModelOptions::Paper();
+  options.regions.explicit_radius = {{1, 0.3}};
+  auto small = BuildPhantomModel(2000, options);
+  auto automatic = BuildPhantomModel(2000);
+  ASSERT_EQ(small->joint_regions().regions.size(), 1u);
+  EXPECT_DOUBLE_EQ(small->joint_regions().regions[0].radius, 0.3);
+  EXPECT_LT(small->joint_regions().regions[0].vertices.size(),
+            automatic->joint_regions().regions[0].vertices.size());
+  // The automatic radius is 1.5 limb radii; the phantom's knee is about 0.5 dm thick.
+  EXPECT_NEAR(automatic->joint_regions().regions[0].limb_radius, 0.55, 0.1);
+}
+
+}  // namespace
+}  // namespace deform

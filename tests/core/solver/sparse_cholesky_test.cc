@@ -1,0 +1,211 @@
+#include "core/solver/sparse_cholesky.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <random>
+#include <string>
+
+namespace deform {
+namespace {
+
+using ColMajorMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
+
+// A random sparse symmetric positive definite matrix: a graph Laplacian plus a positive diagonal.
+ColMajorMatrix RandomSpdMatrix(int n, int edges_per_row, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<int> pick(0, n - 1);
+  std::uniform_real_distribution<double> weight(0.1, 2.0);
+  std::vector<Eigen::Triplet<double>> triplets;
+  Eigen::VectorXd diagonal = Eigen::VectorXd::Constant(n, 0.5);
+  for (int i = 0; i < n; ++i) {
+    for (int e = 0; e < edges_per_row; ++e) {
+      const int j = pick(rng);
+      if (j == i) continue;
+      const double w = weight(rng);
+      triplets.emplace_back(i, j, -w);
+      triplets.emplace_back(j, i, -w);
+      diagonal[i] += w;
+      diagonal[j] += w;
+    }
+  }
+  for (int i = 0; i < n; ++i) triplets.emplace_back(i, i, diagonal[i]);
+  ColMajorMatrix a(n, n);
+  a.setFromTriplets(triplets.begin(), triplets.end());
+  a.makeCompressed();
+  return a;
+}
+
+Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> RandomRightHandSides(int n,
+                                                                               unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> normal;
+  Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> b(n, 3);
+  for (int i = 0; i < b.size(); ++i) b.data()[i] = normal(rng);
+  return b;
+}
+
+class SparseCholeskyTest : public ::testing::TestWithParam<Ordering> {};
+
+TEST_P(SparseCholeskyTest, SolveMatchesDenseCholesky) {
+  const int n = 300;
+  const ColMajorMatrix a = RandomSpdMatrix(n, 3, 7);
+  auto symbolic = SymbolicCholesky::Analyze(a, GetParam());
+  ASSERT_TRUE(symbolic.ok()) << symbolic.status().ToString();
+  auto factor = CholeskyFactor::Factorize(*symbolic, a);
+  ASSERT_TRUE(factor.ok()) << factor.status().ToString();
+
+  const auto b = RandomRightHandSides(n, 11);
+  Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> x(n, 3);
+  std::vector<double> work(factor->WorkSize());
+  factor->Solve3(b.data(), x.data(), work.data());
+
+  const Eigen::MatrixXd dense = Eigen::MatrixXd(a);
+  const Eigen::MatrixXd expected = dense.llt().solve(Eigen::MatrixXd(b));
+  EXPECT_LT((Eigen::MatrixXd(x) - expected).norm(), 1e-10 * expected.norm());
+}
+
+TEST_P(SparseCholeskyTest, SolveInPlaceEqualsSolveOutOfPlace) {
+  const int n = 120;
+  const ColMajorMatrix a = RandomSpdMatrix(n, 2, 3);
+  auto factor = CholeskyFactor::Factorize(*SymbolicCholesky::Analyze(a, GetParam()), a);
+  ASSERT_TRUE(factor.ok());
+  auto b = RandomRightHandSides(n, 5);
+  Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> x(n, 3);
+  std::vector<double> work(factor->WorkSize());
+  factor->Solve3(b.data(), x.data(), work.data());
+  factor->Solve3(b.data(), b.data(), work.data());
+  EXPECT_EQ(Eigen::MatrixXd(x), Eigen::MatrixXd(b));
+}
+
+TEST_P(SparseCholeskyTest, RefactorisationReusesTheAnalysis) {
+  const int n = 200;
+  ColMajorMatrix a = RandomSpdMatrix(n, 3, 13);
+  auto symbolic = SymbolicCholesky::Analyze(a, GetParam());
+  ASSERT_TRUE(symbolic.ok());
+  // Same pattern, other values.
+  ColMajorMatrix scaled = a;
+  for (int k = 0; k < scaled.nonZeros(); ++k) scaled.valuePtr()[k] *= 1.0 + 0.01 * (k % 7);
+  scaled = ColMajorMatrix(0.5 * (scaled + ColMajorMatrix(scaled.transpose())));
+  scaled.makeCompressed();
+  ASSERT_EQ(scaled.nonZeros(), a.nonZeros());
+  auto reused = CholeskyFactor::Factorize(*symbolic, scaled);
+  auto fresh = CholeskyFactor::Factorize(*SymbolicCholesky::Analyze(scaled, GetParam()), scaled);
+  ASSERT_TRUE(reused.ok() && fresh.ok());
+  const auto b = RandomRightHandSides(n, 17);
+  Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> x1(n, 3), x2(n, 3);
+  std::vector<double> work(reused->WorkSize());
+  reused->Solve3(b.data(), x1.data(), work.data());
+  fresh->Solve3(b.data(), x2.data(), work.data());
+  EXPECT_LT((x1 - x2).norm(), 1e-12 * x2.norm());
+}
+
+INSTANTIATE_TEST_SUITE_P(AllOrderings, SparseCholeskyTest,
+                         ::testing::Values(Ordering::kNatural, Ordering::kAmd, Ordering::kMetis,
+                                           Ordering::kAuto),
+                         [](const auto& info) { return std::string(OrderingName(info.param)); });
+
+// Every compiled solve kernel this CPU can run gives the dense answer, on matrices whose
+// supernodes have widths and heights with every remainder modulo four (the kernels' tails).
+class SolveKernelTest : public ::testing::TestWithParam<SolveKernel> {};
+
+TEST_P(SolveKernelTest, MatchesDenseCholeskyOnEveryShape) {
+  if (!SolveKernelAvailable(GetParam())) {
+    GTEST_SKIP() << SolveKernelName(GetParam()) << " is not available on this build or CPU";
+  }
+  for (const int n : {1, 2, 3, 5, 6, 7, 37, 300, 301, 302, 303}) {
+    for (const Ordering ordering : {Ordering::kNatural, Ordering::kAmd, Ordering::kMetis}) {
+      const ColMajorMatrix a = RandomSpdMatrix(n, 4, 100 + n);
+      auto symbolic = SymbolicCholesky::Analyze(a, ordering);
+      ASSERT_TRUE(symbolic.ok()) << symbolic.status().ToString();
+      auto factor = CholeskyFactor::Factorize(*symbolic, a);
+      ASSERT_TRUE(factor.ok()) << factor.status().ToString();
+
+      const auto b = RandomRightHandSides(n, 5 + n);
+      Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> x(n, 3);
+      std::vector<double> work(factor->WorkSize(), std::nan(""));  // the kernel must not read it
+      factor->Solve3(b.data(), x.data(), work.data(), GetParam());
+
+      const Eigen::MatrixXd dense = Eigen::MatrixXd(a);
+      const Eigen::MatrixXd expected = dense.llt().solve(Eigen::MatrixXd(b));
+      EXPECT_LT((Eigen::MatrixXd(x) - expected).norm(), 1e-10 * expected.norm())
+          << "n " << n << ", " << OrderingName(ordering);
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(AllKernels, SolveKernelTest,
+                         ::testing::Values(SolveKernel::kBaseline, SolveKernel::kAvx2Fma),
+                         [](const auto& info) {
+                           return std::string(info.param == SolveKernel::kBaseline ? "baseline"
+                                                                                   : "avx2_fma");
+                         });
+
+TEST(SolveKernel, TheBestIsAvailable) {
+  EXPECT_TRUE(SolveKernelAvailable(BestSolveKernel())) << SolveKernelName(BestSolveKernel());
+  EXPECT_TRUE(SolveKernelAvailable(SolveKernel::kBaseline));
+}
+
+TEST(SparseCholesky, MetisOrderingFillsLessThanNatural) {
+  // A 2D grid Laplacian: nested dissection beats the natural (banded) order.
+  const int side = 40, n = side * side;
+  std::vector<Eigen::Triplet<double>> t;
+  for (int r = 0; r < side; ++r) {
+    for (int c = 0; c < side; ++c) {
+      const int i = r * side + c;
+      t.emplace_back(i, i, 4.5);
+      if (c + 1 < side) t.emplace_back(i, i + 1, -1), t.emplace_back(i + 1, i, -1);
+      if (r + 1 < side) t.emplace_back(i, i + side, -1), t.emplace_back(i + side, i, -1);
+    }
+  }
+  ColMajorMatrix a(n, n);
+  a.setFromTriplets(t.begin(), t.end());
+  a.makeCompressed();
+  auto metis = SymbolicCholesky::Analyze(a, Ordering::kMetis);
+  auto natural = SymbolicCholesky::Analyze(a, Ordering::kNatural);
+  ASSERT_TRUE(metis.ok() && natural.ok());
+  EXPECT_LT((*metis)->factor_nonzeros(), (*natural)->factor_nonzeros());
+}
+
+TEST(SparseCholesky, AutoOrderingKeepsTheSmallerFactor) {
+  const ColMajorMatrix a = RandomSpdMatrix(400, 3, 21);
+  auto amd = SymbolicCholesky::Analyze(a, Ordering::kAmd);
+  auto metis = SymbolicCholesky::Analyze(a, Ordering::kMetis);
+  auto chosen = SymbolicCholesky::Analyze(a, Ordering::kAuto);
+  ASSERT_TRUE(amd.ok() && metis.ok() && chosen.ok());
+  EXPECT_EQ((*chosen)->factor_nonzeros(),
+            std::min((*amd)->factor_nonzeros(), (*metis)->factor_nonzeros()));
+  EXPECT_NE((*chosen)->ordering(), Ordering::kAuto);
+}
+
+TEST(SparseCholesky, IndefiniteMatrixIsRefused) {
+  ColMajorMatrix a = RandomSpdMatrix(50, 2, 1);
+  a.coeffRef(10, 10) = -1.0;
+  auto factor = CholeskyFactor::Factorize(*SymbolicCholesky::Analyze(a, Ordering::kAmd), a);
+  ASSERT_FALSE(factor.ok());
+  EXPECT_EQ(factor.status().code(), StatusCode::kInternal);
+  EXPECT_NE(factor.status().message().find("not positive definite"), std::string::npos);
+}
+
+TEST(SparseCholesky, MissingDiagonalIsRefused) {
+  ColMajorMatrix a(3, 3);
+  a.insert(0, 0) = 1;
+  a.insert(1, 2) = 1;
+  a.insert(2, 1) = 1;
+  a.insert(2, 2) = 1;
+  a.makeCompressed();
+  auto symbolic = SymbolicCholesky::Analyze(a, Ordering::kNatural);
+  ASSERT_FALSE(symbolic.ok());
+  EXPECT_EQ(symbolic.status().code(), StatusCode::kInvalidArgument);
+}
+
+TEST(SparseCholesky, OtherPatternIsRefused) {
+  const ColMajorMatrix a = RandomSpdMatrix(40, 2, 1);
+  const ColMajorMatrix other = RandomSpdMatrix(40, 3, 2);
+  auto factor = CholeskyFactor::Factorize(*SymbolicCholesky::Analyze(a, Ordering::kAmd), other);
+  EXPECT_FALSE(factor.ok());
+}
+
+}  // namespace
+}  // namespace deform
