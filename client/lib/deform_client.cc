@@ -59,18 +59,18 @@ grpc::Status RunLoadMesh(deform::v1::DeformService::Stub* stub, const ClientOpti
     }
   }
   stream->WritesDone();
-  deform::v1::LoadMeshProgress message;
+  deform::v1::LoadMeshResponse message;
   bool ready = false;
   while (stream->Read(&message)) {
     if (progress) progress(message);
-    if (message.stage() == deform::v1::LoadMeshProgress::READY) {
+    if (message.stage() == deform::v1::LoadMeshResponse::STAGE_READY) {
       ready = true;
       if (summary != nullptr) *summary = message.mesh();
     }
   }
   grpc::Status status = stream->Finish();
   if (status.ok() && !ready) {
-    return grpc::Status(grpc::StatusCode::INTERNAL, "LoadMesh ended without a READY message");
+    return grpc::Status(grpc::StatusCode::INTERNAL, "LoadMesh ended without a STAGE_READY message");
   }
   return status;
 }
@@ -134,7 +134,7 @@ grpc::Status DeformClient::LoadMeshBytes(const std::string& name, deform::v1::Me
   header.set_name(name);
   deform::v1::UploadSource* upload = header.mutable_upload();
   upload->set_format(format);
-  upload->set_mesh_bytes(mesh_bytes.size());
+  upload->set_mesh_size_bytes(mesh_bytes.size());
   upload->set_skeleton_format(skeleton_format);
   upload->set_skeleton(skeleton_bytes);
   *header.mutable_options() = options;
@@ -142,7 +142,7 @@ grpc::Status DeformClient::LoadMeshBytes(const std::string& name, deform::v1::Me
 }
 
 grpc::Status DeformClient::GetMeshInfo(const std::string& mesh_id, bool include_geometry,
-                                       deform::v1::MeshInfo* info) {
+                                       deform::v1::GetMeshInfoResponse* info) {
   grpc::ClientContext context;
   deform::v1::GetMeshInfoRequest request;
   request.set_mesh_id(mesh_id);

@@ -25,7 +25,7 @@ struct ClientOptions {
   int upload_chunk_bytes = 1 << 20;
 };
 
-using ProgressCallback = std::function<void(const deform::v1::LoadMeshProgress&)>;
+using ProgressCallback = std::function<void(const deform::v1::LoadMeshResponse&)>;
 
 class DeformStream;
 
@@ -59,7 +59,7 @@ class DeformClient {
                              const ProgressCallback& progress = {});
 
   grpc::Status GetMeshInfo(const std::string& mesh_id, bool include_geometry,
-                           deform::v1::MeshInfo* info);
+                           deform::v1::GetMeshInfoResponse* info);
   grpc::Status ListMeshes(std::vector<deform::v1::MeshSummary>* meshes);
   grpc::Status UnloadMesh(const std::string& mesh_id);
 

@@ -123,8 +123,8 @@ nlohmann::ordered_json ReportJson(const LoadReport& report) {
   out["errors"] = report.errors;
   out["errors_by_code"] = nlohmann::ordered_json::object();
   for (const auto& [code, count] : report.errors_by_code) out["errors_by_code"][code] = count;
-  out["rejected_notices"] = {{"POSE_REJECTED", report.poses_rejected},
-                             {"STIFFNESS_REJECTED", report.stiffness_rejected}};
+  out["rejected_notices"] = {{"KIND_POSE_REJECTED", report.poses_rejected},
+                             {"KIND_STIFFNESS_REJECTED", report.stiffness_rejected}};
   out["throughput_fps"] = Round(report.throughput_fps(), 1);
   out["latency_ms"] = {{"p50", Ms(report.latency.p50)}, {"p90", Ms(report.latency.p90)},
                        {"p99", Ms(report.latency.p99)}, {"p999", Ms(report.latency.p999)},

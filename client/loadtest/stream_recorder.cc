@@ -47,17 +47,17 @@ void StreamRecorder::OnFrame(const deform::v1::DeformFrame& frame) {
 void StreamRecorder::OnNotice(const deform::v1::Notice& notice) {
   std::lock_guard<std::mutex> lock(mu_);
   switch (notice.kind()) {
-    case deform::v1::Notice::POSE_REJECTED:
+    case deform::v1::Notice::KIND_POSE_REJECTED:
       ++stats_.poses_rejected;
       if (notice.sequence() > last_settled_sequence_) {
         last_settled_sequence_ = notice.sequence();
         changed_.notify_all();
       }
       break;
-    case deform::v1::Notice::STIFFNESS_REJECTED:
+    case deform::v1::Notice::KIND_STIFFNESS_REJECTED:
       ++stats_.stiffness_rejected;
       break;
-    case deform::v1::Notice::STIFFNESS_APPLIED:
+    case deform::v1::Notice::KIND_STIFFNESS_APPLIED:
       ++stats_.stiffness_applied;
       stats_.stiffness_factor_ms.push_back(notice.factor_ms());
       break;

@@ -37,7 +37,7 @@ struct StreamStats {
   std::uint64_t poses_rejected = 0;
   std::uint64_t stiffness_applied = 0;
   std::uint64_t stiffness_rejected = 0;
-  std::vector<double> stiffness_factor_ms;  // Notice.factor_ms of each STIFFNESS_APPLIED
+  std::vector<double> stiffness_factor_ms;  // Notice.factor_ms of each KIND_STIFFNESS_APPLIED
   grpc::Status final_status;
   bool done = false;
 };

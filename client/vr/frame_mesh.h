@@ -9,7 +9,7 @@
 namespace deform::vr {
 
 // Builds a mesh from `positions` (float32 little-endian xyz per vertex, as DeformFrame.positions)
-// and `triangles` (uint32 little-endian, 3 per triangle, as MeshInfo.triangles). INVALID_ARGUMENT
+// and `triangles` (uint32 little-endian, 3 per triangle, as GetMeshInfoResponse.triangles). INVALID_ARGUMENT
 // when a buffer's size is not a whole number of records or a triangle names a missing vertex.
 StatusOr<TriangleMesh> MeshFromBuffers(const std::string& positions, const std::string& triangles);
 

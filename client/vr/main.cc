@@ -86,7 +86,7 @@ int WriteLastFrame(deform::client::DeformClient& client, const std::string& mesh
   if (!result.last_pose_answered) {
     return Fail(grpc::Status(grpc::StatusCode::DEADLINE_EXCEEDED, "the last pose got no frame"));
   }
-  deform::v1::MeshInfo geometry;
+  deform::v1::GetMeshInfoResponse geometry;
   const grpc::Status fetched = client.GetMeshInfo(mesh_id, /*include_geometry=*/true, &geometry);
   if (!fetched.ok()) return Fail(fetched);
   auto mesh = deform::vr::MeshFromBuffers(result.last_frame.positions(), geometry.triangles());

@@ -6,7 +6,7 @@ grpc::Status AcquireMesh(client::DeformClient& client, const MeshSource& source,
                          deform::v1::MeshSummary* summary, bool* loaded) {
   *loaded = false;
   if (!source.mesh_id.empty()) {
-    deform::v1::MeshInfo info;
+    deform::v1::GetMeshInfoResponse info;
     grpc::Status status = client.GetMeshInfo(source.mesh_id, /*include_geometry=*/false, &info);
     if (status.ok()) *summary = info.summary();
     return status;

@@ -34,7 +34,7 @@ class PlaybackState {
   }
 
   void OnNotice(const deform::v1::Notice& notice) {
-    if (notice.kind() != deform::v1::Notice::POSE_REJECTED) return;
+    if (notice.kind() != deform::v1::Notice::KIND_POSE_REJECTED) return;
     std::lock_guard<std::mutex> lock(mu_);
     if (result_.poses_rejected++ == 0) {
       result_.first_rejection = "pose rejected: " + notice.message();

@@ -26,7 +26,7 @@ struct PlaybackResult {
   int poses_sent = 0;
   int frames_received = 0;
   std::uint64_t skipped_by_server = 0;  // sum of the frames' skipped_poses
-  int poses_rejected = 0;               // POSE_REJECTED notices
+  int poses_rejected = 0;               // KIND_POSE_REJECTED notices
   std::string first_rejection;          // "pose rejected: " + the first one's message
   std::vector<double> latency_ms;       // per frame: receipt minus the echoed client timestamp
   std::vector<double> solve_ms;         // per frame: timings.solve_ms

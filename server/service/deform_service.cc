@@ -9,14 +9,14 @@
 
 namespace deform::service {
 
-grpc::ServerBidiReactor<v1::LoadMeshRequest, v1::LoadMeshProgress>* DeformServiceImpl::LoadMesh(
+grpc::ServerBidiReactor<v1::LoadMeshRequest, v1::LoadMeshResponse>* DeformServiceImpl::LoadMesh(
     grpc::CallbackServerContext* /*context*/) {
   return NewLoadMeshReactor(core_);
 }
 
 grpc::ServerUnaryReactor* DeformServiceImpl::GetMeshInfo(grpc::CallbackServerContext* context,
                                                          const v1::GetMeshInfoRequest* request,
-                                                         v1::MeshInfo* response) {
+                                                         v1::GetMeshInfoResponse* response) {
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
   auto entry = core_->registry.Find(request->mesh_id());
   if (!entry.ok()) {

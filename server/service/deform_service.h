@@ -12,11 +12,11 @@ class DeformServiceImpl final : public v1::DeformService::CallbackService {
  public:
   explicit DeformServiceImpl(ServiceCore* core) : core_(core) {}
 
-  grpc::ServerBidiReactor<v1::LoadMeshRequest, v1::LoadMeshProgress>* LoadMesh(
+  grpc::ServerBidiReactor<v1::LoadMeshRequest, v1::LoadMeshResponse>* LoadMesh(
       grpc::CallbackServerContext* context) override;
   grpc::ServerUnaryReactor* GetMeshInfo(grpc::CallbackServerContext* context,
                                         const v1::GetMeshInfoRequest* request,
-                                        v1::MeshInfo* response) override;
+                                        v1::GetMeshInfoResponse* response) override;
   grpc::ServerUnaryReactor* ListMeshes(grpc::CallbackServerContext* context,
                                        const v1::ListMeshesRequest* request,
                                        v1::ListMeshesResponse* response) override;

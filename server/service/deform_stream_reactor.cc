@@ -22,7 +22,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// Unwritten notices beyond which new POSE_REJECTED notices are dropped (a client flooding bad
+// Unwritten notices beyond which new KIND_POSE_REJECTED notices are dropped (a client flooding bad
 // poses without reading must not grow the server's memory).
 constexpr std::size_t kMaxPendingNotices = 1024;
 
@@ -144,7 +144,7 @@ void DeformStreamReactor::OnReadDone(bool ok) {
     PumpLocked();
     return;
   }
-  switch (request_.message_case()) {
+  switch (request_.action_case()) {
     case v1::DeformRequest::kStart:
       HandleStart();
       return;
@@ -154,7 +154,7 @@ void DeformStreamReactor::OnReadDone(bool ok) {
     case v1::DeformRequest::kStiffness:
       HandleStiffness();
       return;
-    case v1::DeformRequest::MESSAGE_NOT_SET:
+    case v1::DeformRequest::ACTION_NOT_SET:
       break;
   }
   std::lock_guard<std::mutex> lock(mutex_);
@@ -230,7 +230,7 @@ void DeformStreamReactor::HandlePose() {
       ++poses_rejected_;
       if (notices_.size() < kMaxPendingNotices) {
         AddNoticeLocked(
-            v1::Notice::POSE_REJECTED, request_.pose().sequence(), version_,
+            v1::Notice::KIND_POSE_REJECTED, request_.pose().sequence(), version_,
             "pose " + std::to_string(request_.pose().sequence()) + ": " + converted.message());
         PumpLocked();
       }
@@ -259,11 +259,11 @@ void DeformStreamReactor::HandleStiffness() {
     spdlog::info("{} stiffness version {} rejected: {}", log_context_, version,
                  stiffness.status().message());
     AddNoticeLocked(
-        v1::Notice::STIFFNESS_REJECTED, 0, version,
+        v1::Notice::KIND_STIFFNESS_REJECTED, 0, version,
         "stiffness version " + std::to_string(version) + ": " + stiffness.status().message());
   } else if (refactor_running_) {
     if (has_queued_stiffness_) {
-      AddNoticeLocked(v1::Notice::STIFFNESS_REJECTED, 0, queued_version_,
+      AddNoticeLocked(v1::Notice::KIND_STIFFNESS_REJECTED, 0, queued_version_,
                       "stiffness version " + std::to_string(queued_version_) +
                           " superseded by version " + std::to_string(version) +
                           " before its refactorisation started");
@@ -302,7 +302,7 @@ void DeformStreamReactor::Refactor(const Stiffness& stiffness, std::uint64_t ver
     if (!stopping_) {
       if (result.ok()) {
         if (next_factorization_ != nullptr) {
-          AddNoticeLocked(v1::Notice::STIFFNESS_REJECTED, 0, next_version_,
+          AddNoticeLocked(v1::Notice::KIND_STIFFNESS_REJECTED, 0, next_version_,
                           "stiffness version " + std::to_string(next_version_) +
                               " superseded by version " + std::to_string(version) +
                               " before it was applied");
@@ -316,7 +316,7 @@ void DeformStreamReactor::Refactor(const Stiffness& stiffness, std::uint64_t ver
         spdlog::info("{} stiffness version {} rejected: {}", log_context_, version,
                      result.status().message());
         AddNoticeLocked(
-            v1::Notice::STIFFNESS_REJECTED, 0, version,
+            v1::Notice::KIND_STIFFNESS_REJECTED, 0, version,
             "stiffness version " + std::to_string(version) + ": " + result.status().message());
       }
       if (has_queued_stiffness_) {
@@ -337,7 +337,7 @@ void DeformStreamReactor::AdoptFactorizationLocked() {
   version_ = next_version_;
   spdlog::info("{} stiffness version {} applied (factorisation {:.2f} ms)", log_context_, version_,
                next_factor_ms_);
-  AddNoticeLocked(v1::Notice::STIFFNESS_APPLIED, 0, version_,
+  AddNoticeLocked(v1::Notice::KIND_STIFFNESS_APPLIED, 0, version_,
                   "stiffness version " + std::to_string(version_) + " applied", next_factor_ms_);
 }
 
@@ -387,7 +387,7 @@ void DeformStreamReactor::RunUrgent() {
     } else {
       lock.lock();
       AddNoticeLocked(
-          v1::Notice::POSE_REJECTED, working_.sequence, version_,
+          v1::Notice::KIND_POSE_REJECTED, working_.sequence, version_,
           "pose " + std::to_string(working_.sequence) + ": " + clamped.status().message());
       lock.unlock();
     }

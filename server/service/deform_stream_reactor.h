@@ -17,11 +17,11 @@
 //    it (its pose then counts as skipped in the next frame, so that skipped_poses is the number
 //    of poses since the previous frame that got no frame of their own).
 //  - A refactorisation runs in the background while frames keep using the old factorisation. It
-//    is switched in between two solves, together with the STIFFNESS_APPLIED notice, so every
+//    is switched in between two solves, together with the KIND_STIFFNESS_APPLIED notice, so every
 //    frame written after that notice carries the new version and every frame before it the old.
 //    One refactorisation runs per stream; a newer update waiting behind it replaces an older one
-//    (the older gets STIFFNESS_REJECTED, "superseded").
-//  - Notices are written in order and never dropped (except POSE_REJECTED beyond a backlog of
+//    (the older gets KIND_STIFFNESS_REJECTED, "superseded").
+//  - Notices are written in order and never dropped (except KIND_POSE_REJECTED beyond a backlog of
 //    1,024 unwritten notices).
 //
 // The stream ends with OK after the client half-closes and everything pending is written, with

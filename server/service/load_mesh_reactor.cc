@@ -59,7 +59,7 @@ double MillisecondsSince(Clock::time_point start) {
 }
 
 class LoadMeshReactor final
-    : public grpc::ServerBidiReactor<v1::LoadMeshRequest, v1::LoadMeshProgress> {
+    : public grpc::ServerBidiReactor<v1::LoadMeshRequest, v1::LoadMeshResponse> {
  public:
   explicit LoadMeshReactor(ServiceCore* core)
       : core_(core), log_context_("load=" + std::to_string(core->next_load_id.fetch_add(1))) {
@@ -81,7 +81,7 @@ class LoadMeshReactor final
 
   void Fail(const Status& status);
   // Require mutex_.
-  void AddProgressLocked(v1::LoadMeshProgress::Stage stage, double elapsed_ms,
+  void AddProgressLocked(v1::LoadMeshResponse::Stage stage, double elapsed_ms,
                          const MeshEntry* entry = nullptr);
   void RequestFinishLocked(const grpc::Status& status);
   void PumpLocked();
@@ -102,8 +102,8 @@ class LoadMeshReactor final
   std::mutex mutex_;
   // Guarded by mutex_.
   int holds_ = 1;  // gRPC's (released in OnDone) and the build's
-  std::deque<v1::LoadMeshProgress> outbox_;
-  v1::LoadMeshProgress in_flight_;
+  std::deque<v1::LoadMeshResponse> outbox_;
+  v1::LoadMeshResponse in_flight_;
   bool write_in_flight_ = false;
   bool finish_requested_ = false;
   bool finish_called_ = false;
@@ -158,7 +158,7 @@ Status LoadMeshReactor::HandleHeader() {
     case v1::LoadMeshHeader::kUpload: {
       const v1::UploadSource& upload = header_.upload();
       DEFORM_RETURN_IF_ERROR(CoreMeshFormat(upload.format()).status());
-      if (upload.mesh_bytes() == 0) {
+      if (upload.mesh_size_bytes() == 0) {
         return Status::InvalidArgument("upload.mesh_bytes is 0: the mesh file size is required");
       }
       if (upload.skeleton().empty()) return Status::InvalidArgument("upload.skeleton is empty");
@@ -166,13 +166,13 @@ Status LoadMeshReactor::HandleHeader() {
           upload.skeleton_format() != v1::SKELETON_FORMAT_JSON) {
         return Status::InvalidArgument("upload.skeleton_format is unspecified or unknown");
       }
-      const std::uint64_t total = upload.mesh_bytes() + upload.skeleton().size();
-      if (upload.mesh_bytes() > limits.max_upload_bytes || total > limits.max_upload_bytes) {
+      const std::uint64_t total = upload.mesh_size_bytes() + upload.skeleton().size();
+      if (upload.mesh_size_bytes() > limits.max_upload_bytes || total > limits.max_upload_bytes) {
         return Status::ResourceExhausted("upload of " + std::to_string(total) +
                                          " bytes exceeds the limit of " +
                                          std::to_string(limits.max_upload_bytes) + " bytes");
       }
-      expected_bytes_ = upload.mesh_bytes();
+      expected_bytes_ = upload.mesh_size_bytes();
       mesh_bytes_.reserve(std::min<std::size_t>(expected_bytes_, kMaxInitialReserve));
       spdlog::info("{} upload of {} mesh bytes announced, name='{}'", log_context_, expected_bytes_,
                    header_.name());
@@ -210,7 +210,7 @@ Status LoadMeshReactor::HandleEndOfInput() {
         std::to_string(expected_bytes_) + " mesh bytes announced in the header");
   }
   std::lock_guard<std::mutex> lock(mutex_);
-  AddProgressLocked(v1::LoadMeshProgress::RECEIVED, MillisecondsSince(start_));
+  AddProgressLocked(v1::LoadMeshResponse::STAGE_RECEIVED, MillisecondsSince(start_));
   PumpLocked();
   ++holds_;
   core_->pool.PostBackground([this] { Build(); });
@@ -234,7 +234,7 @@ void LoadMeshReactor::Build() {
         // Nobody is waiting for it: the mesh would be unreachable.
         (void)core_->registry.Unload((*entry)->id);
       } else {
-        AddProgressLocked(v1::LoadMeshProgress::READY, MillisecondsSince(start_), entry->get());
+        AddProgressLocked(v1::LoadMeshResponse::STAGE_READY, MillisecondsSince(start_), entry->get());
         RequestFinishLocked(grpc::Status::OK);
       }
     } else if (!skip) {
@@ -280,13 +280,13 @@ StatusOr<std::shared_ptr<const MeshEntry>> LoadMeshReactor::ParseAndBuild() {
     std::lock_guard<std::mutex> lock(mutex_);
     switch (stage) {
       case LoadStage::kValidated:
-        AddProgressLocked(v1::LoadMeshProgress::VALIDATED, elapsed_ms);
+        AddProgressLocked(v1::LoadMeshResponse::STAGE_VALIDATED, elapsed_ms);
         break;
       case LoadStage::kWeights:
-        AddProgressLocked(v1::LoadMeshProgress::WEIGHTS, elapsed_ms);
+        AddProgressLocked(v1::LoadMeshResponse::STAGE_WEIGHTS, elapsed_ms);
         break;
       case LoadStage::kFactorised:
-        AddProgressLocked(v1::LoadMeshProgress::FACTORISED, elapsed_ms);
+        AddProgressLocked(v1::LoadMeshResponse::STAGE_FACTORISED, elapsed_ms);
         break;
     }
     PumpLocked();
@@ -301,9 +301,9 @@ void LoadMeshReactor::Fail(const Status& status) {
   PumpLocked();
 }
 
-void LoadMeshReactor::AddProgressLocked(v1::LoadMeshProgress::Stage stage, double elapsed_ms,
+void LoadMeshReactor::AddProgressLocked(v1::LoadMeshResponse::Stage stage, double elapsed_ms,
                                         const MeshEntry* entry) {
-  v1::LoadMeshProgress& progress = outbox_.emplace_back();
+  v1::LoadMeshResponse& progress = outbox_.emplace_back();
   progress.set_stage(stage);
   progress.set_elapsed_ms(elapsed_ms);
   if (entry != nullptr) FillMeshSummary(*entry, progress.mutable_mesh());
@@ -363,7 +363,7 @@ void LoadMeshReactor::OnDone() {
 
 }  // namespace
 
-grpc::ServerBidiReactor<v1::LoadMeshRequest, v1::LoadMeshProgress>* NewLoadMeshReactor(
+grpc::ServerBidiReactor<v1::LoadMeshRequest, v1::LoadMeshResponse>* NewLoadMeshReactor(
     ServiceCore* core) {
   return new LoadMeshReactor(core);
 }

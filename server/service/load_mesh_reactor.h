@@ -17,7 +17,7 @@
 namespace deform::service {
 
 // A new reactor for one LoadMesh call. `core` must outlive it.
-grpc::ServerBidiReactor<v1::LoadMeshRequest, v1::LoadMeshProgress>* NewLoadMeshReactor(
+grpc::ServerBidiReactor<v1::LoadMeshRequest, v1::LoadMeshResponse>* NewLoadMeshReactor(
     ServiceCore* core);
 
 }  // namespace deform::service

@@ -86,6 +86,7 @@ StatusOr<ModelOptions> ModelOptionsFromProto(const v1::MethodOptions& proto,
         MaterialFromProto(proto.default_material(), JointMaterial{}, "default material"));
   }
   switch (proto.rotation_blend()) {
+    case v1::ROTATION_BLEND_UNSPECIFIED:
     case v1::ROTATION_BLEND_QUATERNION:
       options.rotation_blend = RotationBlend::kQuaternion;
       break;
@@ -182,7 +183,7 @@ void FillMeshSummary(const MeshEntry& entry, v1::MeshSummary* summary) {
   }
 }
 
-void FillMeshGeometry(const DeformationModel& model, v1::MeshInfo* info) {
+void FillMeshGeometry(const DeformationModel& model, v1::GetMeshInfoResponse* info) {
   const TriangleMesh& mesh = model.mesh();
   std::string* positions = info->mutable_rest_positions();
   positions->resize(static_cast<std::size_t>(mesh.num_vertices()) * 3 * 4);

@@ -31,7 +31,7 @@ StatusOr<Stiffness> StiffnessFromProto(const v1::StiffnessUpdate& proto,
 // The summary of a registered mesh.
 void FillMeshSummary(const MeshEntry& entry, v1::MeshSummary* summary);
 // Rest positions (float32 xyz) and triangles (uint32, 3 per triangle), little-endian.
-void FillMeshGeometry(const DeformationModel& model, v1::MeshInfo* info);
+void FillMeshGeometry(const DeformationModel& model, v1::GetMeshInfoResponse* info);
 
 // `count` doubles into `count` float32 little-endian values at `out` (4 * count bytes).
 // Allocation-free.

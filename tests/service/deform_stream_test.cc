@@ -162,7 +162,7 @@ TEST_F(DeformStreamTest, StiffnessUpdateSwitchesVersionsWithoutAGap) {
   weight->set_joint("knee");
   weight->set_weight(20);
   ASSERT_TRUE(stream->SendStiffness(stiffness));
-  ASSERT_TRUE(recorder.WaitForNotice(v1::Notice::STIFFNESS_APPLIED));
+  ASSERT_TRUE(recorder.WaitForNotice(v1::Notice::KIND_STIFFNESS_APPLIED));
   const std::int64_t at_notice = recorder.frames();
   ASSERT_TRUE(recorder.WaitForFrames(at_notice + 5)) << "frames stopped after the switch";
   stop.store(true);
@@ -170,10 +170,10 @@ TEST_F(DeformStreamTest, StiffnessUpdateSwitchesVersionsWithoutAGap) {
   stream->Close();
   ASSERT_TRUE(stream->Wait().ok());
 
-  const v1::Notice applied = *recorder.FindNotice(v1::Notice::STIFFNESS_APPLIED);
+  const v1::Notice applied = *recorder.FindNotice(v1::Notice::KIND_STIFFNESS_APPLIED);
   EXPECT_EQ(applied.stiffness_version(), 1u);
   EXPECT_GT(applied.factor_ms(), 0);
-  EXPECT_FALSE(recorder.FindNotice(v1::Notice::STIFFNESS_REJECTED).has_value());
+  EXPECT_FALSE(recorder.FindNotice(v1::Notice::KIND_STIFFNESS_REJECTED).has_value());
 
   std::uint64_t previous_version = 0;
   bool after_notice = false;
@@ -181,7 +181,7 @@ TEST_F(DeformStreamTest, StiffnessUpdateSwitchesVersionsWithoutAGap) {
   int frames_before = 0, frames_after = 0;
   for (const RecordedEvent& event : recorder.events()) {
     if (!event.is_frame) {
-      if (event.notice.kind() == v1::Notice::STIFFNESS_APPLIED) after_notice = true;
+      if (event.notice.kind() == v1::Notice::KIND_STIFFNESS_APPLIED) after_notice = true;
       continue;
     }
     const std::uint64_t version = event.frame.stiffness_version();
@@ -211,8 +211,8 @@ TEST_F(DeformStreamTest, NanAngleIsRejectedAndTheStreamGoesOn) {
   ASSERT_TRUE(stream->SendPose(KneePose(1, 30)));
   ASSERT_TRUE(recorder.WaitForFrameWithSequence(1));
   ASSERT_TRUE(stream->SendPose(KneePose(2, std::numeric_limits<double>::quiet_NaN())));
-  ASSERT_TRUE(recorder.WaitForNotice(v1::Notice::POSE_REJECTED));
-  const v1::Notice rejected = *recorder.FindNotice(v1::Notice::POSE_REJECTED);
+  ASSERT_TRUE(recorder.WaitForNotice(v1::Notice::KIND_POSE_REJECTED));
+  const v1::Notice rejected = *recorder.FindNotice(v1::Notice::KIND_POSE_REJECTED);
   EXPECT_EQ(rejected.sequence(), 2u);
   EXPECT_THAT(rejected.message(), HasSubstr("finite"));
   ASSERT_TRUE(stream->SendPose(KneePose(3, std::numeric_limits<double>::infinity(), 10)));
@@ -221,7 +221,7 @@ TEST_F(DeformStreamTest, NanAngleIsRejectedAndTheStreamGoesOn) {
   ASSERT_TRUE(recorder.WaitUntil([&] {
     int count = 0;
     for (const RecordedEvent& event : recorder.EventsLocked()) {
-      count += !event.is_frame && event.notice.kind() == v1::Notice::POSE_REJECTED;
+      count += !event.is_frame && event.notice.kind() == v1::Notice::KIND_POSE_REJECTED;
     }
     return count >= 2;
   }));
@@ -234,7 +234,7 @@ TEST_F(DeformStreamTest, NanAngleIsRejectedAndTheStreamGoesOn) {
     if (event.is_frame) {
       EXPECT_NE(event.frame.sequence(), 2u);
     }
-    if (!event.is_frame && event.notice.kind() == v1::Notice::POSE_REJECTED) ++rejections;
+    if (!event.is_frame && event.notice.kind() == v1::Notice::KIND_POSE_REJECTED) ++rejections;
   }
   EXPECT_EQ(rejections, 2);
   ExpectBackgroundStreamAlive();
@@ -248,16 +248,16 @@ TEST_F(DeformStreamTest, UnknownJointIsRejectedInPosesAndStiffness) {
   v1::PoseUpdate pose = KneePose(1, 10);
   pose.mutable_angles(0)->set_joint("elbow");
   ASSERT_TRUE(stream->SendPose(pose));
-  ASSERT_TRUE(recorder.WaitForNotice(v1::Notice::POSE_REJECTED));
-  EXPECT_THAT(recorder.FindNotice(v1::Notice::POSE_REJECTED)->message(), HasSubstr("elbow"));
+  ASSERT_TRUE(recorder.WaitForNotice(v1::Notice::KIND_POSE_REJECTED));
+  EXPECT_THAT(recorder.FindNotice(v1::Notice::KIND_POSE_REJECTED)->message(), HasSubstr("elbow"));
 
   v1::StiffnessUpdate stiffness;
   v1::JointMaterialUpdate* material = stiffness.add_joint_materials();
   material->set_joint("elbow");
   material->mutable_material()->set_soft(2);
   ASSERT_TRUE(stream->SendStiffness(stiffness));
-  ASSERT_TRUE(recorder.WaitForNotice(v1::Notice::STIFFNESS_REJECTED));
-  const v1::Notice rejected = *recorder.FindNotice(v1::Notice::STIFFNESS_REJECTED);
+  ASSERT_TRUE(recorder.WaitForNotice(v1::Notice::KIND_STIFFNESS_REJECTED));
+  const v1::Notice rejected = *recorder.FindNotice(v1::Notice::KIND_STIFFNESS_REJECTED);
   EXPECT_EQ(rejected.stiffness_version(), 1u);
   EXPECT_THAT(rejected.message(), HasSubstr("elbow"));
 
@@ -351,7 +351,7 @@ TEST_F(DeformStreamTest, CancelledClientLeavesTheServerHealthy) {
   ASSERT_TRUE(fresh.WaitForFrameWithSequence(1));
   again->Close();
   EXPECT_TRUE(again->Wait().ok());
-  v1::MeshInfo info;
+  v1::GetMeshInfoResponse info;
   const auto deadline = std::chrono::steady_clock::now() + kWaitTimeout;
   do {
     ASSERT_TRUE(client_->GetMeshInfo(mesh_id, false, &info).ok());
@@ -379,7 +379,7 @@ TEST_F(DeformStreamTest, UnloadedMeshKeepsItsStreamsButRefusesNewOnes) {
   StreamRecorder refused;
   auto late = client_->OpenStream(mesh_id, refused.Callbacks());
   EXPECT_EQ(late->Wait().error_code(), grpc::StatusCode::NOT_FOUND);
-  v1::MeshInfo info;
+  v1::GetMeshInfoResponse info;
   EXPECT_EQ(client_->GetMeshInfo(mesh_id, false, &info).error_code(), grpc::StatusCode::NOT_FOUND);
 
   ASSERT_TRUE(stream->SendPose(KneePose(3, 30)));

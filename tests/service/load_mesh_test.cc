@@ -58,20 +58,20 @@ class LoadMeshTest : public ServiceTest {};
 
 TEST_F(LoadMeshTest, PhantomLoadReportsEveryStageInOrder) {
   StartServer();
-  std::vector<v1::LoadMeshProgress::Stage> stages;
+  std::vector<v1::LoadMeshResponse::Stage> stages;
   std::vector<double> elapsed;
   v1::MeshSummary summary;
   const grpc::Status status = client_->LoadPhantom(
       600, {}, &summary,
-      [&](const v1::LoadMeshProgress& progress) {
+      [&](const v1::LoadMeshResponse& progress) {
         stages.push_back(progress.stage());
         elapsed.push_back(progress.elapsed_ms());
       },
       "knee");
   ASSERT_TRUE(status.ok()) << status.error_message();
-  EXPECT_THAT(stages, ElementsAre(v1::LoadMeshProgress::RECEIVED, v1::LoadMeshProgress::VALIDATED,
-                                  v1::LoadMeshProgress::WEIGHTS, v1::LoadMeshProgress::FACTORISED,
-                                  v1::LoadMeshProgress::READY));
+  EXPECT_THAT(stages, ElementsAre(v1::LoadMeshResponse::STAGE_RECEIVED, v1::LoadMeshResponse::STAGE_VALIDATED,
+                                  v1::LoadMeshResponse::STAGE_WEIGHTS, v1::LoadMeshResponse::STAGE_FACTORISED,
+                                  v1::LoadMeshResponse::STAGE_READY));
   for (std::size_t k = 1; k < elapsed.size(); ++k) EXPECT_LE(elapsed[k - 1], elapsed[k]);
 
   auto phantom = MakeKneePhantom(600);
@@ -95,7 +95,7 @@ TEST_F(LoadMeshTest, PhantomLoadReportsEveryStageInOrder) {
   EXPECT_EQ(meshes[0].open_streams(), 1u);
   EXPECT_EQ(meshes[1].mesh_id(), summary.mesh_id());
 
-  v1::MeshInfo info;
+  v1::GetMeshInfoResponse info;
   ASSERT_TRUE(client_->GetMeshInfo(summary.mesh_id(), true, &info).ok());
   EXPECT_EQ(info.summary().mesh_id(), summary.mesh_id());
   const std::vector<float> rest = client::DecodePositions(info.rest_positions());
@@ -106,7 +106,7 @@ TEST_F(LoadMeshTest, PhantomLoadReportsEveryStageInOrder) {
     }
   }
   EXPECT_EQ(info.triangles().size(), 12u * phantom->mesh.num_triangles());
-  v1::MeshInfo without;
+  v1::GetMeshInfoResponse without;
   ASSERT_TRUE(client_->GetMeshInfo(summary.mesh_id(), false, &without).ok());
   EXPECT_TRUE(without.rest_positions().empty());
   ExpectBackgroundStreamAlive();
@@ -116,15 +116,15 @@ TEST_F(LoadMeshTest, UploadedFilesBuildTheMesh) {
   StartServer();
   const UploadFiles files = WritePhantomFiles(800);
   v1::MeshSummary summary;
-  std::vector<v1::LoadMeshProgress::Stage> stages;
+  std::vector<v1::LoadMeshResponse::Stage> stages;
   const grpc::Status status = client_->LoadMeshFiles(
       files.mesh_path, files.skeleton_path, {}, &summary,
-      [&](const v1::LoadMeshProgress& progress) { stages.push_back(progress.stage()); });
+      [&](const v1::LoadMeshResponse& progress) { stages.push_back(progress.stage()); });
   ASSERT_TRUE(status.ok()) << status.error_message();
   EXPECT_EQ(summary.vertex_count(), static_cast<std::uint32_t>(files.vertices));
   EXPECT_EQ(summary.name(), "phantom.obj");
-  EXPECT_EQ(stages.back(), v1::LoadMeshProgress::READY);
-  EXPECT_EQ(stages.front(), v1::LoadMeshProgress::RECEIVED);
+  EXPECT_EQ(stages.back(), v1::LoadMeshResponse::STAGE_READY);
+  EXPECT_EQ(stages.front(), v1::LoadMeshResponse::STAGE_RECEIVED);
 
   // Small chunks arrive the same.
   client::ClientOptions small_chunks;
@@ -158,7 +158,7 @@ TEST_F(LoadMeshTest, MissingFileIsNotFoundWithoutContactingTheServer) {
 
 TEST_F(LoadMeshTest, UnknownMeshIsNotFound) {
   StartServer();
-  v1::MeshInfo info;
+  v1::GetMeshInfoResponse info;
   const grpc::Status info_status = client_->GetMeshInfo("mesh-999", false, &info);
   EXPECT_EQ(info_status.error_code(), grpc::StatusCode::NOT_FOUND);
   EXPECT_THAT(info_status.error_message(), HasSubstr("mesh-999"));
@@ -177,14 +177,14 @@ TEST_F(LoadMeshTest, TruncatedUploadIsInvalidArgument) {
   v1::LoadMeshRequest request;
   v1::UploadSource* upload = request.mutable_header()->mutable_upload();
   upload->set_format(v1::MESH_FORMAT_OBJ);
-  upload->set_mesh_bytes(1000);
+  upload->set_mesh_size_bytes(1000);
   upload->set_skeleton_format(v1::SKELETON_FORMAT_TGF);
   upload->set_skeleton("1 0 0 0\n2 0 1 0\n#\n1 2\n#\n");
   ASSERT_TRUE(stream->Write(request));
   request.set_chunk(std::string(400, 'v'));
   stream->Write(request);
   stream->WritesDone();
-  v1::LoadMeshProgress progress;
+  v1::LoadMeshResponse progress;
   while (stream->Read(&progress)) {
   }
   const grpc::Status status = stream->Finish();
