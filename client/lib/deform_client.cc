@@ -42,6 +42,11 @@ std::string BaseName(const std::string& path) {
   return slash == std::string::npos ? path : path.substr(slash + 1);
 }
 
+void SetUnaryDeadline(const ClientOptions& options, grpc::ClientContext* context) {
+  context->set_deadline(std::chrono::system_clock::now() +
+                        std::chrono::milliseconds(options.unary_deadline_ms));
+}
+
 // Runs one LoadMesh call: sends `header` and the chunks of `mesh_bytes`, reads the progress.
 grpc::Status RunLoadMesh(deform::v1::DeformService::Stub* stub, const ClientOptions& options,
                          const deform::v1::LoadMeshHeader& header, const std::string* mesh_bytes,
@@ -144,6 +149,7 @@ grpc::Status DeformClient::LoadMeshBytes(const std::string& name, deform::v1::Me
 grpc::Status DeformClient::GetMeshInfo(const std::string& mesh_id, bool include_geometry,
                                        deform::v1::GetMeshInfoResponse* info) {
   grpc::ClientContext context;
+  SetUnaryDeadline(options_, &context);
   deform::v1::GetMeshInfoRequest request;
   request.set_mesh_id(mesh_id);
   request.set_include_geometry(include_geometry);
@@ -152,6 +158,7 @@ grpc::Status DeformClient::GetMeshInfo(const std::string& mesh_id, bool include_
 
 grpc::Status DeformClient::ListMeshes(std::vector<deform::v1::MeshSummary>* meshes) {
   grpc::ClientContext context;
+  SetUnaryDeadline(options_, &context);
   deform::v1::ListMeshesResponse response;
   const grpc::Status status =
       stub_->ListMeshes(&context, deform::v1::ListMeshesRequest(), &response);
@@ -163,6 +170,7 @@ grpc::Status DeformClient::ListMeshes(std::vector<deform::v1::MeshSummary>* mesh
 
 grpc::Status DeformClient::UnloadMesh(const std::string& mesh_id) {
   grpc::ClientContext context;
+  SetUnaryDeadline(options_, &context);
   deform::v1::UnloadMeshRequest request;
   request.set_mesh_id(mesh_id);
   deform::v1::UnloadMeshResponse response;

@@ -23,6 +23,10 @@ struct ClientOptions {
   int max_receive_message_bytes = 256 << 20;
   // Upload chunk size for LoadMesh. Default: 1 MiB.
   int upload_chunk_bytes = 1 << 20;
+  // Deadline of each unary call (GetMeshInfo, ListMeshes, UnloadMesh): DEADLINE_EXCEEDED after
+  // this long. LoadMesh and Deform streams have none (a load's time grows with the mesh; a stream
+  // lives as long as the session). Default: 30 s.
+  int unary_deadline_ms = 30'000;
 };
 
 using ProgressCallback = std::function<void(const deform::v1::LoadMeshResponse&)>;

@@ -11,10 +11,11 @@
 #include <iostream>
 #include <string>
 
+#include "cli/command_line.h"
+#include "cli/mesh_source.h"
+#include "cli/rotation_blend_flag.h"
 #include "lib/deform_client.h"
 #include "lib/joint_choice.h"
-#include "lib/rotation_blend_flag.h"
-#include "lib/status_names.h"
 #include "loadtest/load_plan.h"
 #include "loadtest/load_report.h"
 #include "loadtest/load_runner.h"
@@ -27,10 +28,8 @@ constexpr char kProgram[] = "deform-loadtest";
 constexpr double kSoftWeights[] = {0.5, 1.0};
 
 struct LoadtestArgs {
-  std::string target = "127.0.0.1:50051";
-  std::string mesh_path;
-  std::string skeleton_path;
-  int phantom_vertices = 0;
+  deform::cli::ConnectionArgs connection;
+  deform::cli::MeshSource source;
   int streams = 1;
   double rate_hz = 90.0;
   double duration_s = 10.0;
@@ -41,25 +40,12 @@ struct LoadtestArgs {
   double peak_degrees = 120.0;
   double cycle_s = 2.0;
   double drain_s = 2.0;
-  int connect_timeout_ms = 5000;
-  deform::v1::RotationBlend rotation_blend = deform::v1::ROTATION_BLEND_QUATERNION;
   bool keep_mesh = false;
   bool json = false;
   bool fail_on_errors = false;
 };
 
-int Fail(const grpc::Status& status) {
-  std::cerr << kProgram << ": " << deform::client::StatusText(status) << "\n";
-  return 1;
-}
-
-grpc::Status LoadMesh(deform::client::DeformClient& client, const LoadtestArgs& args,
-                      deform::v1::MeshSummary* summary) {
-  deform::v1::MethodOptions options;
-  options.set_rotation_blend(args.rotation_blend);
-  if (args.mesh_path.empty()) return client.LoadPhantom(args.phantom_vertices, options, summary);
-  return client.LoadMeshFiles(args.mesh_path, args.skeleton_path, options, summary);
-}
+int Fail(const grpc::Status& status) { return deform::cli::ReportFailure(kProgram, status); }
 
 // Runs the plan on a loaded mesh and prints the report; returns the exit code.
 int RunOnMesh(deform::client::DeformClient& client, const LoadtestArgs& args,
@@ -77,12 +63,12 @@ int RunOnMesh(deform::client::DeformClient& client, const LoadtestArgs& args,
   plan.drain_s = args.drain_s;
 
   deform::loadtest::RunDescription run;
-  run.target = args.target;
-  run.mesh = args.mesh_path.empty() ? "phantom" : args.mesh_path;
+  run.target = args.connection.target;
+  run.mesh = args.source.Description();
   run.mesh_id = summary.mesh_id();
   run.vertices = summary.vertex_count();
   run.triangles = summary.triangle_count();
-  run.rotation_blend = deform::client::RotationBlendName(summary.rotation_blend());
+  run.rotation_blend = deform::cli::RotationBlendName(summary.rotation_blend());
   if (args.stiffness_every_s > 0) {
     run.stiffness_joint = deform::client::ChooseRegionJoint(summary, plan.posed.joint);
     if (run.stiffness_joint.empty()) {
@@ -108,15 +94,13 @@ int RunOnMesh(deform::client::DeformClient& client, const LoadtestArgs& args,
 }
 
 int Run(const LoadtestArgs& args) {
-  deform::client::DeformClient client(args.target);
-  if (!client.WaitForReady(args.connect_timeout_ms)) {
-    return Fail(grpc::Status(grpc::StatusCode::UNAVAILABLE,
-                             "cannot reach " + args.target + " within " +
-                                 std::to_string(args.connect_timeout_ms) + " ms"));
-  }
+  deform::client::DeformClient client(args.connection.target);
+  const grpc::Status connected = deform::cli::WaitForServer(client, args.connection);
+  if (!connected.ok()) return Fail(connected);
   deform::v1::MeshSummary summary;
-  const grpc::Status loaded = LoadMesh(client, args, &summary);
-  if (!loaded.ok()) return Fail(loaded);
+  bool loaded = false;
+  const grpc::Status acquired = deform::cli::AcquireMesh(client, args.source, &summary, &loaded);
+  if (!acquired.ok()) return Fail(acquired);
 
   const int code = RunOnMesh(client, args, summary);
   if (!args.keep_mesh) {
@@ -128,20 +112,8 @@ int Run(const LoadtestArgs& args) {
 }
 
 void AddFlags(CLI::App& app, LoadtestArgs& args) {
-  app.add_option("--target", args.target, "Server address host:port")->capture_default_str();
-  CLI::Option* mesh = app.add_option("--mesh", args.mesh_path,
-                                     "Mesh file to upload (.obj .ply .stl .off); default: the "
-                                     "built-in knee phantom");
-  CLI::Option* skeleton = app.add_option("--skeleton", args.skeleton_path,
-                                         "Skeleton file (.tgf or JSON); required with --mesh");
-  CLI::Option* phantom = app.add_option("--phantom-vertices", args.phantom_vertices,
-                                        "Phantom resolution (0 = the server's default)")
-                             ->capture_default_str()
-                             ->check(CLI::NonNegativeNumber);
-  mesh->needs(skeleton);
-  skeleton->needs(mesh);
-  mesh->excludes(phantom);
-  deform::client::AddRotationBlendFlag(app, &args.rotation_blend);
+  deform::cli::AddConnectionFlags(app, &args.connection);
+  deform::cli::AddMeshSourceFlags(app, &args.source);
 
   app.add_option("--streams", args.streams, "Concurrent Deform streams on the mesh")
       ->capture_default_str()
@@ -178,10 +150,6 @@ void AddFlags(CLI::App& app, LoadtestArgs& args) {
                  "streams to finish")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 3600.0));
-  app.add_option("--connect-timeout-ms", args.connect_timeout_ms,
-                 "How long to wait for the server to be reachable")
-      ->capture_default_str()
-      ->check(CLI::PositiveNumber);
   app.add_flag("--keep-mesh", args.keep_mesh, "Leave the loaded mesh on the server");
   app.add_flag("--json", args.json,
                "Print one JSON object instead of the summary and latency histogram");
@@ -201,12 +169,8 @@ int main(int argc, char** argv) {
   app.get_formatter()->column_width(34);
   LoadtestArgs args;
   AddFlags(app, args);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    if (e.get_exit_code() == 0) return app.exit(e);
-    std::cerr << kProgram << ": " << e.what() << "\n";
-    return 2;
+  if (const auto exit_code = deform::cli::ParseCommandLine(app, argc, argv, kProgram)) {
+    return *exit_code;
   }
   return Run(args);
 }

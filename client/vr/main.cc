@@ -13,14 +13,13 @@
 #include <iostream>
 #include <string>
 
+#include "cli/command_line.h"
+#include "cli/mesh_source.h"
 #include "core/io/mesh_io.h"
 #include "lib/deform_client.h"
 #include "lib/flexion_trajectory.h"
 #include "lib/joint_choice.h"
-#include "lib/rotation_blend_flag.h"
-#include "lib/status_names.h"
 #include "vr/frame_mesh.h"
-#include "vr/mesh_source.h"
 #include "vr/pose_player.h"
 #include "vr/vr_report.h"
 
@@ -31,8 +30,8 @@ using deform::client::JointAxis;
 constexpr char kProgram[] = "deform-vr";
 
 struct VrArgs {
-  std::string target = "127.0.0.1:50051";
-  deform::vr::MeshSource source;
+  deform::cli::ConnectionArgs connection;
+  deform::cli::MeshSource source;
   std::string joint;
   std::string axis;
   double rate_hz = 90.0;
@@ -46,14 +45,10 @@ struct VrArgs {
   bool unload = false;
   bool keep_mesh = false;
   bool json = false;
-  int connect_timeout_ms = 5000;
   int answer_timeout_ms = 5000;
 };
 
-int Fail(const grpc::Status& status) {
-  std::cerr << kProgram << ": " << deform::client::StatusText(status) << "\n";
-  return 1;
-}
+int Fail(const grpc::Status& status) { return deform::cli::ReportFailure(kProgram, status); }
 
 int Fail(const deform::Status& status) {
   std::cerr << kProgram << ": " << status.ToString() << "\n";
@@ -134,15 +129,12 @@ int RunOnMesh(deform::client::DeformClient& client, const VrArgs& args,
 }
 
 int Run(const VrArgs& args) {
-  deform::client::DeformClient client(args.target);
-  if (!client.WaitForReady(args.connect_timeout_ms)) {
-    return Fail(grpc::Status(grpc::StatusCode::UNAVAILABLE,
-                             "cannot reach " + args.target + " within " +
-                                 std::to_string(args.connect_timeout_ms) + " ms"));
-  }
+  deform::client::DeformClient client(args.connection.target);
+  const grpc::Status connected = deform::cli::WaitForServer(client, args.connection);
+  if (!connected.ok()) return Fail(connected);
   deform::v1::MeshSummary summary;
   bool loaded = false;
-  const grpc::Status acquired = deform::vr::AcquireMesh(client, args.source, &summary, &loaded);
+  const grpc::Status acquired = deform::cli::AcquireMesh(client, args.source, &summary, &loaded);
   if (!acquired.ok()) return Fail(acquired);
 
   const int code = RunOnMesh(client, args, summary);
@@ -155,24 +147,13 @@ int Run(const VrArgs& args) {
 }
 
 void AddFlags(CLI::App& app, VrArgs& args) {
-  app.add_option("--target", args.target, "Server address host:port")->capture_default_str();
-  CLI::Option* mesh = app.add_option("--mesh", args.source.mesh_path,
-                                     "Mesh file to upload (.obj .ply .stl .off); default: the "
-                                     "built-in knee phantom");
-  CLI::Option* skeleton = app.add_option("--skeleton", args.source.skeleton_path,
-                                         "Skeleton file (.tgf or JSON); required with --mesh");
-  CLI::Option* phantom = app.add_option("--phantom-vertices", args.source.phantom_vertices,
-                                        "Phantom resolution (0 = the server's default)")
-                             ->capture_default_str()
-                             ->check(CLI::NonNegativeNumber);
+  deform::cli::AddConnectionFlags(app, &args.connection);
+  const deform::cli::MeshSourceOptions source = deform::cli::AddMeshSourceFlags(app, &args.source);
   CLI::Option* mesh_id = app.add_option("--mesh-id", args.source.mesh_id,
                                         "Use a mesh the server already holds (not unloaded at the "
                                         "end unless --unload)");
-  mesh->needs(skeleton);
-  skeleton->needs(mesh);
-  mesh_id->excludes(mesh)->excludes(skeleton)->excludes(phantom);
-  mesh->excludes(phantom);
-  deform::client::AddRotationBlendFlag(app, &args.source.rotation_blend)->excludes(mesh_id);
+  mesh_id->excludes(source.mesh)->excludes(source.skeleton)->excludes(source.phantom_vertices);
+  source.rotation_blend->excludes(mesh_id);
 
   app.add_option("--joint", args.joint,
                  "Joint the trajectory bends, name or 0-based index (default: knee when the "
@@ -207,10 +188,6 @@ void AddFlags(CLI::App& app, VrArgs& args) {
   app.add_flag("--keep-mesh", args.keep_mesh, "Leave a mesh this run loaded on the server")
       ->excludes(unload);
   app.add_flag("--json", args.json, "Print one JSON object instead of text");
-  app.add_option("--connect-timeout-ms", args.connect_timeout_ms,
-                 "How long to wait for the server to be reachable")
-      ->capture_default_str()
-      ->check(CLI::PositiveNumber);
   app.add_option("--answer-timeout-ms", args.answer_timeout_ms,
                  "After the last send: how long to wait for its frame, then for the stream's end")
       ->capture_default_str()
@@ -231,12 +208,8 @@ int main(int argc, char** argv) {
   app.get_formatter()->column_width(34);
   VrArgs args;
   AddFlags(app, args);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    if (e.get_exit_code() == 0) return app.exit(e);
-    std::cerr << kProgram << ": " << e.what() << "\n";
-    return 2;
+  if (const auto exit_code = deform::cli::ParseCommandLine(app, argc, argv, kProgram)) {
+    return *exit_code;
   }
   if (!args.out_path.empty()) {
     const auto format = deform::MeshFormatFromPath(args.out_path);

@@ -8,7 +8,7 @@
 
 #include "deform/v1/deform.pb.h"
 
-namespace deform::client {
+namespace deform::cli {
 
 inline const std::map<std::string, deform::v1::RotationBlend>& RotationBlendNames() {
   static const std::map<std::string, deform::v1::RotationBlend> names = {
@@ -18,6 +18,7 @@ inline const std::map<std::string, deform::v1::RotationBlend>& RotationBlendName
 }
 
 inline std::string RotationBlendName(deform::v1::RotationBlend blend) {
+  if (blend == deform::v1::ROTATION_BLEND_UNSPECIFIED) return "quaternion";  // the default
   for (const auto& [name, value] : RotationBlendNames()) {
     if (value == blend) return name;
   }
@@ -35,4 +36,4 @@ inline CLI::Option* AddRotationBlendFlag(CLI::App& app, deform::v1::RotationBlen
       ->default_str("quaternion");
 }
 
-}  // namespace deform::client
+}  // namespace deform::cli

@@ -1,12 +1,12 @@
-// Where the VR stand-in's mesh comes from: the built-in phantom, uploaded files, or a mesh the
-// server already holds.
+// Where a command-line client's mesh comes from: the built-in phantom, uploaded files, or a mesh
+// the server already holds.
 #pragma once
 
 #include <string>
 
 #include "lib/deform_client.h"
 
-namespace deform::vr {
+namespace deform::cli {
 
 struct MeshSource {
   std::string mesh_id;    // non-empty: use this loaded mesh (nothing is loaded)
@@ -14,7 +14,10 @@ struct MeshSource {
   std::string skeleton_path;
   int phantom_vertices = 0;  // otherwise: load the phantom at this resolution (0 = default)
   // When loading: how the server blends bone rotations near a joint.
-  deform::v1::RotationBlend rotation_blend = deform::v1::ROTATION_BLEND_QUATERNION;
+  deform::v1::RotationBlend rotation_blend = deform::v1::ROTATION_BLEND_UNSPECIFIED;
+
+  // "phantom", the mesh file, or the mesh id: for reports.
+  std::string Description() const;
 };
 
 // Loads or looks up the mesh and fills `summary`. `loaded` tells whether this call loaded it (and
@@ -22,4 +25,4 @@ struct MeshSource {
 grpc::Status AcquireMesh(client::DeformClient& client, const MeshSource& source,
                          deform::v1::MeshSummary* summary, bool* loaded);
 
-}  // namespace deform::vr
+}  // namespace deform::cli

@@ -1,6 +1,11 @@
-#include "vr/mesh_source.h"
+#include "cli/mesh_source.h"
 
-namespace deform::vr {
+namespace deform::cli {
+
+std::string MeshSource::Description() const {
+  if (!mesh_id.empty()) return mesh_id;
+  return mesh_path.empty() ? "phantom" : mesh_path;
+}
 
 grpc::Status AcquireMesh(client::DeformClient& client, const MeshSource& source,
                          deform::v1::MeshSummary* summary, bool* loaded) {
@@ -21,4 +26,4 @@ grpc::Status AcquireMesh(client::DeformClient& client, const MeshSource& source,
   return status;
 }
 
-}  // namespace deform::vr
+}  // namespace deform::cli

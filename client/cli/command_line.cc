@@ -1,0 +1,59 @@
+#include "cli/command_line.h"
+
+#include <iostream>
+
+#include "cli/rotation_blend_flag.h"
+#include "lib/status_names.h"
+
+namespace deform::cli {
+
+void AddConnectionFlags(CLI::App& app, ConnectionArgs* args) {
+  app.add_option("--target", args->target, "Server address host:port")->capture_default_str();
+  app.add_option("--connect-timeout-ms", args->connect_timeout_ms,
+                 "How long to wait for the server to be reachable")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+}
+
+MeshSourceOptions AddMeshSourceFlags(CLI::App& app, MeshSource* source) {
+  MeshSourceOptions options;
+  options.mesh = app.add_option("--mesh", source->mesh_path,
+                                "Mesh file to upload (.obj .ply .stl .off); default: the "
+                                "built-in knee phantom");
+  options.skeleton = app.add_option("--skeleton", source->skeleton_path,
+                                    "Skeleton file (.tgf or JSON); required with --mesh");
+  options.phantom_vertices = app.add_option("--phantom-vertices", source->phantom_vertices,
+                                            "Phantom resolution (0 = the server's default)")
+                                 ->capture_default_str()
+                                 ->check(CLI::NonNegativeNumber);
+  options.mesh->needs(options.skeleton);
+  options.skeleton->needs(options.mesh);
+  options.mesh->excludes(options.phantom_vertices);
+  options.rotation_blend = AddRotationBlendFlag(app, &source->rotation_blend);
+  return options;
+}
+
+std::optional<int> ParseCommandLine(CLI::App& app, int argc, char** argv, const char* program) {
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);
+    std::cerr << program << ": " << e.what() << "\n";
+    return 2;
+  }
+  return std::nullopt;
+}
+
+int ReportFailure(const char* program, const grpc::Status& status) {
+  std::cerr << program << ": " << client::StatusText(status) << "\n";
+  return 1;
+}
+
+grpc::Status WaitForServer(client::DeformClient& client, const ConnectionArgs& args) {
+  if (client.WaitForReady(args.connect_timeout_ms)) return grpc::Status::OK;
+  return grpc::Status(
+      grpc::StatusCode::UNAVAILABLE,
+      "cannot reach " + args.target + " within " + std::to_string(args.connect_timeout_ms) + " ms");
+}
+
+}  // namespace deform::cli

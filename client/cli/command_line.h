@@ -1,0 +1,45 @@
+// What deform-vr and deform-loadtest share on the command line: the server address and connection
+// timeout, where the mesh comes from, parsing with the project's exit codes (0 for --help, 2 for a
+// usage error with one line on stderr), and one-line failure reports (exit code 1).
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <optional>
+#include <string>
+
+#include "cli/mesh_source.h"
+#include "lib/deform_client.h"
+
+namespace deform::cli {
+
+struct ConnectionArgs {
+  std::string target = "127.0.0.1:50051";  // host:port
+  int connect_timeout_ms = 5000;           // how long to wait for the server to be reachable
+};
+
+// --target and --connect-timeout-ms.
+void AddConnectionFlags(CLI::App& app, ConnectionArgs* args);
+
+// The options AddMeshSourceFlags adds, for further constraints (e.g. excludes).
+struct MeshSourceOptions {
+  CLI::Option* mesh = nullptr;
+  CLI::Option* skeleton = nullptr;
+  CLI::Option* phantom_vertices = nullptr;
+  CLI::Option* rotation_blend = nullptr;
+};
+
+// --mesh and --skeleton (each needs the other), --phantom-vertices (excludes --mesh) and
+// --rotation-blend, filling `source` (which must outlive the parse).
+MeshSourceOptions AddMeshSourceFlags(CLI::App& app, MeshSource* source);
+
+// Parses the command line. Returns the exit code the program should end with (0 after --help or
+// --version, 2 after a usage error, reported on stderr as "program: message"), or nullopt to go on.
+std::optional<int> ParseCommandLine(CLI::App& app, int argc, char** argv, const char* program);
+
+// Writes "program: STATUS_NAME: message" to stderr and returns 1 (the runtime-error exit code).
+int ReportFailure(const char* program, const grpc::Status& status);
+
+// Waits up to args.connect_timeout_ms for the server; UNAVAILABLE naming the target otherwise.
+grpc::Status WaitForServer(client::DeformClient& client, const ConnectionArgs& args);
+
+}  // namespace deform::cli
