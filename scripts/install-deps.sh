@@ -1,15 +1,18 @@
 #!/usr/bin/env bash
-# Installs the Debian 12 packages that building, testing and running deformd need.
+# Installs Debian 12 packages: those listed in the given files (one per line, '#' comments), by
+# default scripts/packages/build.txt (everything building, testing and running deformd needs).
 # Idempotent: packages already present are skipped; apt runs only when something is missing.
 set -euo pipefail
+HERE="$(cd "$(dirname "$0")" && pwd)"
+LISTS=("$@")
+[ ${#LISTS[@]} -gt 0 ] || LISTS=("$HERE/packages/build.txt")
 
-PACKAGES=(
-  build-essential cmake ninja-build pkg-config
-  libeigen3-dev libmetis-dev
-  libgrpc++-dev protobuf-compiler-grpc libprotobuf-dev protobuf-compiler grpc-proto
-  libspdlog-dev libopenmesh-dev libcli11-dev nlohmann-json3-dev
-  libgtest-dev libgmock-dev libbenchmark-dev
-)
+PACKAGES=()
+for list in "${LISTS[@]}"; do
+  while read -r package _; do
+    [ -n "$package" ] && [ "${package:0:1}" != "#" ] && PACKAGES+=("$package")
+  done <"$list"
+done
 
 missing=()
 for p in "${PACKAGES[@]}"; do

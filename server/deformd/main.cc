@@ -35,37 +35,48 @@ struct Args {
   double shutdown_grace_s = 5;
 };
 
-bool PreloadAll(const Args& args, DeformServer* server) {
-  const deform::MeshLimits limits{args.server.limits.max_vertices,
-                                  deform::MeshLimits{}.max_triangles};
+// One mesh to load before serving: files (--preload MESH:SKELETON) or the phantom
+// (--preload-phantom N). `flag` is the flag as given, for error messages.
+struct PreloadRequest {
+  std::string flag;
+  std::string mesh_path;
+  std::string skeleton_path;
+  int phantom_vertices = 0;
+};
+
+// Every --preload and --preload-phantom, in that order; false (logged) for a malformed spec.
+bool CollectPreloads(const Args& args, std::vector<PreloadRequest>* requests) {
   for (const std::string& spec : args.preload) {
     const std::size_t colon = spec.rfind(':');
     if (colon == std::string::npos || colon == 0 || colon + 1 == spec.size()) {
       spdlog::error("--preload '{}' is not MESH:SKELETON", spec);
       return false;
     }
-    auto input = deform::LoadModelInput(spec.substr(0, colon), spec.substr(colon + 1), 0, limits);
-    if (!input.ok()) {
-      spdlog::error("--preload '{}': {}", spec, input.status().ToString());
-      return false;
-    }
-    const std::string name = input->description;
-    auto entry = server->Preload(std::move(*input), name);
-    if (!entry.ok()) {
-      spdlog::error("--preload '{}': {}", spec, entry.status().ToString());
-      return false;
-    }
+    requests->push_back(
+        {"--preload '" + spec + "'", spec.substr(0, colon), spec.substr(colon + 1), 0});
   }
   for (const int vertices : args.preload_phantom) {
-    auto input = deform::LoadModelInput("", "", vertices, limits);
+    requests->push_back({"--preload-phantom " + std::to_string(vertices), "", "", vertices});
+  }
+  return true;
+}
+
+bool PreloadAll(const Args& args, DeformServer* server) {
+  std::vector<PreloadRequest> requests;
+  if (!CollectPreloads(args, &requests)) return false;
+  const deform::MeshLimits limits{args.server.limits.max_vertices,
+                                  deform::MeshLimits{}.max_triangles};
+  for (const PreloadRequest& request : requests) {
+    auto input = deform::LoadModelInput(request.mesh_path, request.skeleton_path,
+                                        request.phantom_vertices, limits);
     if (!input.ok()) {
-      spdlog::error("--preload-phantom {}: {}", vertices, input.status().ToString());
+      spdlog::error("{}: {}", request.flag, input.status().ToString());
       return false;
     }
     const std::string name = input->description;
     auto entry = server->Preload(std::move(*input), name);
     if (!entry.ok()) {
-      spdlog::error("--preload-phantom {}: {}", vertices, entry.status().ToString());
+      spdlog::error("{}: {}", request.flag, entry.status().ToString());
       return false;
     }
   }
