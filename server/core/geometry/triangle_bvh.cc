@@ -1,0 +1,235 @@
+#include "core/geometry/triangle_bvh.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+namespace deform {
+namespace {
+
+constexpr int kMaxDepth = 64;  // a median split halves the triangles: depth <= log2(F) + 1
+
+// Whether the segment origin + t direction, t in [0, t_max], meets the box.
+bool SegmentTouchesBox(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                       double t_max, const Eigen::Vector3d& lower, const Eigen::Vector3d& upper) {
+  double t0 = 0;
+  double t1 = t_max;
+  for (int axis = 0; axis < 3; ++axis) {
+    const double d = direction[axis];
+    if (std::abs(d) < 1e-300) {
+      if (origin[axis] < lower[axis] || origin[axis] > upper[axis]) return false;
+      continue;
+    }
+    double a = (lower[axis] - origin[axis]) / d;
+    double b = (upper[axis] - origin[axis]) / d;
+    if (a > b) std::swap(a, b);
+    t0 = std::max(t0, a);
+    t1 = std::min(t1, b);
+    if (t0 > t1) return false;
+  }
+  return true;
+}
+
+double SquaredDistanceToBox(const Eigen::Vector3d& p, const Eigen::Vector3d& lower,
+                            const Eigen::Vector3d& upper) {
+  const Eigen::Vector3d clamped = p.cwiseMax(lower).cwiseMin(upper);
+  return (p - clamped).squaredNorm();
+}
+
+// Closest point of triangle abc to p (Ericson, Real-Time Collision Detection, 5.1.5).
+Eigen::Vector3d ClosestPointOnTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                                       const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return a;
+  const Eigen::Vector3d bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return b;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + d1 / (d1 - d3) * ab;
+  const Eigen::Vector3d cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return c;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + d2 / (d2 - d6) * ac;
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+    return b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b);
+  }
+  const double denominator = 1.0 / (va + vb + vc);
+  return a + ab * (vb * denominator) + ac * (vc * denominator);
+}
+
+}  // namespace
+
+TriangleBvh::TriangleBvh(const TriangleMesh& mesh)
+    : positions_(mesh.vertices), triangles_(mesh.triangles) {
+  const int faces = static_cast<int>(triangles_.rows());
+  order_.resize(faces);
+  std::iota(order_.begin(), order_.end(), 0);
+  centroids_.resize(faces);
+  for (int f = 0; f < faces; ++f) {
+    centroids_[f] = (positions_.row(triangles_(f, 0)) + positions_.row(triangles_(f, 1)) +
+                     positions_.row(triangles_(f, 2)))
+                        .transpose() /
+                    3.0;
+  }
+  nodes_.reserve(2 * static_cast<std::size_t>(faces / kLeafTriangles + 1));
+  if (faces > 0) Build(0, faces);
+  std::vector<Eigen::Vector3d>().swap(centroids_);
+}
+
+// Builds the subtree over order_[begin, end); returns its node's index.
+int TriangleBvh::Build(int begin, int end) {
+  const int index = static_cast<int>(nodes_.size());
+  nodes_.emplace_back();
+  Eigen::Vector3d lower = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d upper = -lower;
+  for (int p = begin; p < end; ++p) {
+    for (int c = 0; c < 3; ++c) {
+      const Eigen::Vector3d v = positions_.row(triangles_(order_[p], c)).transpose();
+      lower = lower.cwiseMin(v);
+      upper = upper.cwiseMax(v);
+    }
+  }
+  nodes_[index].lower = lower;
+  nodes_[index].upper = upper;
+  if (end - begin <= kLeafTriangles) {
+    nodes_[index].first = begin;
+    nodes_[index].count = end - begin;
+    return index;
+  }
+  int axis = 0;
+  (upper - lower).maxCoeff(&axis);
+  const int middle = begin + (end - begin) / 2;
+  std::nth_element(order_.begin() + begin, order_.begin() + middle, order_.begin() + end,
+                   [&](int a, int b) { return centroids_[a][axis] < centroids_[b][axis]; });
+  const int left = Build(begin, middle);
+  const int right = Build(middle, end);
+  nodes_[index].left = left;
+  nodes_[index].right = right;
+  return index;
+}
+
+template <typename Visit>
+bool TriangleBvh::ForEachCandidate(const Eigen::Vector3d& from, const Eigen::Vector3d& direction,
+                                   double t_max, Visit visit) const {
+  if (triangles_.rows() == 0) return false;
+  std::array<int, kMaxDepth> stack;
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& node = nodes_[stack[--top]];
+    if (!SegmentTouchesBox(from, direction, t_max, node.lower, node.upper)) continue;
+    if (node.count > 0) {
+      for (int p = node.first; p < node.first + node.count; ++p) {
+        if (visit(order_[p])) return true;
+      }
+    } else {
+      stack[top++] = node.left;
+      stack[top++] = node.right;
+    }
+  }
+  return false;
+}
+
+double TriangleBvh::IntersectTriangle(int f, const Eigen::Vector3d& origin,
+                                      const Eigen::Vector3d& direction) const {
+  // Moller-Trumbore; a hit on an edge or corner counts (a small tolerance on the barycentrics).
+  constexpr double kEdgeTolerance = 1e-9;
+  const Eigen::Vector3d a = positions_.row(triangles_(f, 0)).transpose();
+  const Eigen::Vector3d e1 = positions_.row(triangles_(f, 1)).transpose() - a;
+  const Eigen::Vector3d e2 = positions_.row(triangles_(f, 2)).transpose() - a;
+  const Eigen::Vector3d p = direction.cross(e2);
+  const double determinant = e1.dot(p);
+  if (std::abs(determinant) < 1e-300) return -1;  // parallel to the triangle's plane
+  const double inverse = 1.0 / determinant;
+  const Eigen::Vector3d s = origin - a;
+  const double u = s.dot(p) * inverse;
+  if (u < -kEdgeTolerance || u > 1 + kEdgeTolerance) return -1;
+  const Eigen::Vector3d q = s.cross(e1);
+  const double v = direction.dot(q) * inverse;
+  if (v < -kEdgeTolerance || u + v > 1 + kEdgeTolerance) return -1;
+  return e2.dot(q) * inverse;
+}
+
+bool TriangleBvh::SegmentCrossesSurface(const Eigen::Vector3d& from, const Eigen::Vector3d& to,
+                                        int skip_vertex, double margin) const {
+  const Eigen::Vector3d direction = to - from;
+  const double length = direction.norm();
+  if (!(length > 2 * margin)) return false;
+  const double t_low = margin / length;
+  const double t_high = 1 - t_low;
+  return ForEachCandidate(from, direction, 1.0, [&](int f) {
+    if (triangles_(f, 0) == skip_vertex || triangles_(f, 1) == skip_vertex ||
+        triangles_(f, 2) == skip_vertex) {
+      return false;
+    }
+    const double t = IntersectTriangle(f, from, direction);
+    return t >= t_low && t <= t_high;
+  });
+}
+
+int TriangleBvh::CountRayCrossings(const Eigen::Vector3d& origin,
+                                   const Eigen::Vector3d& direction) const {
+  if (triangles_.rows() == 0) return 0;
+  // The box test needs a finite end: beyond the root box nothing can be hit.
+  const Node& root = nodes_[0];
+  const double reach = (root.upper - root.lower).norm() + (origin - root.lower).norm() +
+                       (origin - root.upper).norm();
+  const double scale = reach / direction.norm();
+  int crossings = 0;
+  ForEachCandidate(origin, direction * scale, 1.0, [&](int f) {
+    if (IntersectTriangle(f, origin, direction) > 0) ++crossings;
+    return false;
+  });
+  return crossings;
+}
+
+bool TriangleBvh::Contains(const Eigen::Vector3d& point) const {
+  if (triangles_.rows() == 0) return false;
+  // Skew directions, unlikely to run along an edge of a modelled mesh.
+  static const std::array<Eigen::Vector3d, 3> kDirections = {
+      Eigen::Vector3d(0.5773, 0.5774, 0.5772), Eigen::Vector3d(-0.6123, 0.3536, -0.7071),
+      Eigen::Vector3d(0.2672, -0.8018, 0.5345)};
+  int inside = 0;
+  for (const Eigen::Vector3d& direction : kDirections) {
+    inside += CountRayCrossings(point, direction) % 2;
+  }
+  return inside >= 2;
+}
+
+double TriangleBvh::DistanceToSurface(const Eigen::Vector3d& point) const {
+  double best = std::numeric_limits<double>::infinity();
+  if (triangles_.rows() == 0) return best;
+  std::array<int, kMaxDepth> stack;
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& node = nodes_[stack[--top]];
+    if (SquaredDistanceToBox(point, node.lower, node.upper) >= best * best) continue;
+    if (node.count > 0) {
+      for (int p = node.first; p < node.first + node.count; ++p) {
+        const int f = order_[p];
+        const Eigen::Vector3d closest =
+            ClosestPointOnTriangle(point, positions_.row(triangles_(f, 0)).transpose(),
+                                   positions_.row(triangles_(f, 1)).transpose(),
+                                   positions_.row(triangles_(f, 2)).transpose());
+        best = std::min(best, (closest - point).norm());
+      }
+    } else {
+      // Nearer child last, so it is popped first.
+      const double left =
+          SquaredDistanceToBox(point, nodes_[node.left].lower, nodes_[node.left].upper);
+      const double right =
+          SquaredDistanceToBox(point, nodes_[node.right].lower, nodes_[node.right].upper);
+      stack[top++] = left < right ? node.right : node.left;
+      stack[top++] = left < right ? node.left : node.right;
+    }
+  }
+  return best;
+}
+
+}  // namespace deform

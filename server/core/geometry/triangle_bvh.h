@@ -1,0 +1,67 @@
+// A bounding-volume hierarchy over a triangle mesh's faces, for the queries binding needs: does a
+// segment cross the surface, how many times does a ray cross it, is a point inside a closed mesh.
+//
+// Built once in O(F log F) (axis-aligned boxes, median split on the longest axis, at most
+// kLeafTriangles per leaf); holds its own copy of the positions and triangles. Queries are const,
+// allocate nothing beyond a small fixed stack, and are safe from any number of threads.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <vector>
+
+#include "core/geometry/mesh.h"
+
+namespace deform {
+
+class TriangleBvh {
+ public:
+  static constexpr int kLeafTriangles = 4;
+
+  explicit TriangleBvh(const TriangleMesh& mesh);
+
+  // Whether the segment from `from` to `to` crosses a triangle of the mesh, ignoring the triangles
+  // that have `skip_vertex` as a corner (pass the vertex the segment starts at, or -1) and hits
+  // closer than `margin` to either end (model units). Grazing an edge counts as a crossing.
+  bool SegmentCrossesSurface(const Eigen::Vector3d& from, const Eigen::Vector3d& to,
+                             int skip_vertex, double margin) const;
+
+  // The number of triangles the ray origin + t direction, t > 0, crosses.
+  int CountRayCrossings(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction) const;
+
+  // Whether `point` lies inside the surface: the parity of the crossings of three rays in fixed,
+  // skew directions, by majority. Meaningful for closed meshes; for an open mesh it answers for
+  // the surface closed by whatever the rays see.
+  bool Contains(const Eigen::Vector3d& point) const;
+
+  // The smallest distance from `point` to the surface (exact, by descending the tree).
+  double DistanceToSurface(const Eigen::Vector3d& point) const;
+
+ private:
+  struct Node {
+    Eigen::Vector3d lower;
+    Eigen::Vector3d upper;
+    int first = 0;  // leaf: its triangles are order_[first, first + count)
+    int count = 0;  // > 0 for a leaf, 0 for an inner node
+    int left = -1;  // inner node: its children
+    int right = -1;
+  };
+
+  int Build(int begin, int end);
+  // Calls visit(triangle) for every triangle in a leaf whose box the segment [from, from + t dir],
+  // t in [0, t_max], touches; stops early when visit returns true. Returns whether it stopped.
+  template <typename Visit>
+  bool ForEachCandidate(const Eigen::Vector3d& from, const Eigen::Vector3d& direction, double t_max,
+                        Visit visit) const;
+  // The parameter t > 0 at which the ray hits triangle f, or a negative number for no hit.
+  double IntersectTriangle(int f, const Eigen::Vector3d& origin,
+                           const Eigen::Vector3d& direction) const;
+
+  Positions positions_;
+  Triangles triangles_;
+  std::vector<int> order_;  // triangle indices, grouped by leaf
+  std::vector<Eigen::Vector3d> centroids_;
+  std::vector<Node> nodes_;
+};
+
+}  // namespace deform
