@@ -1,0 +1,179 @@
+#include "core/model/binding_report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+namespace deform {
+namespace {
+
+std::string Format(const char* format, double value) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, format, value);
+  return buffer;
+}
+
+std::string BoneName(const Skeleton& skeleton, int bone) {
+  return skeleton.joint(skeleton.bone(bone).head_joint).name + "->" +
+         skeleton.joint(skeleton.bone(bone).tail_joint).name;
+}
+
+double DistanceToBone(const Skeleton& skeleton, int bone, const Eigen::Vector3d& p) {
+  const Bone& b = skeleton.bone(bone);
+  return PointSegmentDistance(p, skeleton.joint(b.head_joint).rest_position,
+                              skeleton.joint(b.tail_joint).rest_position);
+}
+
+// Connected pieces of the vertices whose label equals `bone`, each a list of vertices.
+std::vector<std::vector<int>> Pieces(const VertexAdjacency& adjacency,
+                                     const std::vector<int>& rigid_bone, int bone,
+                                     std::vector<char>* seen) {
+  std::vector<std::vector<int>> pieces;
+  const int n = static_cast<int>(rigid_bone.size());
+  for (int start = 0; start < n; ++start) {
+    if (rigid_bone[start] != bone || (*seen)[start]) continue;
+    std::vector<int> piece{start};
+    (*seen)[start] = 1;
+    for (std::size_t q = 0; q < piece.size(); ++q) {
+      const int i = piece[q];
+      for (int p = adjacency.offsets[i]; p < adjacency.offsets[i + 1]; ++p) {
+        const int j = adjacency.neighbors[p];
+        if (rigid_bone[j] == bone && !(*seen)[j]) {
+          (*seen)[j] = 1;
+          piece.push_back(j);
+        }
+      }
+    }
+    pieces.push_back(std::move(piece));
+  }
+  std::sort(pieces.begin(), pieces.end(),
+            [](const auto& a, const auto& b) { return a.size() > b.size(); });
+  return pieces;
+}
+
+// The smallest distance between a vertex of `piece` and one of `main` (the main piece sampled
+// with a stride so that the work stays below about 2e7 pairs).
+double PieceGap(const Positions& vertices, const std::vector<int>& piece,
+                const std::vector<int>& main) {
+  const std::size_t pairs = piece.size() * main.size();
+  const std::size_t stride = std::max<std::size_t>(1, pairs / 20'000'000 + 1);
+  double gap = std::numeric_limits<double>::infinity();
+  for (int i : piece) {
+    for (std::size_t m = 0; m < main.size(); m += stride) {
+      gap = std::min(gap, (vertices.row(i) - vertices.row(main[m])).norm());
+    }
+  }
+  return gap;
+}
+
+double Median(std::vector<double> values) {
+  if (values.empty()) return 0;
+  const auto middle = values.begin() + values.size() / 2;
+  std::nth_element(values.begin(), middle, values.end());
+  return *middle;
+}
+
+void ReportBone(const TriangleMesh& mesh, const Skeleton& skeleton,
+                const VertexAdjacency& adjacency, const std::vector<int>& bound_bone,
+                const std::vector<int>& rigid_bone, double diagonal, std::vector<char>* seen,
+                BoneBinding* report, std::vector<std::string>* warnings) {
+  const int k = report->bone;
+  std::vector<double> distances;
+  for (int i = 0; i < mesh.num_vertices(); ++i) {
+    if (bound_bone[i] != k) continue;
+    ++report->vertices;
+    report->rigid_vertices += rigid_bone[i] == k;
+    distances.push_back(DistanceToBone(skeleton, k, mesh.vertices.row(i).transpose()));
+  }
+  report->thickness = 2 * Median(distances);
+  for (double d : distances) report->beyond_thickness += d > report->thickness;
+
+  const std::vector<std::vector<int>> pieces = Pieces(adjacency, rigid_bone, k, seen);
+  for (const auto& piece : pieces) report->pieces.push_back(static_cast<int>(piece.size()));
+  for (std::size_t p = 1; p < pieces.size(); ++p) {
+    report->farthest_piece =
+        std::max(report->farthest_piece, PieceGap(mesh.vertices, pieces[p], pieces[0]));
+  }
+  const double far_apart = std::max(2 * report->thickness, 0.05 * diagonal);
+  if (pieces.size() > 1 && report->farthest_piece > far_apart) {
+    warnings->push_back("bone " + report->name + ": its rigid zone falls into " +
+                        std::to_string(pieces.size()) + " pieces, one " +
+                        Format("%.3g", report->farthest_piece / diagonal) +
+                        " diagonals from the largest (a part bound to the wrong bone?)");
+  }
+  if (report->vertices == 0) {
+    warnings->push_back("bone " + report->name + ": no vertex follows it");
+  } else if (report->rigid_vertices > 0 && report->beyond_thickness > report->vertices / 20) {
+    warnings->push_back("bone " + report->name + ": " + std::to_string(report->beyond_thickness) +
+                        " of its " + std::to_string(report->vertices) +
+                        " vertices lie farther from it than the limb is thick (" +
+                        Format("%.3g", report->thickness) + ")");
+  }
+}
+
+}  // namespace
+
+Status CheckSkeletonAgainstMesh(const TriangleMesh& mesh, const Skeleton& skeleton,
+                                const TriangleBvh& bvh) {
+  const double diagonal = BoundingBoxDiagonal(mesh.vertices);
+  const Eigen::Vector3d lower =
+      mesh.vertices.colwise().minCoeff().transpose().array() - 0.01 * diagonal;
+  const Eigen::Vector3d upper =
+      mesh.vertices.colwise().maxCoeff().transpose().array() + 0.01 * diagonal;
+  bool any_inside_box = false;
+  for (const Joint& joint : skeleton.joints()) {
+    const Eigen::Vector3d& p = joint.rest_position;
+    any_inside_box |= (p.array() >= lower.array()).all() && (p.array() <= upper.array()).all();
+    const double distance = bvh.DistanceToSurface(p);
+    if (distance > diagonal) {
+      return Status::InvalidArgument(
+          "joint '" + joint.name + "' lies " + Format("%.3g", distance / diagonal) +
+          " mesh diagonals from the mesh's surface: the skeleton does not belong to this mesh "
+          "(same units and placement?)");
+    }
+  }
+  if (!any_inside_box) {
+    return Status::InvalidArgument(
+        "no joint of the skeleton lies within the mesh's bounding box: the skeleton does not "
+        "belong to this mesh (same units and placement?)");
+  }
+  return Status::Ok();
+}
+
+BindingReport ReportBinding(const TriangleMesh& mesh, const Skeleton& skeleton,
+                            const VertexAdjacency& adjacency, const TriangleBvh& bvh,
+                            const std::vector<int>& bound_bone, const std::vector<int>& rigid_bone,
+                            const std::vector<int>& anchors, bool closed) {
+  const double diagonal = BoundingBoxDiagonal(mesh.vertices);
+  BindingReport report;
+  std::vector<char> seen(mesh.num_vertices(), 0);
+  for (int k = 0; k < skeleton.num_bones(); ++k) {
+    BoneBinding bone;
+    bone.bone = k;
+    bone.name = BoneName(skeleton, k);
+    ReportBone(mesh, skeleton, adjacency, bound_bone, rigid_bone, diagonal, &seen, &bone,
+               &report.warnings);
+    report.bones.push_back(std::move(bone));
+  }
+  for (int a : anchors) {
+    if (rigid_bone[a] >= 0) ++report.bones[rigid_bone[a]].anchors;
+  }
+  for (const Joint& joint : skeleton.joints()) {
+    const double distance = bvh.DistanceToSurface(joint.rest_position);
+    const bool outside = closed ? !bvh.Contains(joint.rest_position) : false;
+    if (outside && distance > 0.01 * diagonal) {
+      report.joints_outside.push_back(joint.name);
+      report.warnings.push_back("joint '" + joint.name + "' lies outside the mesh, " +
+                                Format("%.3g", distance / diagonal) +
+                                " diagonals from its surface");
+    } else if (!closed && distance > 0.25 * diagonal) {
+      report.warnings.push_back("joint '" + joint.name + "' lies " +
+                                Format("%.3g", distance / diagonal) +
+                                " diagonals from the mesh's surface");
+    }
+  }
+  return report;
+}
+
+}  // namespace deform

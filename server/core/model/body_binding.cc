@@ -1,0 +1,114 @@
+#include "core/model/body_binding.h"
+
+#include <algorithm>
+#include <functional>
+#include <limits>
+#include <queue>
+#include <utility>
+
+namespace deform {
+namespace {
+
+NearestBone MeasureToBone(const Skeleton& skeleton, int bone, const Eigen::Vector3d& p) {
+  const Bone& b = skeleton.bone(bone);
+  const Eigen::Vector3d head = skeleton.joint(b.head_joint).rest_position;
+  const Eigen::Vector3d tail = skeleton.joint(b.tail_joint).rest_position;
+  NearestBone result;
+  result.bone = bone;
+  result.parameter = ClosestSegmentParameter(p, head, tail);
+  result.distance = (head + result.parameter * (tail - head) - p).norm();
+  return result;
+}
+
+// The first of the vertex's nearest bones whose closest point it sees through the body, or a
+// NearestBone with bone -1.
+NearestBone FirstVisibleBone(const Skeleton& skeleton, const TriangleBvh& bvh,
+                             const Eigen::Vector3d& p, int vertex, int max_candidates,
+                             double distance_ratio, double margin, std::vector<NearestBone>* candidates, int* tested) {
+  candidates->clear();
+  for (int k = 0; k < skeleton.num_bones(); ++k) {
+    candidates->push_back(MeasureToBone(skeleton, k, p));
+  }
+  const int count = std::min<int>(max_candidates, static_cast<int>(candidates->size()));
+  std::partial_sort(candidates->begin(), candidates->begin() + count, candidates->end(),
+                    [](const NearestBone& a, const NearestBone& b) {
+                      return a.distance < b.distance || (a.distance == b.distance && a.bone < b.bone);
+                    });
+  const double farthest = (*candidates)[0].distance * distance_ratio;
+  for (int c = 0; c < count && (*candidates)[c].distance <= farthest; ++c) {
+    const NearestBone& candidate = (*candidates)[c];
+    const Bone& b = skeleton.bone(candidate.bone);
+    const Eigen::Vector3d head = skeleton.joint(b.head_joint).rest_position;
+    const Eigen::Vector3d target =
+        head + candidate.parameter * (skeleton.joint(b.tail_joint).rest_position - head);
+    ++*tested;
+    if (!bvh.SegmentCrossesSurface(p, target, vertex, margin)) return candidate;
+  }
+  return NearestBone{};
+}
+
+// Gives every vertex with bone -1 the bone of the nearest bound vertex along mesh edges (multi-
+// source Dijkstra); returns how many it reached.
+int PropagateAlongSurface(const TriangleMesh& mesh, const VertexAdjacency& adjacency,
+                          std::vector<int>* bone) {
+  const int n = mesh.num_vertices();
+  std::vector<double> distance(n, std::numeric_limits<double>::infinity());
+  using Entry = std::pair<double, int>;
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> queue;
+  for (int i = 0; i < n; ++i) {
+    if ((*bone)[i] >= 0) {
+      distance[i] = 0;
+      queue.emplace(0.0, i);
+    }
+  }
+  int reached = 0;
+  while (!queue.empty()) {
+    const auto [d, i] = queue.top();
+    queue.pop();
+    if (d > distance[i]) continue;
+    for (int p = adjacency.offsets[i]; p < adjacency.offsets[i + 1]; ++p) {
+      const int j = adjacency.neighbors[p];
+      const double through = d + (mesh.vertices.row(i) - mesh.vertices.row(j)).norm();
+      if (through < distance[j]) {
+        if (distance[j] == std::numeric_limits<double>::infinity()) ++reached;
+        distance[j] = through;
+        (*bone)[j] = (*bone)[i];
+        queue.emplace(through, j);
+      }
+    }
+  }
+  return reached;
+}
+
+}  // namespace
+
+BodyBinding BindThroughBody(const TriangleMesh& mesh, const Skeleton& skeleton,
+                            const VertexAdjacency& adjacency, const TriangleBvh& bvh,
+                            int max_candidates, double distance_ratio) {
+  const int n = mesh.num_vertices();
+  const double margin = 1e-7 * BoundingBoxDiagonal(mesh.vertices);
+  BodyBinding result;
+  std::vector<int> bone(n, -1);
+  std::vector<NearestBone> candidates;
+  for (int i = 0; i < n; ++i) {
+    const NearestBone visible =
+        FirstVisibleBone(skeleton, bvh, mesh.vertices.row(i).transpose(), i, max_candidates,
+                         distance_ratio, margin, &candidates, &result.candidates_tested);
+    bone[i] = visible.bone;
+    if (visible.bone >= 0) ++result.seen_through_body;
+  }
+  result.reached_along_surface = PropagateAlongSurface(mesh, adjacency, &bone);
+  const std::vector<NearestBone> straight = NearestBones(mesh.vertices, skeleton);
+  result.bones.resize(n);
+  for (int i = 0; i < n; ++i) {
+    if (bone[i] < 0) {
+      result.bones[i] = straight[i];
+      ++result.straight_line;
+    } else {
+      result.bones[i] = MeasureToBone(skeleton, bone[i], mesh.vertices.row(i).transpose());
+    }
+  }
+  return result;
+}
+
+}  // namespace deform

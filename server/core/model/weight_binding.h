@@ -1,0 +1,31 @@
+// The binding a rig's own skinning weights give (used instead of binding through the body when a
+// client supplies weights): the weights are the rotation field; a vertex that follows one bone
+// alone (weight 1) is in that bone's rigid zone; a vertex that blends bones joins the region of a
+// joint between them.
+#pragma once
+
+#include <vector>
+
+#include "core/geometry/mesh.h"
+#include "core/geometry/skeleton.h"
+#include "core/geometry/skin_weights.h"
+
+namespace deform {
+
+struct WeightBinding {
+  std::vector<int> rigid_bone;    // per vertex: the bone it follows alone, or -1 (it blends)
+  std::vector<int> region_joint;  // per blending vertex: the inner joint whose region it joins,
+                                  // or -1 when no inner joint lies between its bones
+  std::vector<int> main_bone;     // per vertex: its largest weight's bone
+};
+
+// A vertex is rigid when one bone carries at least 1 - kRigidTolerance of its weight.
+inline constexpr double kRigidTolerance = 1e-6;
+
+// `weights` must be normalised for this mesh and skeleton (NormalizeSkinWeights). A blending
+// vertex's region: of the inner joints on the skeleton path between its two largest weights' bones
+// (the joint they share when they meet), the one nearest to the vertex.
+WeightBinding BindFromWeights(const TriangleMesh& mesh, const Skeleton& skeleton,
+                              const SkinWeights& weights);
+
+}  // namespace deform
