@@ -19,14 +19,14 @@ namespace deform {
 
 struct BoneBinding {
   int bone = -1;
-  std::string name;            // "head->tail", the joints' names
-  int vertices = 0;            // vertices bound to the bone (rigid zone and joint regions)
-  int rigid_vertices = 0;      // vertices that follow it alone
-  std::vector<int> pieces;     // sizes of its rigid zone's connected pieces, largest first
-  double farthest_piece = 0;   // distance from the largest piece to the farthest other piece
+  std::string name;           // "head->tail", the joints' names
+  int vertices = 0;           // vertices bound to the bone (rigid zone and joint regions)
+  int rigid_vertices = 0;     // vertices that follow it alone
+  std::vector<int> pieces;    // sizes of its rigid zone's connected pieces, largest first
+  double farthest_piece = 0;  // distance from the largest piece to the farthest other piece
   int anchors = 0;
-  double thickness = 0;        // twice the median distance of its vertices from the bone
-  int beyond_thickness = 0;    // vertices bound farther from the bone than `thickness`
+  double thickness = 0;      // twice the median distance of its vertices from the bone
+  int beyond_thickness = 0;  // vertices bound farther from the bone than `thickness`
 };
 
 struct BindingReport {

@@ -24,7 +24,8 @@ NearestBone MeasureToBone(const Skeleton& skeleton, int bone, const Eigen::Vecto
 // NearestBone with bone -1.
 NearestBone FirstVisibleBone(const Skeleton& skeleton, const TriangleBvh& bvh,
                              const Eigen::Vector3d& p, int vertex, int max_candidates,
-                             double distance_ratio, double margin, std::vector<NearestBone>* candidates, int* tested) {
+                             double distance_ratio, double margin,
+                             std::vector<NearestBone>* candidates, int* tested) {
   candidates->clear();
   for (int k = 0; k < skeleton.num_bones(); ++k) {
     candidates->push_back(MeasureToBone(skeleton, k, p));
@@ -32,7 +33,8 @@ NearestBone FirstVisibleBone(const Skeleton& skeleton, const TriangleBvh& bvh,
   const int count = std::min<int>(max_candidates, static_cast<int>(candidates->size()));
   std::partial_sort(candidates->begin(), candidates->begin() + count, candidates->end(),
                     [](const NearestBone& a, const NearestBone& b) {
-                      return a.distance < b.distance || (a.distance == b.distance && a.bone < b.bone);
+                      return a.distance < b.distance ||
+                             (a.distance == b.distance && a.bone < b.bone);
                     });
   const double farthest = (*candidates)[0].distance * distance_ratio;
   for (int c = 0; c < count && (*candidates)[c].distance <= farthest; ++c) {

@@ -75,8 +75,8 @@ WeightBinding BindFromWeights(const TriangleMesh& mesh, const Skeleton& skeleton
       result.rigid_bone[i] = first;
       continue;
     }
-    result.region_joint[i] = NearestInnerJoint(skeleton, inner, JointsBetween(skeleton, first, second),
-                                               mesh.vertices.row(i).transpose());
+    result.region_joint[i] = NearestInnerJoint(
+        skeleton, inner, JointsBetween(skeleton, first, second), mesh.vertices.row(i).transpose());
   }
   return result;
 }
