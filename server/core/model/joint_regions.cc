@@ -83,11 +83,7 @@ StatusOr<JointRegions> ComputeJointRegions(const TriangleMesh& mesh, const Skele
     return Status::InvalidArgument("joint region radius factor must be positive and finite");
   }
 
-  JointRegions result;
-  result.relative_distance.assign(n, std::numeric_limits<double>::infinity());
-  result.nearest_region.assign(n, -1);
-  std::vector<std::vector<int>> memberships(n);
-  std::vector<char> in_region(n, 0);
+  std::vector<JointRegion> regions;
   for (int joint : inner) {
     JointRegion region;
     region.joint = joint;
@@ -97,31 +93,49 @@ StatusOr<JointRegions> ComputeJointRegions(const TriangleMesh& mesh, const Skele
     for (const auto& [j, radius] : options.explicit_radius) {
       if (j == joint) region.radius = radius;
     }
-    const int index = static_cast<int>(result.regions.size());
+    for (int i = 0; i < n; ++i) {
+      const double d = (mesh.vertices.row(i).transpose() - region.centre).norm();
+      if (d <= region.radius && BoneTouchesJoint(skeleton, nearest[i].bone, joint)) {
+        region.vertices.push_back(i);
+      }
+    }
+    regions.push_back(std::move(region));
+  }
+  return AssembleJointRegions(mesh, adjacency, std::move(regions));
+}
+
+JointRegions AssembleJointRegions(const TriangleMesh& mesh, const VertexAdjacency& adjacency,
+                                  std::vector<JointRegion> regions) {
+  const int n = mesh.num_vertices();
+  JointRegions result;
+  result.relative_distance.assign(n, std::numeric_limits<double>::infinity());
+  result.nearest_region.assign(n, -1);
+  std::vector<std::vector<int>> memberships(n);
+  for (int index = 0; index < static_cast<int>(regions.size()); ++index) {
+    JointRegion& region = regions[index];
     for (int i = 0; i < n; ++i) {
       const double d = (mesh.vertices.row(i).transpose() - region.centre).norm();
       if (region.radius > 0 && d / region.radius < result.relative_distance[i]) {
         result.relative_distance[i] = d / region.radius;
         result.nearest_region[i] = index;
       }
-      if (d <= region.radius && BoneTouchesJoint(skeleton, nearest[i].bone, joint)) {
-        region.vertices.push_back(i);
-        memberships[i].push_back(index);
-        in_region[i] = 1;
-      }
     }
+    for (int i : region.vertices) memberships[i].push_back(index);
+  }
+  for (int index = 0; index < static_cast<int>(regions.size()); ++index) {
+    JointRegion& region = regions[index];
+    region.seam_vertices.clear();
     for (int i : region.vertices) {
       for (int p = adjacency.offsets[i]; p < adjacency.offsets[i + 1]; ++p) {
-        const int u = adjacency.neighbors[p];
-        const auto& m = memberships[u];
+        const auto& m = memberships[adjacency.neighbors[p]];
         if (std::find(m.begin(), m.end(), index) == m.end()) {
           region.seam_vertices.push_back(i);
           break;
         }
       }
     }
-    result.regions.push_back(std::move(region));
   }
+  result.regions = std::move(regions);
   result.membership_offsets.assign(n + 1, 0);
   for (int i = 0; i < n; ++i) {
     result.membership_offsets[i + 1] =

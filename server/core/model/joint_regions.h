@@ -49,4 +49,10 @@ StatusOr<JointRegions> ComputeJointRegions(const TriangleMesh& mesh, const Skele
                                            const std::vector<NearestBone>& nearest,
                                            const JointRegionOptions& options);
 
+// The per-vertex parts of JointRegions for regions whose joint, centre, radii and vertices are
+// set: relative distances and nearest regions (by each region's radius), seam vertices (a
+// neighbour outside the region) and memberships. Regions are numbered in the order given.
+JointRegions AssembleJointRegions(const TriangleMesh& mesh, const VertexAdjacency& adjacency,
+                                  std::vector<JointRegion> regions);
+
 }  // namespace deform

@@ -81,4 +81,35 @@ WeightBinding BindFromWeights(const TriangleMesh& mesh, const Skeleton& skeleton
   return result;
 }
 
+JointRegions RegionsFromWeightBinding(const TriangleMesh& mesh, const Skeleton& skeleton,
+                                      const VertexAdjacency& adjacency,
+                                      const WeightBinding& binding) {
+  const int n = mesh.num_vertices();
+  const std::vector<int> inner = skeleton.InnerJoints();
+  std::vector<std::vector<int>> region_vertices(inner.size());
+  for (int i = 0; i < n; ++i) {
+    const auto it = std::find(inner.begin(), inner.end(), binding.region_joint[i]);
+    if (it != inner.end()) region_vertices[it - inner.begin()].push_back(i);
+  }
+  std::vector<JointRegion> regions;
+  for (std::size_t r = 0; r < inner.size(); ++r) {
+    JointRegion region;
+    region.joint = inner[r];
+    region.centre = skeleton.joint(inner[r]).rest_position;
+    std::vector<double> distances;
+    for (int i : region_vertices[r]) {
+      distances.push_back((mesh.vertices.row(i).transpose() - region.centre).norm());
+    }
+    if (!distances.empty()) {
+      region.radius = *std::max_element(distances.begin(), distances.end());
+      std::nth_element(distances.begin(), distances.begin() + distances.size() / 2,
+                       distances.end());
+      region.limb_radius = distances[distances.size() / 2];
+    }
+    region.vertices = std::move(region_vertices[r]);
+    regions.push_back(std::move(region));
+  }
+  return AssembleJointRegions(mesh, adjacency, std::move(regions));
+}
+
 }  // namespace deform

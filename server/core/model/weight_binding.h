@@ -7,8 +7,10 @@
 #include <vector>
 
 #include "core/geometry/mesh.h"
+#include "core/geometry/mesh_topology.h"
 #include "core/geometry/skeleton.h"
 #include "core/geometry/skin_weights.h"
+#include "core/model/joint_regions.h"
 
 namespace deform {
 
@@ -27,5 +29,13 @@ inline constexpr double kRigidTolerance = 1e-6;
 // (the joint they share when they meet), the one nearest to the vertex.
 WeightBinding BindFromWeights(const TriangleMesh& mesh, const Skeleton& skeleton,
                               const SkinWeights& weights);
+
+// The joint regions of a weight binding: region c holds the vertices whose region_joint is c's
+// joint (one region per inner joint, in Skeleton::InnerJoints() order, possibly empty). Its radius
+// is the largest distance of those vertices from the joint centre, its limb radius the median; the
+// per-vertex relative distances and nearest regions are measured with those radii.
+JointRegions RegionsFromWeightBinding(const TriangleMesh& mesh, const Skeleton& skeleton,
+                                      const VertexAdjacency& adjacency,
+                                      const WeightBinding& binding);
 
 }  // namespace deform
