@@ -4,6 +4,45 @@
 #include <string>
 
 namespace deform::service {
+namespace {
+
+// Largest translation a root transform may carry, in model units (beyond it float32 frames lose
+// every digit of a limb's shape).
+constexpr double kMaxRootTranslation = 1e9;
+
+// The unit quaternion of (w, x, y, z), scaled before normalising so that huge finite components
+// (1e155) are not squared into infinity. INVALID_ARGUMENT for NaN, infinite or all-zero input.
+StatusOr<Eigen::Quaterniond> UnitQuaternion(double w, double x, double y, double z,
+                                            const std::string& what) {
+  const Eigen::Vector4d q(w, x, y, z);
+  if (!q.allFinite()) {
+    return Status::InvalidArgument(what + " has a NaN or infinite component");
+  }
+  const double largest = q.cwiseAbs().maxCoeff();
+  if (!(largest > 0)) return Status::InvalidArgument(what + " is the zero quaternion");
+  const Eigen::Vector4d unit = (q / largest).normalized();
+  return Eigen::Quaterniond(unit[0], unit[1], unit[2], unit[3]);
+}
+
+Status RootFromProto(const v1::RootTransform& root, RigidTransform* transform) {
+  *transform = RigidTransform();
+  if (root.has_rotation()) {
+    const v1::Quaternion& r = root.rotation();
+    DEFORM_ASSIGN_OR_RETURN(transform->rotation,
+                            UnitQuaternion(r.w(), r.x(), r.y(), r.z(), "root rotation"));
+  }
+  if (root.has_translation()) {
+    const v1::Vector3& t = root.translation();
+    transform->translation = Eigen::Vector3d(t.x(), t.y(), t.z());
+    if (!transform->translation.allFinite() ||
+        transform->translation.cwiseAbs().maxCoeff() > kMaxRootTranslation) {
+      return Status::InvalidArgument("root translation must be finite and within 1e9 units");
+    }
+  }
+  return Status::Ok();
+}
+
+}  // namespace
 
 Status PoseInputFromProto(const v1::PoseUpdate& update, const Skeleton& skeleton,
                           PoseInput* input) {
@@ -14,17 +53,10 @@ Status PoseInputFromProto(const v1::PoseUpdate& update, const Skeleton& skeleton
   for (const v1::JointRotation& rotation : update.rotations()) {
     auto joint = skeleton.FindJoint(rotation.joint());
     if (!joint.ok()) return Status::InvalidArgument("rotation: " + joint.status().message());
-    const Eigen::Quaterniond q(rotation.w(), rotation.x(), rotation.y(), rotation.z());
-    if (!q.coeffs().allFinite()) {
-      return Status::InvalidArgument("rotation of joint '" + rotation.joint() +
-                                     "' has a NaN or infinite component");
-    }
-    const double norm = q.norm();
-    if (!(norm > 1e-12)) {
-      return Status::InvalidArgument("rotation of joint '" + rotation.joint() +
-                                     "' is the zero quaternion");
-    }
-    input->rotations.emplace_back(*joint, Eigen::Quaterniond(q.coeffs() / norm));
+    DEFORM_ASSIGN_OR_RETURN(const Eigen::Quaterniond q,
+                            UnitQuaternion(rotation.w(), rotation.x(), rotation.y(), rotation.z(),
+                                           "rotation of joint '" + rotation.joint() + "'"));
+    input->rotations.emplace_back(*joint, q);
   }
   for (const v1::JointAngle& angle : update.angles()) {
     auto joint = skeleton.FindJoint(angle.joint());
@@ -57,7 +89,7 @@ Status PoseInputFromProto(const v1::PoseUpdate& update, const Skeleton& skeleton
     }
     input->angles.push_back(term);
   }
-  return Status::Ok();
+  return RootFromProto(update.root(), &input->root);
 }
 
 StatusOr<int> PoseFromInput(const Skeleton& skeleton, const PoseInput& input, Pose* pose) {
@@ -68,6 +100,7 @@ StatusOr<int> PoseFromInput(const Skeleton& skeleton, const PoseInput& input, Po
     q = it->second * q;
     q.normalize();
   }
+  pose->root = input.root;
   return clamped;
 }
 

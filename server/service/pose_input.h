@@ -24,16 +24,19 @@ struct PoseInput {
   std::chrono::steady_clock::time_point arrival;
   std::vector<PoseTerm> angles;                               // in the order sent
   std::vector<std::pair<int, Eigen::Quaterniond>> rotations;  // unit quaternions, in order
+  RigidTransform root;                                        // the whole body's placement
 };
 
 // Fills `input` from `update` (sequence, timestamp, resolved angles and rotations; `arrival` is
 // left to the caller). INVALID_ARGUMENT naming the problem for an unknown joint or axis, an angle
-// or quaternion component that is NaN or infinite, or a zero quaternion.
+// or quaternion component that is NaN or infinite, a zero quaternion (huge finite components are
+// scaled, never squared into infinity), or a root translation that is not finite or beyond 1e9
+// model units.
 Status PoseInputFromProto(const v1::PoseUpdate& update, const Skeleton& skeleton, PoseInput* input);
 
 // The core pose of `input`: per joint, its rotations (composed in order), then its angles
-// (composed in order, named degrees of freedom clamped to their range). Returns the number of
-// angles clamped. `pose`'s buffers are reused: allocation-free once sized.
+// (composed in order, named degrees of freedom clamped to their range), and the root transform.
+// Returns the number of angles clamped. `pose`'s buffers are reused: allocation-free once sized.
 StatusOr<int> PoseFromInput(const Skeleton& skeleton, const PoseInput& input, Pose* pose);
 
 }  // namespace deform::service
