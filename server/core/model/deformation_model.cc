@@ -178,8 +178,9 @@ StatusOr<std::shared_ptr<const MaterialFactorization>> DeformationModel::Factori
     }
     result->row_weights_ = Eigen::VectorXd::Ones(n);
   } else {
-    DEFORM_ASSIGN_OR_RETURN(result->row_weights_,
-                            MaterialRowWeights(regions_, n, options_.default_material, stiffness));
+    DEFORM_ASSIGN_OR_RETURN(
+        result->row_weights_,
+        MaterialRowWeights(regions_, skeleton_, n, options_.default_material, stiffness));
   }
   result->row_weights_squared_ = result->row_weights_.array().square();
 
