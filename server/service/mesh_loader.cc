@@ -20,9 +20,8 @@ StatusOr<std::shared_ptr<const MeshEntry>> BuildAndRegister(MeshRegistry* regist
                                                             const LoadProgress& progress) {
   job.options.limits.max_vertices = registry->limits().max_vertices;
   DEFORM_RETURN_IF_ERROR(ValidateMesh(job.mesh, job.options.limits).WithContext("mesh"));
-  const std::size_t geometry_bytes = static_cast<std::size_t>(job.mesh.num_vertices()) * 400 +
-                                     static_cast<std::size_t>(job.mesh.num_triangles()) * 12;
-  DEFORM_RETURN_IF_ERROR(registry->CheckMemoryAvailable(geometry_bytes));
+  DEFORM_RETURN_IF_ERROR(registry->CheckMemoryAvailable(DeformationModel::EstimateBytesBeforeBuild(
+      job.mesh.num_vertices(), job.mesh.num_triangles())));
   if (progress) progress(LoadStage::kValidated, MillisecondsSince(job.start));
 
   const int vertices = job.mesh.num_vertices();

@@ -218,6 +218,19 @@ Eigen::SparseMatrix<double> DeformationModel::NormalMatrix(
   return BuildNormalMatrix(factorization.row_weights_squared_);
 }
 
+std::size_t DeformationModel::EstimateBytesBeforeBuild(int num_vertices, int num_triangles) {
+  constexpr std::size_t kBytesPerVertex = 400;
+  constexpr std::size_t kBytesPerTriangle = 12;
+  return static_cast<std::size_t>(num_vertices) * kBytesPerVertex +
+         static_cast<std::size_t>(num_triangles) * kBytesPerTriangle;
+}
+
+std::size_t DeformationModel::EstimatedBytes() const {
+  const LinearPoseResponse* response = default_factorization_->linear_response();
+  return default_factorization_->factor().bytes() + (response ? response->bytes() : 0) +
+         EstimateBytesBeforeBuild(mesh_.num_vertices(), mesh_.num_triangles());
+}
+
 DeformScratch DeformationModel::MakeScratch() const {
   DeformScratch scratch;
   scratch.num_vertices = mesh_.num_vertices();

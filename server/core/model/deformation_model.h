@@ -17,6 +17,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -183,6 +184,14 @@ class DeformationModel {
   double bounding_box_diagonal() const { return diagonal_; }
   // Seconds spent in Build() before the first numeric factorisation.
   double precompute_seconds() const { return precompute_seconds_; }
+
+  // The memory a model holds, estimated; the one formula behind every memory budget. Before the
+  // build, from the mesh's size alone: per vertex its rest and differential coordinates, Laplacian
+  // rows (both orientations), bone weights and region data (about 400 bytes in all), plus 12 bytes
+  // per triangle; a lower bound of EstimatedBytes(), which adds the default factorisation's factor
+  // and linear response once they are known.
+  static std::size_t EstimateBytesBeforeBuild(int num_vertices, int num_triangles);
+  std::size_t EstimatedBytes() const;
 
  private:
   DeformationModel() = default;

@@ -221,6 +221,14 @@ TEST(DeformationModel, ReportsThePrecomputationBeforeFactorising) {
   EXPECT_EQ(calls, 1);  // not reached for input refused by validation
 }
 
+TEST(DeformationModel, EstimatedBytesAddTheFactorToTheEstimateBeforeTheBuild) {
+  auto model = BuildPhantomModel(600);
+  const std::size_t before = DeformationModel::EstimateBytesBeforeBuild(
+      model->mesh().num_vertices(), model->mesh().num_triangles());
+  EXPECT_EQ(before, 400u * model->mesh().num_vertices() + 12u * model->mesh().num_triangles());
+  EXPECT_EQ(model->EstimatedBytes(), before + model->default_factorization()->factor().bytes());
+}
+
 TEST(DeformationModel, ExplicitRegionRadiusIsUsed) {
   ModelOptions options = ModelOptions::Paper();
   options.regions.explicit_radius = {{1, 0.3}};
