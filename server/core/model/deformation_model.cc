@@ -48,19 +48,8 @@ std::vector<int> ChooseAnchors(const VertexAdjacency& adjacency, const std::vect
   return anchors;
 }
 
-}  // namespace
-
-ModelOptions ModelOptions::PlainLaplacian(ModelOptions base) {
-  base.use_joint_nodes = false;
-  base.uniform_material = true;
-  return base;
-}
-
-StatusOr<std::shared_ptr<const DeformationModel>> DeformationModel::Build(
-    TriangleMesh mesh, Skeleton skeleton, const ModelOptions& options,
-    const std::function<void()>& on_precomputed) {
-  const auto start = Clock::now();
-  DEFORM_RETURN_IF_ERROR(ValidateMesh(mesh, options.limits));
+// The options Build() checks (the region radii are checked where the regions are computed).
+Status CheckOptions(const ModelOptions& options) {
   if (!(options.joint_node_weight > 0) || !(options.anchor_weight > 0) ||
       !std::isfinite(options.joint_node_weight) || !std::isfinite(options.anchor_weight) ||
       !(options.anchor_distance_factor >= 0)) {
@@ -72,13 +61,30 @@ StatusOr<std::shared_ptr<const DeformationModel>> DeformationModel::Build(
                                    std::to_string(ModelOptions::kMaxLinearBlendSegments) +
                                    "], got " + std::to_string(options.linear_blend_segments));
   }
+  return Status::Ok();
+}
+
+}  // namespace
+
+ModelOptions ModelOptions::PlainLaplacian(ModelOptions base) {
+  base.use_joint_nodes = false;
+  base.uniform_material = true;
+  return base;
+}
+
+StatusOr<std::shared_ptr<const DeformationModel>> DeformationModel::Build(
+    TriangleMesh mesh, Skeleton skeleton, const ModelOptions& options, const BuildHooks& hooks) {
+  const auto start = Clock::now();
+  DEFORM_RETURN_IF_ERROR(ValidateMesh(mesh, options.limits));
+  DEFORM_RETURN_IF_ERROR(CheckOptions(options));
+  if (hooks.validated) DEFORM_RETURN_IF_ERROR(hooks.validated());
   std::shared_ptr<DeformationModel> model(new DeformationModel());
   model->mesh_ = std::move(mesh);
   model->skeleton_ = std::move(skeleton);
   model->options_ = options;
   DEFORM_RETURN_IF_ERROR(model->Precompute());
   model->precompute_seconds_ = SecondsSince(start);
-  if (on_precomputed) on_precomputed();
+  if (hooks.precomputed) hooks.precomputed();
   DEFORM_ASSIGN_OR_RETURN(model->default_factorization_, model->FactorizeImpl(Stiffness{}));
   spdlog::debug("model built: {} vertices, {} joint nodes, {} anchors, factor {} non-zeros",
                 model->mesh_.num_vertices(), model->num_nodes_, model->anchors_.size(),

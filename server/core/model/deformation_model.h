@@ -136,13 +136,33 @@ struct DeformTimings {
   double solve = 0;            // the two triangular solves, or evaluating the linear response
 };
 
+// Optional callbacks of DeformationModel::Build(), each run on the calling thread.
+struct BuildHooks {
+  // Once the mesh and options are checked, before the precomputation. A non-OK status stops the
+  // build and is returned (the service checks its memory budget and reports progress here).
+  std::function<Status()> validated;
+  // Once the weights, regions and symbolic analysis are done, before the first numeric
+  // factorisation (for progress reports).
+  std::function<void()> precomputed;
+};
+
 class DeformationModel {
  public:
-  // `on_precomputed`, if given, is called on the calling thread once the weights, regions and
-  // symbolic analysis are done, before the first numeric factorisation (for progress reports).
-  static StatusOr<std::shared_ptr<const DeformationModel>> Build(
-      TriangleMesh mesh, Skeleton skeleton, const ModelOptions& options,
-      const std::function<void()>& on_precomputed = {});
+  // Builds the model: the expensive precomputation and the default factorisation.
+  //
+  // Validates its inputs, whoever made them, so callers need not check first: the mesh with
+  // ValidateMesh() against options.limits (INVALID_ARGUMENT naming the first problem,
+  // RESOURCE_EXHAUSTED for limits) and the options (INVALID_ARGUMENT naming the option: weights
+  // positive and finite, joint_node_balance, linear_blend_segments, region radii). The skeleton is
+  // valid by construction (Skeleton::Create). Who validates what, end to end: the mesh readers
+  // check what parsing needs and return meshes that pass ValidateMesh (core/io/mesh_io.h); Build
+  // checks again for direct callers (phantoms, tests, meshes made in code); the service adds only
+  // its own limits (options.limits, the memory budget in hooks.validated) and checks nothing twice.
+  // INVALID_ARGUMENT also for a mesh component that cannot be anchored (no vertex in a rigid zone).
+  static StatusOr<std::shared_ptr<const DeformationModel>> Build(TriangleMesh mesh,
+                                                                 Skeleton skeleton,
+                                                                 const ModelOptions& options,
+                                                                 const BuildHooks& hooks = {});
 
   // A new factorisation for `stiffness`, reusing the symbolic analysis. INVALID_ARGUMENT for
   // non-finite or non-positive weights, unknown joints or vertex indices out of range.

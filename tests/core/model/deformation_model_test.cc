@@ -202,23 +202,35 @@ TEST(DeformationModel, RefusesBadStiffness) {
   EXPECT_TRUE(model->Factorize(good).ok());
 }
 
-TEST(DeformationModel, ReportsThePrecomputationBeforeFactorising) {
+TEST(DeformationModel, ReportsValidationAndThePrecomputationBeforeFactorising) {
   auto phantom = MakeKneePhantom(600);
-  int calls = 0;
-  auto model = DeformationModel::Build(phantom->mesh, phantom->skeleton, ModelOptions::Paper(),
-                                       [&] { ++calls; });
+  std::vector<std::string> calls;
+  BuildHooks hooks;
+  hooks.validated = [&] {
+    calls.push_back("validated");
+    return Status::Ok();
+  };
+  hooks.precomputed = [&] { calls.push_back("precomputed"); };
+  auto model = DeformationModel::Build(phantom->mesh, phantom->skeleton, {}, hooks);
   ASSERT_TRUE(model.ok());
-  EXPECT_EQ(calls, 1);
-  auto refused = DeformationModel::Build(
-      phantom->mesh, phantom->skeleton,
-      [] {
-        ModelOptions o;
-        o.limits.max_vertices = 10;
-        return o;
-      }(),
-      [&] { ++calls; });
-  EXPECT_FALSE(refused.ok());
-  EXPECT_EQ(calls, 1);  // not reached for input refused by validation
+  EXPECT_EQ(calls, (std::vector<std::string>{"validated", "precomputed"}));
+
+  calls.clear();
+  ModelOptions limited;
+  limited.limits.max_vertices = 10;
+  EXPECT_FALSE(DeformationModel::Build(phantom->mesh, phantom->skeleton, limited, hooks).ok());
+  EXPECT_TRUE(calls.empty());  // not reached for input refused by validation
+}
+
+TEST(DeformationModel, TheValidatedHookCanStopTheBuild) {
+  auto phantom = MakeKneePhantom(600);
+  bool precomputed = false;
+  BuildHooks hooks;
+  hooks.validated = [] { return Status::ResourceExhausted("no room"); };
+  hooks.precomputed = [&] { precomputed = true; };
+  auto model = DeformationModel::Build(phantom->mesh, phantom->skeleton, {}, hooks);
+  EXPECT_EQ(model.status().ToString(), "RESOURCE_EXHAUSTED: no room");
+  EXPECT_FALSE(precomputed);
 }
 
 TEST(DeformationModel, EstimatedBytesAddTheFactorToTheEstimateBeforeTheBuild) {
