@@ -55,6 +55,12 @@ Status CheckOptions(const ModelOptions& options) {
       !(options.anchor_distance_factor >= 0)) {
     return Status::InvalidArgument("joint node and anchor weights must be positive and finite");
   }
+  if (!std::isfinite(options.joint_node_balance) || !(options.joint_node_balance > 0) ||
+      options.joint_node_balance > ModelOptions::kMaxJointNodeBalance) {
+    return Status::InvalidArgument("joint_node_balance must be finite and in (0, " +
+                                   std::to_string(ModelOptions::kMaxJointNodeBalance) + "], got " +
+                                   std::to_string(options.joint_node_balance));
+  }
   if (options.linear_blend_segments < 1 ||
       options.linear_blend_segments > ModelOptions::kMaxLinearBlendSegments) {
     return Status::InvalidArgument("linear_blend_segments must be in [1, " +

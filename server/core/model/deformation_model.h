@@ -62,8 +62,9 @@ struct ModelOptions {
   // node weighs lambda times the whole one-ring. Default: 1 (half one-ring mean, half joint
   // centre), chosen by measurement: on the shared 1.6k leg at 90 degrees of flexion the volume
   // change is -2.1% with 1 and -4.2% with METHOD.md's literal "one more neighbour" edge (set
-  // joint_node_one_neighbor), against -2.8% for LBS.
+  // joint_node_one_neighbor), against -2.8% for LBS. Finite and in (0, kMaxJointNodeBalance].
   double joint_node_balance = 1.0;
+  static constexpr double kMaxJointNodeBalance = 100;
   // Weigh the joint node as exactly one more neighbour (METHOD.md's 1/(d_i + 1)). Default: false.
   bool joint_node_one_neighbor = false;
   // Weight of the rows that move anchor vertices rigidly with their bone. Default: 10.

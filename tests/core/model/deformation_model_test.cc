@@ -182,6 +182,24 @@ TEST(DeformationModel, RefusesBadMeshesAndOptions) {
             StatusCode::kInvalidArgument);
 }
 
+TEST(DeformationModel, RefusesAJointNodeBalanceOutOfRange) {
+  auto phantom = MakeKneePhantom(600);
+  for (double balance :
+       {0.0, -1.0, ModelOptions::kMaxJointNodeBalance * 2, std::numeric_limits<double>::quiet_NaN(),
+        std::numeric_limits<double>::infinity()}) {
+    ModelOptions options;
+    options.joint_node_balance = balance;
+    auto model = DeformationModel::Build(phantom->mesh, phantom->skeleton, options);
+    ASSERT_FALSE(model.ok()) << balance;
+    EXPECT_EQ(model.status().code(), StatusCode::kInvalidArgument) << balance;
+    EXPECT_NE(model.status().message().find("joint_node_balance"), std::string::npos)
+        << model.status().message();
+  }
+  ModelOptions largest;
+  largest.joint_node_balance = ModelOptions::kMaxJointNodeBalance;
+  EXPECT_TRUE(DeformationModel::Build(phantom->mesh, phantom->skeleton, largest).ok());
+}
+
 TEST(DeformationModel, RefusesBadStiffness) {
   auto model = BuildPhantomModel(600);
   const double nan = std::numeric_limits<double>::quiet_NaN();
