@@ -3,6 +3,8 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <atomic>
+#include <cassert>
 #include <chrono>
 #include <limits>
 #include <map>
@@ -21,6 +23,12 @@ using ColMajorMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 
 double SecondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// Model ids: unique within the process, never 0 (the id of no model).
+std::uint64_t NextModelId() {
+  static std::atomic<std::uint64_t> next{1};
+  return next.fetch_add(1, std::memory_order_relaxed);
 }
 
 // Anchors: rigid-zone vertices far from every joint centre; per component, if none is far enough,
@@ -85,6 +93,7 @@ StatusOr<std::shared_ptr<const DeformationModel>> DeformationModel::Build(
   DEFORM_RETURN_IF_ERROR(CheckOptions(options));
   if (hooks.validated) DEFORM_RETURN_IF_ERROR(hooks.validated());
   std::shared_ptr<DeformationModel> model(new DeformationModel());
+  model->id_ = NextModelId();
   model->mesh_ = std::move(mesh);
   model->skeleton_ = std::move(skeleton);
   model->options_ = options;
@@ -182,6 +191,7 @@ StatusOr<std::shared_ptr<const MaterialFactorization>> DeformationModel::Factori
   const auto start = Clock::now();
   const int n = mesh_.num_vertices();
   auto result = std::make_shared<MaterialFactorization>();
+  result->model_id_ = id_;
   result->stiffness_ = stiffness;
   if (options_.uniform_material) {
     if (!stiffness.joint_materials.empty() || !stiffness.region_weights.empty() ||
@@ -245,6 +255,7 @@ std::size_t DeformationModel::EstimatedBytes() const {
 
 DeformScratch DeformationModel::MakeScratch() const {
   DeformScratch scratch;
+  scratch.model_id_ = id_;
   scratch.num_vertices = mesh_.num_vertices();
   scratch.bone_transforms.resize(skeleton_.num_bones());
   scratch.bone_rotations.resize(skeleton_.num_bones());
@@ -254,8 +265,16 @@ DeformScratch DeformationModel::MakeScratch() const {
   return scratch;
 }
 
-void DeformationModel::Deform(const MaterialFactorization& factorization, const Pose& pose,
+bool DeformationModel::RefusesForeign(const MaterialFactorization& factorization,
+                                      const DeformScratch& scratch) const {
+  const bool owned = Owns(factorization, scratch);
+  assert(owned && "a factorisation or scratch of another model");
+  return !owned;
+}
+
+bool DeformationModel::Deform(const MaterialFactorization& factorization, const Pose& pose,
                               DeformScratch* scratch, DeformTimings* timings) const {
+  if (RefusesForeign(factorization, *scratch)) return false;
   const auto start = Clock::now();
   Clock::time_point solve_start;
   if (const LinearPoseResponse* response = factorization.linear_response()) {
@@ -263,14 +282,29 @@ void DeformationModel::Deform(const MaterialFactorization& factorization, const 
     solve_start = Clock::now();
     response->Evaluate(scratch->bone_transforms, scratch->solution.data());
   } else {
-    AssembleRightHandSide(factorization, pose, scratch);
+    AssembleOwnedRightHandSide(factorization, pose, scratch);
     solve_start = Clock::now();
-    SolveInPlace(factorization, scratch);
+    SolveOwnedInPlace(factorization, scratch);
   }
   if (timings != nullptr) {
     timings->right_hand_side = std::chrono::duration<double>(solve_start - start).count();
     timings->solve = SecondsSince(solve_start);
   }
+  return true;
+}
+
+bool DeformationModel::AssembleRightHandSide(const MaterialFactorization& factorization,
+                                             const Pose& pose, DeformScratch* scratch) const {
+  if (RefusesForeign(factorization, *scratch)) return false;
+  AssembleOwnedRightHandSide(factorization, pose, scratch);
+  return true;
+}
+
+bool DeformationModel::SolveInPlace(const MaterialFactorization& factorization,
+                                    DeformScratch* scratch) const {
+  if (RefusesForeign(factorization, *scratch)) return false;
+  SolveOwnedInPlace(factorization, scratch);
+  return true;
 }
 
 namespace {
@@ -312,8 +346,8 @@ void MultiplySparseBy3(const Eigen::SparseMatrix<double, Eigen::RowMajor, int>& 
 
 }  // namespace
 
-void DeformationModel::AssembleRightHandSide(const MaterialFactorization& factorization,
-                                             const Pose& pose, DeformScratch* scratch) const {
+void DeformationModel::AssembleOwnedRightHandSide(const MaterialFactorization& factorization,
+                                                  const Pose& pose, DeformScratch* scratch) const {
   const int n = mesh_.num_vertices();
   ForwardKinematics(skeleton_, pose, &scratch->bone_transforms);
   const auto& bones = scratch->bone_transforms;
@@ -388,10 +422,13 @@ Eigen::Matrix3d DeformationModel::LinearBlend(
   return blend;
 }
 
-void DeformationModel::SolveInPlace(const MaterialFactorization& factorization,
-                                    DeformScratch* scratch) const {
-  factorization.factor().Solve3(scratch->solution.data(), scratch->solution.data(),
-                                scratch->solve_work.data());
+// A factorisation made by this model always has a factor: Solve3 cannot refuse it.
+void DeformationModel::SolveOwnedInPlace(const MaterialFactorization& factorization,
+                                         DeformScratch* scratch) const {
+  const Status solved = factorization.factor().Solve3(
+      scratch->solution.data(), scratch->solution.data(), scratch->solve_work.data());
+  assert(solved.ok());
+  (void)solved;
 }
 
 // A slot is a rotation the response is linear in: a bone (with its translation) or a knot of a
@@ -498,7 +535,7 @@ std::unique_ptr<const LinearPoseResponse> DeformationModel::BuildLinearResponse(
     }
     MultiplySparseBy3(laplacian_transpose_, weighted_deltas.data(), rhs.data());
     add_constraints(k, [](const Eigen::RowVector3d& rest) { return rest; });
-    factor.Solve3(rhs.data(), rhs.data(), work.data());
+    if (!factor.Solve3(rhs.data(), rhs.data(), work.data()).ok()) return nullptr;
     for (int b = 0; b < 3; ++b) {
       for (int i = 0; i < n; ++i) response[b * stride + i] = rhs(i, b);
     }
@@ -506,7 +543,7 @@ std::unique_ptr<const LinearPoseResponse> DeformationModel::BuildLinearResponse(
     // V_k: t_k = 1 (the same scalar response for each coordinate), every rotation zero.
     rhs.setZero();
     add_constraints(k, [](const Eigen::RowVector3d&) { return Eigen::RowVector3d(1, 0, 0); });
-    factor.Solve3(rhs.data(), rhs.data(), work.data());
+    if (!factor.Solve3(rhs.data(), rhs.data(), work.data()).ok()) return nullptr;
     for (int i = 0; i < n; ++i) response[3 * stride + i] = rhs(i, 0);
   }
   return std::make_unique<LinearPoseResponse>(n, std::move(bones), std::move(knots),

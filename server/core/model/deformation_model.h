@@ -116,9 +116,11 @@ class MaterialFactorization {
   CholeskyFactor factor_;
   std::unique_ptr<const LinearPoseResponse> linear_response_;
   double factor_seconds_ = 0;
+  std::uint64_t model_id_ = 0;  // the model that made it (DeformationModel::Owns)
 };
 
 // Per-caller buffers for Deform(). Create with DeformationModel::MakeScratch(); one per stream.
+// It belongs to the model that made it: another model's Deform() refuses it.
 struct DeformScratch {
   std::vector<RigidTransform> bone_transforms;  // K
   std::vector<Eigen::Matrix3d> bone_rotations;  // K, the same rotations as matrices
@@ -129,6 +131,10 @@ struct DeformScratch {
   // The deformed vertex positions of the last Deform() (n by 3, a view into `solution`).
   auto positions() const { return solution.topRows(num_vertices); }
   int num_vertices = 0;
+
+ private:
+  friend class DeformationModel;
+  std::uint64_t model_id_ = 0;  // the model that made it; 0 for a default-constructed scratch
 };
 
 // Wall-clock split of one Deform() call, in seconds.
@@ -177,19 +183,27 @@ class DeformationModel {
   DeformScratch MakeScratch() const;
 
   // Deforms the mesh into `pose`; result in scratch->positions(). Precondition: pose sized to
-  // this skeleton (Pose::Rest / PoseFromTerms do so) and scratch from MakeScratch(). No allocation.
+  // this skeleton (Pose::Rest / PoseFromTerms do so). No allocation.
   // With a linear response (factorization.linear_response()), only the forward kinematics and the
   // response's evaluation run (right_hand_side times the former), and the joint nodes' rows of
   // scratch->solution are left as they were.
-  void Deform(const MaterialFactorization& factorization, const Pose& pose, DeformScratch* scratch,
+  // `factorization` and `scratch` must come from this model (Factorize / default_factorization,
+  // MakeScratch): checked on every call at O(1) cost (Owns). Given another model's (or a
+  // default-constructed scratch), Deform refuses: it returns false and writes nothing, not even
+  // `timings`; debug builds assert, as for any programmer error. Returns true otherwise.
+  bool Deform(const MaterialFactorization& factorization, const Pose& pose, DeformScratch* scratch,
               DeformTimings* timings = nullptr) const;
 
   // The two halves of the solving path of Deform(), for tests and diagnostics (they never use the
   // linear response). AssembleRightHandSide writes A^T b ((n + m) by 3) into scratch->solution;
-  // SolveInPlace replaces it by the solution.
-  void AssembleRightHandSide(const MaterialFactorization& factorization, const Pose& pose,
+  // SolveInPlace replaces it by the solution. The same ownership check and refusal as Deform.
+  bool AssembleRightHandSide(const MaterialFactorization& factorization, const Pose& pose,
                              DeformScratch* scratch) const;
-  void SolveInPlace(const MaterialFactorization& factorization, DeformScratch* scratch) const;
+  bool SolveInPlace(const MaterialFactorization& factorization, DeformScratch* scratch) const;
+  // Whether both were made by this model (what Deform checks). O(1).
+  bool Owns(const MaterialFactorization& factorization, const DeformScratch& scratch) const {
+    return factorization.model_id_ == id_ && scratch.model_id_ == id_;
+  }
   // The normal matrix A^T A ((n + m) square) that `factorization` factorises.
   Eigen::SparseMatrix<double> NormalMatrix(const MaterialFactorization& factorization) const;
 
@@ -216,6 +230,13 @@ class DeformationModel {
 
  private:
   DeformationModel() = default;
+  // !Owns(factorization, scratch), asserting in debug builds.
+  bool RefusesForeign(const MaterialFactorization& factorization,
+                      const DeformScratch& scratch) const;
+  // AssembleRightHandSide and SolveInPlace without the ownership check.
+  void AssembleOwnedRightHandSide(const MaterialFactorization& factorization, const Pose& pose,
+                                  DeformScratch* scratch) const;
+  void SolveOwnedInPlace(const MaterialFactorization& factorization, DeformScratch* scratch) const;
   Status Precompute();
   StatusOr<std::shared_ptr<const MaterialFactorization>> FactorizeImpl(
       const Stiffness& stiffness) const;
@@ -228,6 +249,7 @@ class DeformationModel {
   std::unique_ptr<const LinearPoseResponse> BuildLinearResponse(
       const MaterialFactorization& factorization) const;
 
+  std::uint64_t id_ = 0;  // unique within the process, never 0 (Owns)
   TriangleMesh mesh_;
   Skeleton skeleton_;
   ModelOptions options_;

@@ -213,6 +213,7 @@ StatusOr<std::shared_ptr<const SymbolicCholesky>> SymbolicCholesky::Analyze(cons
 
 StatusOr<CholeskyFactor> CholeskyFactor::Factorize(std::shared_ptr<const SymbolicCholesky> symbolic,
                                                    const ColMajorMatrix& a) {
+  if (!symbolic) return Status::InvalidArgument("no symbolic analysis to factorise with");
   const SymbolicCholesky& s = *symbolic;
   const int n = s.n_;
   if (a.rows() != n || a.cols() != n || a.nonZeros() != s.a_nonzeros_ || !a.isCompressed() ||
@@ -302,12 +303,14 @@ std::size_t CholeskyFactor::WorkSize() const {
                    : 0;
 }
 
-void CholeskyFactor::Solve3(const double* b, double* x, double* work) const {
-  Solve3(b, x, work, BestSolveKernel());
+Status CholeskyFactor::Solve3(const double* b, double* x, double* work) const {
+  return Solve3(b, x, work, BestSolveKernel());
 }
 
-void CholeskyFactor::Solve3(const double* b, double* x, double* work, SolveKernel kernel) const {
+Status CholeskyFactor::Solve3(const double* b, double* x, double* work, SolveKernel kernel) const {
+  if (!symbolic_) return Status::FailedPrecondition("the Cholesky factor is empty");
   Solve3For(kernel)(View(), b, x, work);
+  return Status::Ok();
 }
 
 SupernodalFactorView CholeskyFactor::View() const {

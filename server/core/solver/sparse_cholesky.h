@@ -67,10 +67,11 @@ class SymbolicCholesky {
 
 class CholeskyFactor {
  public:
+  // An empty factor (size 0): Solve3 refuses it. Factorize() makes usable ones.
   CholeskyFactor() = default;
 
   // `a` must have exactly the pattern that `symbolic` was analysed with. INTERNAL if `a` is not
-  // positive definite (names the pivot).
+  // positive definite (names the pivot); INVALID_ARGUMENT for another pattern or a null `symbolic`.
   static StatusOr<CholeskyFactor> Factorize(
       std::shared_ptr<const SymbolicCholesky> symbolic,
       const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& a);
@@ -78,10 +79,11 @@ class CholeskyFactor {
   int size() const { return symbolic_ ? symbolic_->size() : 0; }
   // Solves A X = B for three right-hand sides stored interleaved: b[3 i + c] is row i, column c.
   // `x` may equal `b`. `work` holds WorkSize() doubles. Allocation-free; const and thread-safe.
-  // Runs the fastest kernel this CPU supports (see supernodal_solve.h).
-  void Solve3(const double* b, double* x, double* work) const;
+  // Runs the fastest kernel this CPU supports (see supernodal_solve.h). FAILED_PRECONDITION, with
+  // nothing written, for an empty (default-constructed) factor.
+  Status Solve3(const double* b, double* x, double* work) const;
   // The same with a chosen kernel, which must be available (for tests and benchmarks).
-  void Solve3(const double* b, double* x, double* work, SolveKernel kernel) const;
+  Status Solve3(const double* b, double* x, double* work, SolveKernel kernel) const;
   // Doubles of scratch Solve3 needs (SolveWorkSize: a four-double row per unknown plus room for
   // the widest supernode). The same for every factor of one symbolic analysis.
   std::size_t WorkSize() const;

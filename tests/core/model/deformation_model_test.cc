@@ -117,6 +117,40 @@ TEST(DeformationModel, AFrameAllocatesNothing) {
   EXPECT_EQ(test_support::AllocationCount() - before, 0);
 }
 
+// Deform() refuses a factorisation or scratch made by another model: false and nothing written in
+// release builds, an assertion in debug builds.
+TEST(DeformationModel, RefusesAFactorisationOrScratchOfAnotherModel) {
+  auto model = BuildPhantomModel(600);
+  auto other = BuildPhantomModel(600);  // the same mesh, yet another model
+  const Pose pose = PoseFromSpec(model->skeleton(), "knee:flexion:45");
+  const MaterialFactorization& own = *model->default_factorization();
+  const MaterialFactorization& foreign = *other->default_factorization();
+  DeformScratch scratch = model->MakeScratch();
+  DeformScratch foreign_scratch = other->MakeScratch();
+  EXPECT_TRUE(model->Owns(own, scratch));
+  EXPECT_FALSE(model->Owns(foreign, scratch));
+  EXPECT_FALSE(model->Owns(own, foreign_scratch));
+  EXPECT_FALSE(model->Owns(own, DeformScratch{}));
+#ifdef NDEBUG
+  scratch.solution.setConstant(7);
+  DeformTimings timings{-1, -1};
+  EXPECT_FALSE(model->Deform(foreign, pose, &scratch, &timings));
+  EXPECT_FALSE(model->Deform(own, pose, &foreign_scratch, &timings));
+  DeformScratch empty;
+  EXPECT_FALSE(model->Deform(own, pose, &empty, &timings));
+  EXPECT_FALSE(model->AssembleRightHandSide(foreign, pose, &scratch));
+  EXPECT_FALSE(model->SolveInPlace(foreign, &scratch));
+  EXPECT_TRUE((scratch.solution.array() == 7).all());  // nothing written
+  EXPECT_EQ(timings.solve, -1);
+#else
+  EXPECT_DEATH(model->Deform(foreign, pose, &scratch), "another model");
+  EXPECT_DEATH(model->Deform(own, pose, &foreign_scratch), "another model");
+#endif
+  EXPECT_TRUE(model->Deform(own, pose, &scratch));
+  EXPECT_TRUE(other->Deform(foreign, pose, &foreign_scratch));
+  EXPECT_EQ(scratch.positions(), foreign_scratch.positions());
+}
+
 TEST(DeformationModel, ThreadsShareOneModelAndFactorisation) {
   auto model = BuildPhantomModel();
   const Pose pose = PoseFromSpec(model->skeleton(), "knee:flexion:60");
