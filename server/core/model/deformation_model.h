@@ -12,7 +12,9 @@
 //      the caller's scratch. Any number of threads may call it at once on one model and one
 //      factorisation, each with its own scratch.
 //
-// Notation (only in this file's comments): n mesh vertices, m joint centre nodes, K bones.
+// Notation (in the comments of the model's headers): n mesh vertices, m joint centre nodes, K
+// bones. The pieces: options (model_options.h), the least-squares system (laplacian_system.h), the
+// linear response (linear_pose_response.h), weights, regions and stiffness (their own headers).
 #pragma once
 
 #include <Eigen/Core>
@@ -29,68 +31,13 @@
 #include "core/geometry/skeleton.h"
 #include "core/model/bone_weights.h"
 #include "core/model/joint_regions.h"
+#include "core/model/laplacian_system.h"
 #include "core/model/linear_pose_response.h"
+#include "core/model/model_options.h"
 #include "core/model/stiffness.h"
 #include "core/solver/sparse_cholesky.h"
 
 namespace deform {
-
-// How a blend-region vertex's rotation T_i mixes the rotations of its bones.
-enum class RotationBlend {
-  // Normalised weighted quaternion sum (QLERP; METHOD.md's slerp for two bones, generalised).
-  kQuaternion,
-  // T_i = sum_k h_ik R_k, not re-normalised. METHOD.md's fast path: the solution is linear in the
-  // bone transforms, so a frame can come from a precomputed response without a solve
-  // (LinearPoseResponse). Cheaper per frame; differs from kQuaternion in the blend regions.
-  kLinear,
-};
-
-struct ModelOptions {
-  // Add a joint centre node per inner joint, joined to its region's vertices. Default: true.
-  // false with uniform_material gives the plain Laplacian baseline.
-  bool use_joint_nodes = true;
-  // Every row weight 1 whatever the stiffness (the plain Laplacian baseline). Default: false.
-  bool uniform_material = false;
-  // Joint regions: radius factor, explicit radii. See JointRegionOptions.
-  JointRegionOptions regions;
-  // Default material profile for every inner joint. See stiffness.h.
-  JointMaterial default_material;
-  // Weight of the rows that pin each joint node to its posed joint centre. Default: 1e3.
-  double joint_node_weight = 1e3;
-  // How much a region vertex's differential coordinate refers to its joint centre rather than its
-  // one-ring: delta_i = v_i - (sum_j v_j + lambda d_i o_c) / (d_i (1 + lambda)), i.e. the joint
-  // node weighs lambda times the whole one-ring. Default: 1 (half one-ring mean, half joint
-  // centre), chosen by measurement: on the shared 1.6k leg at 90 degrees of flexion the volume
-  // change is -2.1% with 1 and -4.2% with METHOD.md's literal "one more neighbour" edge (set
-  // joint_node_one_neighbor), against -2.8% for LBS. Finite and in (0, kMaxJointNodeBalance].
-  double joint_node_balance = 1.0;
-  static constexpr double kMaxJointNodeBalance = 100;
-  // Weigh the joint node as exactly one more neighbour (METHOD.md's 1/(d_i + 1)). Default: false.
-  bool joint_node_one_neighbor = false;
-  // Weight of the rows that move anchor vertices rigidly with their bone. Default: 10.
-  double anchor_weight = 10;
-  // Anchors are vertices in a bone's rigid zone (harmonic weight 1) at least this many region
-  // radii away from every joint centre. Default: 2.
-  double anchor_distance_factor = 2.0;
-  // Fill-reducing ordering for the Cholesky factor. Default: kAuto (AMD or METIS, whichever
-  // fills less).
-  Ordering ordering = Ordering::kAuto;
-  // Default: kQuaternion.
-  RotationBlend rotation_blend = RotationBlend::kQuaternion;
-  // With kLinear: a vertex blending two bones interpolates linearly between this many + 1 samples
-  // of the pair's quaternion blend (rotation_blend.h); 1 is METHOD.md's plain linear blend, more
-  // segments approach the quaternion blend at 3 more response vectors per pair and segment.
-  // Vertices blending three or more bones take the plain linear blend. Default: 4; at most
-  // kMaxLinearBlendSegments.
-  int linear_blend_segments = 4;
-  static constexpr int kMaxLinearBlendSegments = 64;
-  MeshLimits limits;
-
-  static ModelOptions Paper() { return {}; }
-  // The plain Laplacian baseline: `base` with no joint node and every row weight 1.
-  static ModelOptions PlainLaplacian(ModelOptions base);
-  static ModelOptions PlainLaplacian() { return PlainLaplacian(Paper()); }
-};
 
 // Numeric factorisation of the normal equations for one stiffness. Immutable; shared read-only by
 // every stream that deforms with it.
@@ -212,10 +159,10 @@ class DeformationModel {
   const ModelOptions& options() const { return options_; }
   const BoneWeights& bone_weights() const { return bone_weights_; }
   const JointRegions& joint_regions() const { return regions_; }
-  const std::vector<int>& anchor_vertices() const { return anchors_; }
+  const std::vector<int>& anchor_vertices() const { return system_.anchors; }
   // The bone each anchor vertex follows rigidly (same order as anchor_vertices()).
-  const std::vector<int>& anchor_bones() const { return anchor_bone_; }
-  int num_joint_nodes() const { return num_nodes_; }
+  const std::vector<int>& anchor_bones() const { return system_.anchor_bones; }
+  int num_joint_nodes() const { return system_.num_nodes; }
   double bounding_box_diagonal() const { return diagonal_; }
   // Seconds spent in Build() before the first numeric factorisation.
   double precompute_seconds() const { return precompute_seconds_; }
@@ -238,16 +185,12 @@ class DeformationModel {
                                   DeformScratch* scratch) const;
   void SolveOwnedInPlace(const MaterialFactorization& factorization, DeformScratch* scratch) const;
   Status Precompute();
-  StatusOr<std::shared_ptr<const MaterialFactorization>> FactorizeImpl(
-      const Stiffness& stiffness) const;
-  Eigen::SparseMatrix<double> BuildNormalMatrix(const Eigen::VectorXd& row_weights_squared) const;
-  // The linear blend T_i of vertex i (piecewise along pairs; rotation_blend.h).
-  Eigen::Matrix3d LinearBlend(int vertex, const std::vector<RigidTransform>& bones,
-                              const std::vector<Eigen::Matrix3d>& bone_rotations) const;
-  // METHOD.md's precomputed response for `factorization` (its factor and row weights set), or null
-  // when it would be larger than the factor.
-  std::unique_ptr<const LinearPoseResponse> BuildLinearResponse(
-      const MaterialFactorization& factorization) const;
+  // The vertex rows' weights w_i for `stiffness` (all 1 with uniform_material).
+  StatusOr<Eigen::VectorXd> RowWeights(const Stiffness& stiffness) const;
+  // The steps of AssembleRightHandSide: r = w^2 T delta into scratch->rotated_deltas (after the
+  // forward kinematics), then the anchors' and joint nodes' targets into scratch->solution.
+  void RotateDeltas(const MaterialFactorization& factorization, DeformScratch* scratch) const;
+  void AddConstraintTargets(const Pose& pose, DeformScratch* scratch) const;
 
   std::uint64_t id_ = 0;  // unique within the process, never 0 (Owns)
   TriangleMesh mesh_;
@@ -256,15 +199,7 @@ class DeformationModel {
   double diagonal_ = 0;
   BoneWeights bone_weights_;
   JointRegions regions_;
-  int num_nodes_ = 0;
-  std::vector<int> node_joint_;  // joint index of each joint node (m)
-  // L' (n by n + m), uniform weights, compressed by rows; and its transpose for A^T b.
-  Eigen::SparseMatrix<double, Eigen::RowMajor, int> laplacian_;
-  Eigen::SparseMatrix<double, Eigen::RowMajor, int> laplacian_transpose_;
-  Positions rest_deltas_;         // n by 3: L' x_rest
-  std::vector<int> anchors_;      // vertex indices
-  std::vector<int> anchor_bone_;  // the bone each anchor follows
-  Positions anchor_rest_;         // anchors by 3
+  LaplacianSystem system_;  // L', the rest deltas, the anchors and joint nodes
   std::shared_ptr<const SymbolicCholesky> symbolic_;
   std::shared_ptr<const MaterialFactorization> default_factorization_;
   double precompute_seconds_ = 0;
