@@ -141,8 +141,8 @@ void BM_TriangularSolve(benchmark::State& state, BenchMesh mesh, SolveKernel ker
   model->AssembleRightHandSide(factorization, pose, &scratch);
   const auto rhs = scratch.solution;
   const auto seconds = TimeEach(state, [&] {
-    factorization.factor().Solve3(rhs.data(), scratch.solution.data(), scratch.solve_work.data(),
-                                  kernel);
+    benchmark::DoNotOptimize(factorization.factor().Solve3(rhs.data(), scratch.solution.data(),
+                                                           scratch.solve_work.data(), kernel));
   });
   ReportAgainstBound(state, factorization.factor().bytes(), seconds);
 }

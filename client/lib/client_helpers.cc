@@ -2,65 +2,27 @@
 #include <algorithm>
 #include <cctype>
 #include <chrono>
-#include <cmath>
 #include <cstdint>
-#include <cstdlib>
 #include <cstring>
 #include <string>
-#include <string_view>
 #include <vector>
 
+#include "core/base/pose_spec.h"
 #include "deform_client.h"
 
 namespace deform::client {
-namespace {
-
-std::string_view Trim(std::string_view text) {
-  while (!text.empty() && std::isspace(static_cast<unsigned char>(text.front()))) {
-    text.remove_prefix(1);
-  }
-  while (!text.empty() && std::isspace(static_cast<unsigned char>(text.back()))) {
-    text.remove_suffix(1);
-  }
-  return text;
-}
-
-}  // namespace
 
 bool ParsePoseAngles(const std::string& spec, deform::v1::PoseUpdate* pose, std::string* error) {
-  const std::string_view all = Trim(spec);
-  if (all.empty() || all == "rest") return true;
-  std::size_t start = 0;
-  while (start <= all.size()) {
-    const std::size_t comma = std::min(all.find(',', start), all.size());
-    const std::string_view term = Trim(all.substr(start, comma - start));
-    const std::size_t first = term.find(':');
-    const std::size_t second = first == std::string_view::npos ? first : term.find(':', first + 1);
-    if (second == std::string_view::npos || term.find(':', second + 1) != std::string_view::npos) {
-      if (error != nullptr) {
-        *error =
-            "INVALID_ARGUMENT: pose term '" + std::string(term) + "' is not JOINT:AXIS:DEGREES";
-      }
-      return false;
-    }
-    const std::string joint(Trim(term.substr(0, first)));
-    const std::string axis(Trim(term.substr(first + 1, second - first - 1)));
-    const std::string degrees_text(Trim(term.substr(second + 1)));
-    char* end = nullptr;
-    const double degrees = std::strtod(degrees_text.c_str(), &end);
-    if (joint.empty() || axis.empty() || degrees_text.empty() ||
-        end != degrees_text.c_str() + degrees_text.size()) {
-      if (error != nullptr) {
-        *error =
-            "INVALID_ARGUMENT: pose term '" + std::string(term) + "' is not JOINT:AXIS:DEGREES";
-      }
-      return false;
-    }
+  StatusOr<std::vector<PoseSpecTerm>> terms = ParsePoseSpecTerms(spec);
+  if (!terms.ok()) {
+    if (error != nullptr) *error = terms.status().ToString();
+    return false;
+  }
+  for (const PoseSpecTerm& term : *terms) {
     deform::v1::JointAngle* angle = pose->add_angles();
-    angle->set_joint(joint);
-    angle->set_axis(axis);
-    angle->set_degrees(degrees);
-    start = comma + 1;
+    angle->set_joint(term.joint);
+    angle->set_axis(term.axis);
+    angle->set_degrees(term.degrees);
   }
   return true;
 }

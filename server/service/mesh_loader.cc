@@ -19,19 +19,21 @@ StatusOr<std::shared_ptr<const MeshEntry>> BuildAndRegister(MeshRegistry* regist
                                                             LoadJob job,
                                                             const LoadProgress& progress) {
   job.options.limits.max_vertices = registry->limits().max_vertices;
-  DEFORM_RETURN_IF_ERROR(ValidateMesh(job.mesh, job.options.limits).WithContext("mesh"));
-  const std::size_t geometry_bytes = static_cast<std::size_t>(job.mesh.num_vertices()) * 400 +
-                                     static_cast<std::size_t>(job.mesh.num_triangles()) * 12;
-  DEFORM_RETURN_IF_ERROR(registry->CheckMemoryAvailable(geometry_bytes));
-  if (progress) progress(LoadStage::kValidated, MillisecondsSince(job.start));
-
+  const std::size_t bytes_before_build =
+      DeformationModel::EstimateBytesBeforeBuild(job.mesh.num_vertices(), job.mesh.num_triangles());
   const int vertices = job.mesh.num_vertices();
-  const auto on_precomputed = [&] {
+  BuildHooks hooks;
+  hooks.validated = [&] {
+    DEFORM_RETURN_IF_ERROR(registry->CheckMemoryAvailable(bytes_before_build));
+    if (progress) progress(LoadStage::kValidated, MillisecondsSince(job.start));
+    return Status::Ok();
+  };
+  hooks.precomputed = [&] {
     if (progress) progress(LoadStage::kWeights, MillisecondsSince(job.start));
   };
-  DEFORM_ASSIGN_OR_RETURN(std::shared_ptr<const DeformationModel> model,
-                          DeformationModel::Build(std::move(job.mesh), std::move(job.skeleton),
-                                                  job.options, on_precomputed));
+  DEFORM_ASSIGN_OR_RETURN(
+      std::shared_ptr<const DeformationModel> model,
+      DeformationModel::Build(std::move(job.mesh), std::move(job.skeleton), job.options, hooks));
   if (progress) progress(LoadStage::kFactorised, MillisecondsSince(job.start));
   DEFORM_ASSIGN_OR_RETURN(std::shared_ptr<const MeshEntry> entry,
                           registry->Register(std::move(reservation), job.name, std::move(model)));

@@ -36,9 +36,12 @@ struct LoadJob {
   std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
 };
 
-// Validates (ValidateMesh against the registry's vertex limit, the memory budget for the
-// geometry), builds the model and registers it with `reservation`. Errors: INVALID_ARGUMENT for a
-// bad mesh or options (naming the problem), RESOURCE_EXHAUSTED for limits.
+// Builds the model and registers it with `reservation`. Checks nothing the core checks: the mesh
+// readers validated an uploaded mesh, and DeformationModel::Build validates mesh and options again
+// (with the registry's vertex limit in options.limits); once it has, the memory budget is checked
+// for the mesh's size (DeformationModel::EstimateBytesBeforeBuild) and kValidated reported.
+// Errors: INVALID_ARGUMENT for a bad mesh or options (naming the problem), RESOURCE_EXHAUSTED for
+// limits.
 StatusOr<std::shared_ptr<const MeshEntry>> BuildAndRegister(MeshRegistry* registry,
                                                             MeshRegistry::Reservation reservation,
                                                             LoadJob job,

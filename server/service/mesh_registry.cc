@@ -25,14 +25,6 @@ std::string MebiBytes(std::size_t bytes) {
 
 }  // namespace
 
-std::size_t EstimateModelBytes(const DeformationModel& model) {
-  const std::size_t vertices = static_cast<std::size_t>(model.mesh().num_vertices());
-  const std::size_t triangles = static_cast<std::size_t>(model.mesh().num_triangles());
-  const LinearPoseResponse* response = model.default_factorization()->linear_response();
-  return model.default_factorization()->factor().bytes() + (response ? response->bytes() : 0) +
-         vertices * 400 + triangles * 12;
-}
-
 MeshRegistry::Reservation::Reservation(Reservation&& other) noexcept
     : registry_(std::exchange(other.registry_, nullptr)) {}
 
@@ -88,7 +80,7 @@ StatusOr<std::shared_ptr<const MeshEntry>> MeshRegistry::Register(
   entry->precompute_ms = model->precompute_seconds() * 1e3;
   entry->factor_ms = model->default_factorization()->factor_seconds() * 1e3;
   entry->factor_bytes = model->default_factorization()->factor().bytes();
-  entry->memory_bytes = EstimateModelBytes(*model);
+  entry->memory_bytes = model->EstimatedBytes();
   entry->model = std::move(model);
 
   std::lock_guard<std::mutex> lock(mutex_);

@@ -5,8 +5,8 @@
 //
 // Limits: the number of meshes loaded or being loaded (a Reservation is taken before the
 // expensive work, so a client learns early that no slot is free) and a memory budget checked
-// against EstimateModelBytes() when the mesh is registered. Memory is released from the budget at
-// unload, even while open streams still use the model until they end.
+// against DeformationModel::EstimatedBytes() when the mesh is registered. Memory is released from
+// the budget at unload, even while open streams still use the model until they end.
 //
 // Thread safety: all methods may be called from any thread.
 #pragma once
@@ -33,16 +33,11 @@ struct MeshEntry {
   double precompute_ms = 0;
   double factor_ms = 0;
   std::size_t factor_bytes = 0;
-  std::size_t memory_bytes = 0;  // EstimateModelBytes(*model)
+  std::size_t memory_bytes = 0;  // model->EstimatedBytes()
 
   mutable std::atomic<bool> unloaded{false};
   mutable std::atomic<int> open_streams{0};
 };
-
-// Bytes a model holds, estimated: the Cholesky factor and the linear response if any, plus per
-// vertex its rest and differential coordinates, Laplacian rows (both orientations), bone weights
-// and region data (about 400 bytes in all), plus 12 bytes per triangle.
-std::size_t EstimateModelBytes(const DeformationModel& model);
 
 class MeshRegistry {
  public:

@@ -69,24 +69,7 @@ Status PoseInputFromProto(const v1::PoseUpdate& update, const Skeleton& skeleton
     PoseTerm term;
     term.joint = *joint;
     term.degrees = angle.degrees();
-    const std::string& axis = angle.axis();
-    if (axis == "x" || axis == "y" || axis == "z") {
-      term.axis = Eigen::Vector3d::Unit(axis[0] - 'x');
-    } else {
-      const std::vector<DegreeOfFreedom>& dofs = skeleton.joint(term.joint).dofs;
-      int found = -1;
-      for (int d = 0; d < static_cast<int>(dofs.size()); ++d) {
-        if (dofs[d].name == axis) found = d;
-      }
-      if (found < 0) {
-        std::string known = "x, y, z";
-        for (const DegreeOfFreedom& dof : dofs) known += ", " + dof.name;
-        return Status::InvalidArgument("joint '" + skeleton.joint(term.joint).name +
-                                       "' has no axis '" + axis + "' (known: " + known + ")");
-      }
-      term.dof = found;
-      term.axis = dofs[found].axis;
-    }
+    DEFORM_RETURN_IF_ERROR(ResolvePoseAxis(skeleton, angle.axis(), &term));
     input->angles.push_back(term);
   }
   return RootFromProto(update.root(), &input->root);

@@ -17,15 +17,6 @@ void PutUint32(std::uint32_t bits, char* out) {
   out[3] = static_cast<char>((bits >> 24) & 0xffu);
 }
 
-Status CheckWeight(double weight, const std::string& what) {
-  if (!std::isfinite(weight) || weight <= 0 || weight > kMaxMaterialWeight) {
-    return Status::InvalidArgument(what + " must be finite and in (0, " +
-                                   std::to_string(kMaxMaterialWeight) + "], got " +
-                                   std::to_string(weight));
-  }
-  return Status::Ok();
-}
-
 // Zero fields keep `defaults`; set fields must be valid weights.
 StatusOr<JointMaterial> MaterialFromProto(const v1::JointMaterial& proto,
                                           const JointMaterial& defaults, const std::string& what) {
@@ -33,9 +24,7 @@ StatusOr<JointMaterial> MaterialFromProto(const v1::JointMaterial& proto,
   if (proto.rigid() != 0) material.rigid = proto.rigid();
   if (proto.soft() != 0) material.soft = proto.soft();
   if (proto.seam() != 0) material.seam = proto.seam();
-  DEFORM_RETURN_IF_ERROR(CheckWeight(material.rigid, what + " rigid weight"));
-  DEFORM_RETURN_IF_ERROR(CheckWeight(material.soft, what + " soft weight"));
-  DEFORM_RETURN_IF_ERROR(CheckWeight(material.seam, what + " seam weight"));
+  DEFORM_RETURN_IF_ERROR(CheckJointMaterial(material, what));
   return material;
 }
 
@@ -51,12 +40,10 @@ StatusOr<int> JointOf(const Skeleton& skeleton, const std::string& name, const c
 StatusOr<int> RegionJointOf(const DeformationModel& model, const std::string& name,
                             const char* what) {
   DEFORM_ASSIGN_OR_RETURN(const int joint, JointOf(model.skeleton(), name, what));
-  for (const JointRegion& region : model.joint_regions().regions) {
-    if (region.joint == joint) return joint;
-  }
-  return Status::InvalidArgument(std::string(what) + ": joint '" +
-                                 model.skeleton().joint(joint).name +
-                                 "' has no joint region (only inner joints have a material)");
+  const Status has_region =
+      RegionOfJoint(model.joint_regions(), model.skeleton(), joint).status().WithContext(what);
+  if (!has_region.ok()) return has_region;
+  return joint;
 }
 
 }  // namespace
@@ -120,7 +107,7 @@ StatusOr<Stiffness> StiffnessFromProto(const v1::StiffnessUpdate& proto,
     DEFORM_ASSIGN_OR_RETURN(const int joint,
                             RegionJointOf(model, weight.joint(), "region_weights"));
     DEFORM_RETURN_IF_ERROR(
-        CheckWeight(weight.weight(), "region weight of joint '" + weight.joint() + "'"));
+        CheckMaterialWeight(weight.weight(), "region weight of joint '" + weight.joint() + "'"));
     stiffness.region_weights.emplace_back(joint, weight.weight());
   }
   if (proto.vertex_indices_size() != proto.vertex_weights_size()) {
@@ -138,7 +125,7 @@ StatusOr<Stiffness> StiffnessFromProto(const v1::StiffnessUpdate& proto,
                                      std::to_string(vertices) + " vertices");
     }
     DEFORM_RETURN_IF_ERROR(
-        CheckWeight(proto.vertex_weights(k), "weight of vertex " + std::to_string(vertex)));
+        CheckMaterialWeight(proto.vertex_weights(k), "weight of vertex " + std::to_string(vertex)));
     stiffness.vertex_weights.emplace_back(static_cast<int>(vertex), proto.vertex_weights(k));
   }
   return stiffness;
@@ -175,11 +162,7 @@ void FillMeshSummary(const MeshEntry& entry, v1::MeshSummary* summary) {
       out->set_min_degrees(dof.min_degrees);
       out->set_max_degrees(dof.max_degrees);
     }
-    bool has_region = false;
-    for (const JointRegion& region : model.joint_regions().regions) {
-      has_region = has_region || region.joint == j;
-    }
-    info->set_has_region(has_region);
+    info->set_has_region(FindJointRegion(model.joint_regions(), j) >= 0);
   }
 }
 

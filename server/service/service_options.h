@@ -11,7 +11,7 @@ struct ServiceLimits {
   std::size_t max_vertices = 2'000'000;
   // Meshes loaded (or being loaded) at once. Default: 64.
   int max_meshes = 64;
-  // Budget for loaded meshes, estimated from factor bytes and geometry (EstimateModelBytes).
+  // Budget for loaded meshes, estimated by DeformationModel::EstimatedBytes (factor and geometry).
   // Default: 4 GiB.
   std::size_t max_memory_bytes = std::size_t{4} << 30;
   // Largest upload (mesh file plus skeleton file) accepted by LoadMesh. Default: 256 MiB.

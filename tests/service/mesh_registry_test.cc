@@ -29,8 +29,8 @@ TEST(MeshRegistryTest, RegistersFindsListsAndUnloads) {
   auto second = registry.Register(registry.Reserve().value(), "second", model);
   ASSERT_TRUE(second.ok());
   EXPECT_NE((*first)->id, (*second)->id);
-  EXPECT_EQ((*first)->memory_bytes, EstimateModelBytes(*model));
-  EXPECT_EQ(registry.memory_bytes_used(), 2 * EstimateModelBytes(*model));
+  EXPECT_EQ((*first)->memory_bytes, model->EstimatedBytes());
+  EXPECT_EQ(registry.memory_bytes_used(), 2 * model->EstimatedBytes());
 
   auto found = registry.Find((*first)->id);
   ASSERT_TRUE(found.ok());
@@ -44,7 +44,7 @@ TEST(MeshRegistryTest, RegistersFindsListsAndUnloads) {
   EXPECT_EQ(registry.Unload((*first)->id).code(), StatusCode::kNotFound);
   EXPECT_EQ(registry.Find("nonsense").status().code(), StatusCode::kNotFound);
   EXPECT_EQ(registry.mesh_count(), 1);
-  EXPECT_EQ(registry.memory_bytes_used(), EstimateModelBytes(*model));
+  EXPECT_EQ(registry.memory_bytes_used(), model->EstimatedBytes());
 }
 
 TEST(MeshRegistryTest, ReservationsCountAgainstTheMeshLimitUntilReleased) {
@@ -71,7 +71,7 @@ TEST(MeshRegistryTest, ReservationsCountAgainstTheMeshLimitUntilReleased) {
 TEST(MeshRegistryTest, MemoryBudgetRefusesAModelThatDoesNotFit) {
   const auto model = SmallModel();
   ServiceLimits limits;
-  limits.max_memory_bytes = EstimateModelBytes(*model) + EstimateModelBytes(*model) / 2;
+  limits.max_memory_bytes = model->EstimatedBytes() + model->EstimatedBytes() / 2;
   limits.max_meshes = 2;
   MeshRegistry registry(limits);
   ASSERT_TRUE(registry.Register(registry.Reserve().value(), "fits", model).ok());

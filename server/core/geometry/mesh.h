@@ -35,6 +35,8 @@ struct MeshLimits {
 // Returns INVALID_ARGUMENT (or RESOURCE_EXHAUSTED for limits) with a message that names the
 // offending vertex or triangle index.
 // Zero area means area <= 1e-14 * diagonal^2. Open (boundary) meshes are valid. O(V + F).
+// The one definition of a usable mesh: the mesh readers (core/io/mesh_io.h) apply it to every mesh
+// they return and DeformationModel::Build to its input; nothing else needs to.
 Status ValidateMesh(const TriangleMesh& mesh, const MeshLimits& limits = {});
 
 // Axis-aligned bounding-box diagonal length; 0 for an empty mesh.

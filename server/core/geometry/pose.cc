@@ -4,39 +4,12 @@
 #include <cmath>
 #include <string>
 
+#include "core/base/pose_spec.h"
+
 namespace deform {
 namespace {
 
 constexpr double kDegreesToRadians = M_PI / 180.0;
-
-std::vector<std::string_view> Split(std::string_view text, char separator) {
-  std::vector<std::string_view> parts;
-  size_t start = 0;
-  while (true) {
-    const size_t end = text.find(separator, start);
-    parts.push_back(text.substr(start, end == std::string_view::npos ? end : end - start));
-    if (end == std::string_view::npos) break;
-    start = end + 1;
-  }
-  return parts;
-}
-
-std::string_view Trim(std::string_view s) {
-  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.front()))) s.remove_prefix(1);
-  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.remove_suffix(1);
-  return s;
-}
-
-StatusOr<double> ParseDegrees(std::string_view text) {
-  const std::string s(text);
-  char* end = nullptr;
-  const double value = std::strtod(s.c_str(), &end);
-  if (s.empty() || end != s.c_str() + s.size()) {
-    return Status::InvalidArgument("'" + s + "' is not a number of degrees");
-  }
-  if (!std::isfinite(value)) return Status::InvalidArgument("angle '" + s + "' is not finite");
-  return value;
-}
 
 }  // namespace
 
@@ -46,39 +19,37 @@ Pose Pose::Rest(const Skeleton& skeleton) {
   return pose;
 }
 
-StatusOr<std::vector<PoseTerm>> ParsePoseSpec(std::string_view spec, const Skeleton& skeleton) {
-  std::vector<PoseTerm> terms;
-  spec = Trim(spec);
-  if (spec.empty() || spec == "rest") return terms;
-  for (std::string_view raw : Split(spec, ',')) {
-    const std::string_view item = Trim(raw);
-    const std::vector<std::string_view> fields = Split(item, ':');
-    if (fields.size() != 3) {
-      return Status::InvalidArgument("pose term '" + std::string(item) +
-                                     "' is not JOINT:AXIS:DEGREES");
+Status ResolvePoseAxis(const Skeleton& skeleton, std::string_view axis_name, PoseTerm* term) {
+  if (axis_name == "x" || axis_name == "y" || axis_name == "z") {
+    term->dof = -1;
+    term->axis = Eigen::Vector3d::Unit(axis_name[0] - 'x');
+    return Status::Ok();
+  }
+  const Joint& joint = skeleton.joint(term->joint);
+  for (int d = 0; d < static_cast<int>(joint.dofs.size()); ++d) {
+    if (joint.dofs[d].name == axis_name) {
+      term->dof = d;
+      term->axis = joint.dofs[d].axis;
+      return Status::Ok();
     }
+  }
+  std::string known = "x, y, z";
+  for (const DegreeOfFreedom& dof : joint.dofs) known += ", " + dof.name;
+  return Status::InvalidArgument("joint '" + joint.name + "' has no axis '" +
+                                 std::string(axis_name) + "' (known: " + known + ")");
+}
+
+StatusOr<std::vector<PoseTerm>> ParsePoseSpec(std::string_view spec, const Skeleton& skeleton) {
+  DEFORM_ASSIGN_OR_RETURN(const std::vector<PoseSpecTerm> written, ParsePoseSpecTerms(spec));
+  std::vector<PoseTerm> terms;
+  terms.reserve(written.size());
+  for (const PoseSpecTerm& term_text : written) {
     PoseTerm term;
-    auto joint = skeleton.FindJoint(Trim(fields[0]));
+    auto joint = skeleton.FindJoint(term_text.joint);
     if (!joint.ok()) return Status::InvalidArgument(joint.status().message());
     term.joint = *joint;
-    const std::string_view axis = Trim(fields[1]);
-    if (axis == "x" || axis == "y" || axis == "z") {
-      term.axis = Eigen::Vector3d::Unit(axis[0] - 'x');
-    } else {
-      const auto& dofs = skeleton.joint(term.joint).dofs;
-      const auto it = std::find_if(dofs.begin(), dofs.end(),
-                                   [&](const DegreeOfFreedom& d) { return d.name == axis; });
-      if (it == dofs.end()) {
-        std::string known = "x, y, z";
-        for (const auto& d : dofs) known += ", " + d.name;
-        return Status::InvalidArgument("joint '" + skeleton.joint(term.joint).name +
-                                       "' has no axis '" + std::string(axis) +
-                                       "' (known: " + known + ")");
-      }
-      term.dof = static_cast<int>(it - dofs.begin());
-      term.axis = it->axis;
-    }
-    DEFORM_ASSIGN_OR_RETURN(term.degrees, ParseDegrees(Trim(fields[2])));
+    DEFORM_RETURN_IF_ERROR(ResolvePoseAxis(skeleton, term_text.axis, &term));
+    term.degrees = term_text.degrees;
     terms.push_back(term);
   }
   return terms;

@@ -43,9 +43,17 @@ struct PoseTerm {
   double degrees = 0;
 };
 
-// Parses "JOINT:AXIS:DEGREES[,JOINT:AXIS:DEGREES...]": JOINT is a joint name or 0-based index;
-// AXIS is x, y, z or the name of one of that joint's degrees of freedom. "rest" or "" is the rest
-// pose. INVALID_ARGUMENT names the bad term (unknown joint or axis, non-finite angle).
+// Resolves an axis name for the joint `term->joint` (a valid joint index): "x", "y" or "z" is
+// that rest-frame axis (term->dof = -1), any other name must be one of the joint's degrees of
+// freedom (term->dof its index, term->axis its axis). INVALID_ARGUMENT "joint 'knee' has no axis
+// 'twist' (known: x, y, z, flexion, ...)" otherwise. The one place pose axes are resolved: the
+// pose syntax below and the service's pose updates both come here. Allocates only on error.
+Status ResolvePoseAxis(const Skeleton& skeleton, std::string_view axis_name, PoseTerm* term);
+
+// Parses "JOINT:AXIS:DEGREES[,JOINT:AXIS:DEGREES...]" (the syntax of core/base/pose_spec.h) and
+// resolves each term against `skeleton`: JOINT is a joint name or 0-based index (FindJoint), AXIS
+// as ResolvePoseAxis. "rest" or "" is the rest pose. INVALID_ARGUMENT names the bad term (malformed
+// syntax, unknown joint or axis, non-finite angle).
 StatusOr<std::vector<PoseTerm>> ParsePoseSpec(std::string_view spec, const Skeleton& skeleton);
 
 // Sets `pose` (sized to the skeleton; its buffers are reused) from terms, composed per joint in

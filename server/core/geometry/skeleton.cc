@@ -1,22 +1,14 @@
 #include "core/geometry/skeleton.h"
 
-#include <charconv>
 #include <cmath>
 #include <unordered_set>
+
+#include "core/base/text.h"
 
 namespace deform {
 namespace {
 
 bool IsFinite(const Eigen::Vector3d& v) { return v.allFinite(); }
-
-StatusOr<int> ParseIndex(std::string_view text) {
-  int value = 0;
-  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-  if (ec != std::errc() || end != text.data() + text.size()) {
-    return Status::InvalidArgument("'" + std::string(text) + "' is not an integer");
-  }
-  return value;
-}
 
 }  // namespace
 
@@ -120,8 +112,8 @@ StatusOr<int> Skeleton::FindJoint(std::string_view name_or_index) const {
   for (int j = 0; j < num_joints(); ++j) {
     if (joints_[j].name == name_or_index) return j;
   }
-  auto index = ParseIndex(name_or_index);
-  if (index.ok() && *index >= 0 && *index < num_joints()) return *index;
+  int index = -1;
+  if (ParseInt(name_or_index, &index) && index >= 0 && index < num_joints()) return index;
   return Status::NotFound("no joint named '" + std::string(name_or_index) + "' (the skeleton has " +
                           std::to_string(num_joints()) + " joints)");
 }

@@ -1,9 +1,14 @@
 // Reading and writing triangle meshes through OpenMesh.
 //
 // Supported: OBJ, PLY (ASCII and binary), STL (ASCII and binary; duplicate vertices welded),
-// OFF. Polygons are fan-triangulated. Every mesh read is validated with ValidateMesh() before it
-// is returned, so a returned mesh is always usable. No input crashes the reader: unreadable,
-// truncated or malformed content yields INVALID_ARGUMENT naming the problem.
+// OFF. Polygons are fan-triangulated. No input crashes the reader: unreadable, truncated or
+// malformed content yields INVALID_ARGUMENT naming the problem.
+//
+// What the readers validate: first what parsing needs (syntax, numbers, indices, and declared
+// counts against the limits before anything is allocated for them), then the whole mesh with
+// ValidateMesh(limits) before it is returned, so a returned mesh is always usable and a bad file
+// is reported as the file's problem. DeformationModel::Build validates its input again for callers
+// that make meshes in code; callers of these readers need not validate.
 #pragma once
 
 #include <string>

@@ -59,6 +59,23 @@ double LimbRadius(const TriangleMesh& mesh, const Skeleton& skeleton,
 
 }  // namespace
 
+int FindJointRegion(const JointRegions& regions, int joint) {
+  for (int r = 0; r < static_cast<int>(regions.regions.size()); ++r) {
+    if (regions.regions[r].joint == joint) return r;
+  }
+  return -1;
+}
+
+StatusOr<int> RegionOfJoint(const JointRegions& regions, const Skeleton& skeleton, int joint) {
+  const int region = FindJointRegion(regions, joint);
+  if (region >= 0) return region;
+  const std::string name = joint >= 0 && joint < skeleton.num_joints()
+                               ? "'" + skeleton.joint(joint).name + "'"
+                               : std::to_string(joint);
+  return Status::InvalidArgument("joint " + name +
+                                 " has no joint region (only inner joints have one)");
+}
+
 StatusOr<JointRegions> ComputeJointRegions(const TriangleMesh& mesh, const Skeleton& skeleton,
                                            const VertexAdjacency& adjacency,
                                            const std::vector<NearestBone>& nearest,

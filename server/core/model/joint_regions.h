@@ -41,6 +41,13 @@ struct JointRegions {
   std::vector<int> membership;
 };
 
+// The index into regions.regions of `joint`'s region, or -1 when it has none (only inner joints
+// have one; any int is accepted).
+int FindJointRegion(const JointRegions& regions, int joint);
+// The same as a status: INVALID_ARGUMENT "joint 'hip' has no joint region (only inner joints have
+// one)" when there is none, naming the joint from `skeleton` (the regions' own) where it exists.
+StatusOr<int> RegionOfJoint(const JointRegions& regions, const Skeleton& skeleton, int joint);
+
 // The limb radius at a joint is measured on the vertices whose closest skeleton point lies within
 // a band around the joint (10% of the shortest adjacent bone, widened until it holds 8 vertices).
 // INVALID_ARGUMENT for a non-positive or non-finite explicit radius or an unknown joint.

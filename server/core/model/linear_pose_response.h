@@ -16,14 +16,21 @@
 // bones at a fixed s, computed per frame, and enters like one more rotation with three response
 // vectors (the translations only reach the right-hand side through the bones themselves).
 //
+// BuildLinearPoseResponse (at the end) computes it from the model's least-squares system.
 // Immutable after construction; Evaluate() is const, allocation-free and may run on any number of
 // threads at once.
 #pragma once
 
+#include <Eigen/Core>
 #include <cstddef>
+#include <memory>
 #include <vector>
 
 #include "core/geometry/pose.h"
+#include "core/geometry/skeleton.h"
+#include "core/model/bone_weights.h"
+#include "core/model/laplacian_system.h"
+#include "core/solver/cholesky_factor.h"
 
 namespace deform {
 
@@ -59,5 +66,15 @@ class LinearPoseResponse {
   std::vector<Knot> knots_;
   std::vector<double> columns_;
 };
+
+// METHOD.md's precomputed response of `system` for the linear blend (`segments` per bone pair,
+// rotation_blend.h) of `bone_weights`, with the vertex rows' squared weights
+// `row_weights_squared` (n) and `factor`, the Cholesky factor of that NormalMatrix. Costs 2 K + 3
+// (knots) three-column solves. Null when a frame would read more from it than a solve reads from
+// the factor (its doubles against twice the factor's non-zeros), or when a joint node moves with
+// the root transform (its joint has no incoming bone; inner joints always have one).
+std::unique_ptr<const LinearPoseResponse> BuildLinearPoseResponse(
+    const LaplacianSystem& system, const Skeleton& skeleton, const BoneWeights& bone_weights,
+    int segments, const Eigen::VectorXd& row_weights_squared, const CholeskyFactor& factor);
 
 }  // namespace deform

@@ -5,42 +5,31 @@
 #include <string>
 
 namespace deform {
-namespace {
-
-Status CheckWeight(double w, const std::string& what) {
-  if (!std::isfinite(w) || w <= 0 || w > kMaxMaterialWeight) {
+Status CheckMaterialWeight(double weight, const std::string& what) {
+  if (!std::isfinite(weight) || weight <= 0 || weight > kMaxMaterialWeight) {
     return Status::InvalidArgument(what + " must be finite and in (0, " +
                                    std::to_string(kMaxMaterialWeight) + "], got " +
-                                   std::to_string(w));
+                                   std::to_string(weight));
   }
   return Status::Ok();
 }
 
-Status CheckMaterial(const JointMaterial& m, const std::string& where) {
-  DEFORM_RETURN_IF_ERROR(CheckWeight(m.rigid, where + " rigid weight"));
-  DEFORM_RETURN_IF_ERROR(CheckWeight(m.soft, where + " soft weight"));
-  DEFORM_RETURN_IF_ERROR(CheckWeight(m.seam, where + " seam weight"));
+Status CheckJointMaterial(const JointMaterial& material, const std::string& what) {
+  DEFORM_RETURN_IF_ERROR(CheckMaterialWeight(material.rigid, what + " rigid weight"));
+  DEFORM_RETURN_IF_ERROR(CheckMaterialWeight(material.soft, what + " soft weight"));
+  DEFORM_RETURN_IF_ERROR(CheckMaterialWeight(material.seam, what + " seam weight"));
   return Status::Ok();
 }
 
-StatusOr<int> RegionOfJoint(const JointRegions& regions, int joint) {
-  for (int r = 0; r < static_cast<int>(regions.regions.size()); ++r) {
-    if (regions.regions[r].joint == joint) return r;
-  }
-  return Status::InvalidArgument("joint " + std::to_string(joint) +
-                                 " has no joint region (only inner joints do)");
-}
-
-}  // namespace
-
-StatusOr<Eigen::VectorXd> MaterialRowWeights(const JointRegions& regions, int num_vertices,
+StatusOr<Eigen::VectorXd> MaterialRowWeights(const JointRegions& regions, const Skeleton& skeleton,
+                                             int num_vertices,
                                              const JointMaterial& default_material,
                                              const Stiffness& stiffness) {
-  DEFORM_RETURN_IF_ERROR(CheckMaterial(default_material, "default material"));
+  DEFORM_RETURN_IF_ERROR(CheckJointMaterial(default_material, "default material"));
   std::vector<JointMaterial> materials(regions.regions.size(), default_material);
   for (const auto& [joint, material] : stiffness.joint_materials) {
-    DEFORM_ASSIGN_OR_RETURN(const int r, RegionOfJoint(regions, joint));
-    DEFORM_RETURN_IF_ERROR(CheckMaterial(material, "joint " + std::to_string(joint)));
+    DEFORM_ASSIGN_OR_RETURN(const int r, RegionOfJoint(regions, skeleton, joint));
+    DEFORM_RETURN_IF_ERROR(CheckJointMaterial(material, "joint " + std::to_string(joint)));
     materials[r] = material;
   }
 
@@ -61,8 +50,9 @@ StatusOr<Eigen::VectorXd> MaterialRowWeights(const JointRegions& regions, int nu
   }
 
   for (const auto& [joint, weight] : stiffness.region_weights) {
-    DEFORM_ASSIGN_OR_RETURN(const int r, RegionOfJoint(regions, joint));
-    DEFORM_RETURN_IF_ERROR(CheckWeight(weight, "region weight of joint " + std::to_string(joint)));
+    DEFORM_ASSIGN_OR_RETURN(const int r, RegionOfJoint(regions, skeleton, joint));
+    DEFORM_RETURN_IF_ERROR(
+        CheckMaterialWeight(weight, "region weight of joint " + std::to_string(joint)));
     for (int i : regions.regions[r].vertices) w[i] = weight;
   }
   for (const auto& [vertex, weight] : stiffness.vertex_weights) {
@@ -71,7 +61,8 @@ StatusOr<Eigen::VectorXd> MaterialRowWeights(const JointRegions& regions, int nu
                                      " but the mesh has " + std::to_string(num_vertices) +
                                      " vertices");
     }
-    DEFORM_RETURN_IF_ERROR(CheckWeight(weight, "weight of vertex " + std::to_string(vertex)));
+    DEFORM_RETURN_IF_ERROR(
+        CheckMaterialWeight(weight, "weight of vertex " + std::to_string(vertex)));
     w[vertex] = weight;
   }
   return w;

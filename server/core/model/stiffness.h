@@ -2,10 +2,12 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <string>
 #include <utility>
 #include <vector>
 
 #include "core/base/status.h"
+#include "core/geometry/skeleton.h"
 #include "core/model/joint_regions.h"
 
 namespace deform {
@@ -28,12 +30,20 @@ struct Stiffness {
 // Largest weight accepted; keeps the normal equations well conditioned.
 constexpr double kMaxMaterialWeight = 1e4;
 
+// The rule for every material weight: finite and in (0, kMaxMaterialWeight]. INVALID_ARGUMENT
+// "<what> must be finite and in (0, 10000.000000], got <weight>" otherwise. MaterialRowWeights
+// checks every weight with it; the service calls it to refuse a request before factorising.
+Status CheckMaterialWeight(double weight, const std::string& what);
+// CheckMaterialWeight on the three weights, described as "<what> rigid weight" and so on.
+Status CheckJointMaterial(const JointMaterial& material, const std::string& what);
+
 // Per-vertex row weights w_i. A vertex in one or more joint regions takes the largest soft (or, on
 // a region's border, seam) weight among them; a vertex outside every region takes the rigid weight
 // of its nearest region's joint (`default_material.rigid` if the skeleton has no inner joint).
 // INVALID_ARGUMENT for weights that are not finite and in (0, kMaxMaterialWeight], joints without a
-// region, or vertices out of range.
-StatusOr<Eigen::VectorXd> MaterialRowWeights(const JointRegions& regions, int num_vertices,
+// region (RegionOfJoint; `skeleton` names them), or vertices out of range.
+StatusOr<Eigen::VectorXd> MaterialRowWeights(const JointRegions& regions, const Skeleton& skeleton,
+                                             int num_vertices,
                                              const JointMaterial& default_material,
                                              const Stiffness& stiffness);
 

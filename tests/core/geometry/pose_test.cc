@@ -37,6 +37,22 @@ TEST(ParsePoseSpec, RefusesBadTerms) {
   }
 }
 
+TEST(ResolvePoseAxis, NamesRestFrameAxesAndDegreesOfFreedom) {
+  const Skeleton skeleton = PhantomSkeleton();
+  PoseTerm term;
+  term.joint = 1;  // the knee
+  ASSERT_TRUE(ResolvePoseAxis(skeleton, "y", &term).ok());
+  EXPECT_EQ(term.dof, -1);
+  EXPECT_EQ(term.axis, Eigen::Vector3d::UnitY());
+  ASSERT_TRUE(ResolvePoseAxis(skeleton, "varus_valgus", &term).ok());
+  EXPECT_EQ(term.dof, 1);
+  EXPECT_EQ(term.axis, skeleton.joint(1).dofs[1].axis);
+  const Status unknown = ResolvePoseAxis(skeleton, "twist", &term);
+  EXPECT_EQ(unknown.code(), StatusCode::kInvalidArgument);
+  EXPECT_EQ(unknown.message(),
+            "joint 'knee' has no axis 'twist' (known: x, y, z, flexion, varus_valgus, rotation)");
+}
+
 TEST(PoseFromTerms, ClampsToTheRangeOfMotion) {
   const Skeleton skeleton = PhantomSkeleton();
   Pose pose;

@@ -117,6 +117,40 @@ TEST(DeformationModel, AFrameAllocatesNothing) {
   EXPECT_EQ(test_support::AllocationCount() - before, 0);
 }
 
+// Deform() refuses a factorisation or scratch made by another model: false and nothing written in
+// release builds, an assertion in debug builds.
+TEST(DeformationModel, RefusesAFactorisationOrScratchOfAnotherModel) {
+  auto model = BuildPhantomModel(600);
+  auto other = BuildPhantomModel(600);  // the same mesh, yet another model
+  const Pose pose = PoseFromSpec(model->skeleton(), "knee:flexion:45");
+  const MaterialFactorization& own = *model->default_factorization();
+  const MaterialFactorization& foreign = *other->default_factorization();
+  DeformScratch scratch = model->MakeScratch();
+  DeformScratch foreign_scratch = other->MakeScratch();
+  EXPECT_TRUE(model->Owns(own, scratch));
+  EXPECT_FALSE(model->Owns(foreign, scratch));
+  EXPECT_FALSE(model->Owns(own, foreign_scratch));
+  EXPECT_FALSE(model->Owns(own, DeformScratch{}));
+#ifdef NDEBUG
+  scratch.solution.setConstant(7);
+  DeformTimings timings{-1, -1};
+  EXPECT_FALSE(model->Deform(foreign, pose, &scratch, &timings));
+  EXPECT_FALSE(model->Deform(own, pose, &foreign_scratch, &timings));
+  DeformScratch empty;
+  EXPECT_FALSE(model->Deform(own, pose, &empty, &timings));
+  EXPECT_FALSE(model->AssembleRightHandSide(foreign, pose, &scratch));
+  EXPECT_FALSE(model->SolveInPlace(foreign, &scratch));
+  EXPECT_TRUE((scratch.solution.array() == 7).all());  // nothing written
+  EXPECT_EQ(timings.solve, -1);
+#else
+  EXPECT_DEATH(model->Deform(foreign, pose, &scratch), "another model");
+  EXPECT_DEATH(model->Deform(own, pose, &foreign_scratch), "another model");
+#endif
+  EXPECT_TRUE(model->Deform(own, pose, &scratch));
+  EXPECT_TRUE(other->Deform(foreign, pose, &foreign_scratch));
+  EXPECT_EQ(scratch.positions(), foreign_scratch.positions());
+}
+
 TEST(DeformationModel, ThreadsShareOneModelAndFactorisation) {
   auto model = BuildPhantomModel();
   const Pose pose = PoseFromSpec(model->skeleton(), "knee:flexion:60");
@@ -182,6 +216,24 @@ TEST(DeformationModel, RefusesBadMeshesAndOptions) {
             StatusCode::kInvalidArgument);
 }
 
+TEST(DeformationModel, RefusesAJointNodeBalanceOutOfRange) {
+  auto phantom = MakeKneePhantom(600);
+  for (double balance :
+       {0.0, -1.0, ModelOptions::kMaxJointNodeBalance * 2, std::numeric_limits<double>::quiet_NaN(),
+        std::numeric_limits<double>::infinity()}) {
+    ModelOptions options;
+    options.joint_node_balance = balance;
+    auto model = DeformationModel::Build(phantom->mesh, phantom->skeleton, options);
+    ASSERT_FALSE(model.ok()) << balance;
+    EXPECT_EQ(model.status().code(), StatusCode::kInvalidArgument) << balance;
+    EXPECT_NE(model.status().message().find("joint_node_balance"), std::string::npos)
+        << model.status().message();
+  }
+  ModelOptions largest;
+  largest.joint_node_balance = ModelOptions::kMaxJointNodeBalance;
+  EXPECT_TRUE(DeformationModel::Build(phantom->mesh, phantom->skeleton, largest).ok());
+}
+
 TEST(DeformationModel, RefusesBadStiffness) {
   auto model = BuildPhantomModel(600);
   const double nan = std::numeric_limits<double>::quiet_NaN();
@@ -202,23 +254,43 @@ TEST(DeformationModel, RefusesBadStiffness) {
   EXPECT_TRUE(model->Factorize(good).ok());
 }
 
-TEST(DeformationModel, ReportsThePrecomputationBeforeFactorising) {
+TEST(DeformationModel, ReportsValidationAndThePrecomputationBeforeFactorising) {
   auto phantom = MakeKneePhantom(600);
-  int calls = 0;
-  auto model = DeformationModel::Build(phantom->mesh, phantom->skeleton, ModelOptions::Paper(),
-                                       [&] { ++calls; });
+  std::vector<std::string> calls;
+  BuildHooks hooks;
+  hooks.validated = [&] {
+    calls.push_back("validated");
+    return Status::Ok();
+  };
+  hooks.precomputed = [&] { calls.push_back("precomputed"); };
+  auto model = DeformationModel::Build(phantom->mesh, phantom->skeleton, {}, hooks);
   ASSERT_TRUE(model.ok());
-  EXPECT_EQ(calls, 1);
-  auto refused = DeformationModel::Build(
-      phantom->mesh, phantom->skeleton,
-      [] {
-        ModelOptions o;
-        o.limits.max_vertices = 10;
-        return o;
-      }(),
-      [&] { ++calls; });
-  EXPECT_FALSE(refused.ok());
-  EXPECT_EQ(calls, 1);  // not reached for input refused by validation
+  EXPECT_EQ(calls, (std::vector<std::string>{"validated", "precomputed"}));
+
+  calls.clear();
+  ModelOptions limited;
+  limited.limits.max_vertices = 10;
+  EXPECT_FALSE(DeformationModel::Build(phantom->mesh, phantom->skeleton, limited, hooks).ok());
+  EXPECT_TRUE(calls.empty());  // not reached for input refused by validation
+}
+
+TEST(DeformationModel, TheValidatedHookCanStopTheBuild) {
+  auto phantom = MakeKneePhantom(600);
+  bool precomputed = false;
+  BuildHooks hooks;
+  hooks.validated = [] { return Status::ResourceExhausted("no room"); };
+  hooks.precomputed = [&] { precomputed = true; };
+  auto model = DeformationModel::Build(phantom->mesh, phantom->skeleton, {}, hooks);
+  EXPECT_EQ(model.status().ToString(), "RESOURCE_EXHAUSTED: no room");
+  EXPECT_FALSE(precomputed);
+}
+
+TEST(DeformationModel, EstimatedBytesAddTheFactorToTheEstimateBeforeTheBuild) {
+  auto model = BuildPhantomModel(600);
+  const std::size_t before = DeformationModel::EstimateBytesBeforeBuild(
+      model->mesh().num_vertices(), model->mesh().num_triangles());
+  EXPECT_EQ(before, 400u * model->mesh().num_vertices() + 12u * model->mesh().num_triangles());
+  EXPECT_EQ(model->EstimatedBytes(), before + model->default_factorization()->factor().bytes());
 }
 
 TEST(DeformationModel, ExplicitRegionRadiusIsUsed) {

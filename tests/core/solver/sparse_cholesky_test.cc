@@ -59,7 +59,7 @@ TEST_P(SparseCholeskyTest, SolveMatchesDenseCholesky) {
   const auto b = RandomRightHandSides(n, 11);
   Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> x(n, 3);
   std::vector<double> work(factor->WorkSize());
-  factor->Solve3(b.data(), x.data(), work.data());
+  ASSERT_TRUE(factor->Solve3(b.data(), x.data(), work.data()).ok());
 
   const Eigen::MatrixXd dense = Eigen::MatrixXd(a);
   const Eigen::MatrixXd expected = dense.llt().solve(Eigen::MatrixXd(b));
@@ -74,8 +74,8 @@ TEST_P(SparseCholeskyTest, SolveInPlaceEqualsSolveOutOfPlace) {
   auto b = RandomRightHandSides(n, 5);
   Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> x(n, 3);
   std::vector<double> work(factor->WorkSize());
-  factor->Solve3(b.data(), x.data(), work.data());
-  factor->Solve3(b.data(), b.data(), work.data());
+  ASSERT_TRUE(factor->Solve3(b.data(), x.data(), work.data()).ok());
+  ASSERT_TRUE(factor->Solve3(b.data(), b.data(), work.data()).ok());
   EXPECT_EQ(Eigen::MatrixXd(x), Eigen::MatrixXd(b));
 }
 
@@ -96,9 +96,25 @@ TEST_P(SparseCholeskyTest, RefactorisationReusesTheAnalysis) {
   const auto b = RandomRightHandSides(n, 17);
   Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> x1(n, 3), x2(n, 3);
   std::vector<double> work(reused->WorkSize());
-  reused->Solve3(b.data(), x1.data(), work.data());
-  fresh->Solve3(b.data(), x2.data(), work.data());
+  ASSERT_TRUE(reused->Solve3(b.data(), x1.data(), work.data()).ok());
+  ASSERT_TRUE(fresh->Solve3(b.data(), x2.data(), work.data()).ok());
   EXPECT_LT((x1 - x2).norm(), 1e-12 * x2.norm());
+}
+
+TEST(CholeskyFactor, AnEmptyFactorRefusesToSolve) {
+  const CholeskyFactor empty;
+  EXPECT_EQ(empty.size(), 0);
+  EXPECT_EQ(empty.WorkSize(), 0u);
+  double b[3] = {1, 2, 3};
+  double x[3] = {7, 7, 7};
+  const Status status = empty.Solve3(b, x, nullptr);
+  EXPECT_EQ(status.code(), StatusCode::kFailedPrecondition);
+  EXPECT_EQ(x[0], 7);  // nothing written
+}
+
+TEST(CholeskyFactor, FactorizeRefusesANullAnalysis) {
+  const ColMajorMatrix a = RandomSpdMatrix(10, 2, 1);
+  EXPECT_EQ(CholeskyFactor::Factorize(nullptr, a).status().code(), StatusCode::kInvalidArgument);
 }
 
 INSTANTIATE_TEST_SUITE_P(AllOrderings, SparseCholeskyTest,
@@ -125,7 +141,7 @@ TEST_P(SolveKernelTest, MatchesDenseCholeskyOnEveryShape) {
       const auto b = RandomRightHandSides(n, 5 + n);
       Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> x(n, 3);
       std::vector<double> work(factor->WorkSize(), std::nan(""));  // the kernel must not read it
-      factor->Solve3(b.data(), x.data(), work.data(), GetParam());
+      ASSERT_TRUE(factor->Solve3(b.data(), x.data(), work.data(), GetParam()).ok());
 
       const Eigen::MatrixXd dense = Eigen::MatrixXd(a);
       const Eigen::MatrixXd expected = dense.llt().solve(Eigen::MatrixXd(b));

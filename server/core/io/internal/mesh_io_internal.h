@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "core/base/status.h"
+#include "core/base/text.h"
 #include "core/geometry/mesh.h"
 #include "core/io/mesh_io.h"
 
@@ -24,11 +25,7 @@ class SoupImporter;  // mesh_soup_importer.h
 // ---------------------------------------------------------------------------------------------
 // Text helpers (mesh_io_text.cc)
 
-inline bool IsSpace(char c) {
-  return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\v' || c == '\f';
-}
-
-std::string_view Trim(std::string_view text);
+// IsSpace and Trim are core/base/text.h's.
 bool EqualsIgnoreCase(std::string_view a, std::string_view b);
 bool StartsWithIgnoreCase(std::string_view text, std::string_view prefix);
 

@@ -1,0 +1,171 @@
+#include "core/model/laplacian_system.h"
+
+#include <algorithm>
+#include <cstddef>
+
+namespace deform {
+namespace {
+
+// Anchors: rigid-zone vertices far from every joint centre; per component, if none is far enough,
+// the rigid-zone vertices farthest from the joints (within 90% of the farthest).
+std::vector<int> ChooseAnchors(const VertexAdjacency& adjacency, const std::vector<int>& fixed_bone,
+                               const JointRegions& regions, double distance_factor) {
+  std::vector<int> component;
+  const int count = ConnectedComponents(adjacency, &component);
+  const int n = static_cast<int>(fixed_bone.size());
+  std::vector<double> farthest(count, -1.0);
+  std::vector<char> has_far(count, 0);
+  for (int i = 0; i < n; ++i) {
+    if (fixed_bone[i] < 0) continue;
+    const double s = regions.relative_distance[i];
+    farthest[component[i]] = std::max(farthest[component[i]], s);
+    if (s >= distance_factor) has_far[component[i]] = 1;
+  }
+  std::vector<int> anchors;
+  for (int i = 0; i < n; ++i) {
+    if (fixed_bone[i] < 0) continue;
+    const double s = regions.relative_distance[i];
+    const int c = component[i];
+    if (has_far[c] ? s >= distance_factor : s >= 0.9 * farthest[c]) anchors.push_back(i);
+  }
+  return anchors;
+}
+
+// L' (n by n + m): uniform weights over the one-ring plus the joint nodes of the vertex.
+RowMajorSparseMatrix BuildLaplacian(const VertexAdjacency& adjacency, const JointRegions& regions,
+                                    int num_nodes, const ModelOptions& options) {
+  const int n = static_cast<int>(adjacency.offsets.size()) - 1;
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(adjacency.neighbors.size() + n * 2);
+  for (int i = 0; i < n; ++i) {
+    const int nodes = options.use_joint_nodes
+                          ? regions.membership_offsets[i + 1] - regions.membership_offsets[i]
+                          : 0;
+    // Weight of the edge to each joint node, in units of one one-ring edge.
+    const double node_edge =
+        options.joint_node_one_neighbor ? 1.0 : options.joint_node_balance * adjacency.degree(i);
+    const double share = 1.0 / (adjacency.degree(i) + nodes * node_edge);
+    triplets.emplace_back(i, i, 1.0);
+    for (int p = adjacency.offsets[i]; p < adjacency.offsets[i + 1]; ++p) {
+      triplets.emplace_back(i, adjacency.neighbors[p], -share);
+    }
+    if (nodes > 0) {
+      for (int p = regions.membership_offsets[i]; p < regions.membership_offsets[i + 1]; ++p) {
+        triplets.emplace_back(i, n + regions.membership[p], -share * node_edge);
+      }
+    }
+  }
+  RowMajorSparseMatrix laplacian(n, n + num_nodes);
+  laplacian.setFromTriplets(triplets.begin(), triplets.end());
+  laplacian.makeCompressed();
+  return laplacian;
+}
+
+// L' x_rest, the joint nodes at their regions' centres.
+Positions RestDeltas(const TriangleMesh& mesh, const JointRegions& regions,
+                     const RowMajorSparseMatrix& laplacian, int num_nodes) {
+  const int n = mesh.num_vertices();
+  Positions rest_with_nodes(n + num_nodes, 3);
+  rest_with_nodes.topRows(n) = mesh.vertices;
+  for (int c = 0; c < num_nodes; ++c) {
+    rest_with_nodes.row(n + c) = regions.regions[c].centre.transpose();
+  }
+  return laplacian * rest_with_nodes;
+}
+
+// out = m r for a row-major sparse m and n by 3 row-major r and out. Two partial sums per row, so
+// consecutive entries do not wait on each other's adds.
+void MultiplySparseBy3(const Eigen::SparseMatrix<double, Eigen::RowMajor, int>& m,
+                       const double* __restrict r, double* __restrict out) {
+  const int* columns = m.innerIndexPtr();
+  const double* values = m.valuePtr();
+  const int* row_begin = m.outerIndexPtr();
+  for (int row = 0; row < m.outerSize(); ++row) {
+    double a0 = 0, a1 = 0, a2 = 0, b0 = 0, b1 = 0, b2 = 0;
+    int p = row_begin[row];
+    const int end = row_begin[row + 1];
+    for (; p + 2 <= end; p += 2) {
+      const double* x = r + 3 * static_cast<std::ptrdiff_t>(columns[p]);
+      const double* y = r + 3 * static_cast<std::ptrdiff_t>(columns[p + 1]);
+      const double u = values[p], v = values[p + 1];
+      a0 += u * x[0];
+      a1 += u * x[1];
+      a2 += u * x[2];
+      b0 += v * y[0];
+      b1 += v * y[1];
+      b2 += v * y[2];
+    }
+    if (p < end) {
+      const double* x = r + 3 * static_cast<std::ptrdiff_t>(columns[p]);
+      a0 += values[p] * x[0];
+      a1 += values[p] * x[1];
+      a2 += values[p] * x[2];
+    }
+    double* target = out + 3 * static_cast<std::ptrdiff_t>(row);
+    target[0] = a0 + b0;
+    target[1] = a1 + b1;
+    target[2] = a2 + b2;
+  }
+}
+
+}  // namespace
+
+LaplacianSystem BuildLaplacianSystem(const TriangleMesh& mesh, const VertexAdjacency& adjacency,
+                                     const JointRegions& regions,
+                                     const std::vector<int>& fixed_bone,
+                                     const ModelOptions& options) {
+  LaplacianSystem system;
+  system.num_vertices = mesh.num_vertices();
+  system.num_nodes = options.use_joint_nodes ? static_cast<int>(regions.regions.size()) : 0;
+  for (int c = 0; c < system.num_nodes; ++c) {
+    system.node_joints.push_back(regions.regions[c].joint);
+  }
+  system.laplacian = BuildLaplacian(adjacency, regions, system.num_nodes, options);
+  system.laplacian_transpose = system.laplacian.transpose();
+  system.laplacian_transpose.makeCompressed();
+  system.rest_deltas = RestDeltas(mesh, regions, system.laplacian, system.num_nodes);
+
+  system.anchors = ChooseAnchors(adjacency, fixed_bone, regions, options.anchor_distance_factor);
+  system.anchor_bones.resize(system.anchors.size());
+  system.anchor_rest.resize(static_cast<Eigen::Index>(system.anchors.size()), 3);
+  for (std::size_t a = 0; a < system.anchors.size(); ++a) {
+    system.anchor_bones[a] = fixed_bone[system.anchors[a]];
+    system.anchor_rest.row(a) = mesh.vertices.row(system.anchors[a]);
+  }
+  system.anchor_weight = options.anchor_weight;
+  system.node_weight = options.joint_node_weight;
+  return system;
+}
+
+Eigen::SparseMatrix<double> NormalMatrix(const LaplacianSystem& system,
+                                         const Eigen::VectorXd& row_weights_squared) {
+  const int n = system.num_vertices;
+  RowMajorSparseMatrix weighted = system.laplacian;
+  for (int i = 0; i < n; ++i) {
+    for (RowMajorSparseMatrix::InnerIterator it(weighted, i); it; ++it) {
+      it.valueRef() *= row_weights_squared[i];
+    }
+  }
+  Eigen::SparseMatrix<double> normal = system.laplacian_transpose * weighted;
+  const double anchor2 = system.anchor_weight * system.anchor_weight;
+  const double node2 = system.node_weight * system.node_weight;
+  for (int a : system.anchors) normal.coeffRef(a, a) += anchor2;
+  for (int c = 0; c < system.num_nodes; ++c) normal.coeffRef(n + c, n + c) += node2;
+  normal.makeCompressed();
+  return normal;
+}
+
+Eigen::SparseMatrix<double> NormalMatrixPattern(const LaplacianSystem& system) {
+  const int n = system.num_vertices;
+  Eigen::SparseMatrix<double> pattern = system.laplacian_transpose * system.laplacian;
+  for (int a : system.anchors) pattern.coeffRef(a, a) += 1.0;
+  for (int c = 0; c < system.num_nodes; ++c) pattern.coeffRef(n + c, n + c) += 1.0;
+  pattern.makeCompressed();
+  return pattern;
+}
+
+void MultiplyLaplacianTranspose(const LaplacianSystem& system, const double* r, double* out) {
+  MultiplySparseBy3(system.laplacian_transpose, r, out);
+}
+
+}  // namespace deform

@@ -1,0 +1,63 @@
+// The least-squares system of METHOD.md for one mesh, without its material weights and pose: the
+// rows that DeformationModel factorises and solves (deformation_model.h's notation: n vertices,
+// m joint centre nodes, K bones; x holds the n vertices' positions, then the m nodes'):
+//
+//   vertex rows  w_i ((L' x)_i - T_i delta_i)    delta = L' x_rest, T_i the vertex's rotation blend
+//   anchor rows  anchor_weight (x_a - posed a)   an anchor vertex moves rigidly with its bone
+//   node rows    node_weight (x_(n+c) - o_c')    joint node c follows its posed joint centre
+//
+// so that A^T A = L'^T W^2 L' + anchor_weight^2 sum e_a e_a^T + node_weight^2 sum e_c e_c^T and
+// A^T b = L'^T (W^2 T delta) + anchor_weight^2 (posed anchors) + node_weight^2 (posed centres).
+// Immutable once built.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <vector>
+
+#include "core/geometry/mesh.h"
+#include "core/geometry/mesh_topology.h"
+#include "core/model/joint_regions.h"
+#include "core/model/model_options.h"
+
+namespace deform {
+
+using RowMajorSparseMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor, int>;
+
+struct LaplacianSystem {
+  int num_vertices = 0;          // n
+  int num_nodes = 0;             // m: one per joint region with options.use_joint_nodes, else none
+  std::vector<int> node_joints;  // the joint of each joint node (m)
+  // L' (n by n + m), uniform weights over the one-ring plus the vertex's joint nodes, compressed
+  // by rows; and its transpose for A^T b.
+  RowMajorSparseMatrix laplacian;
+  RowMajorSparseMatrix laplacian_transpose;
+  Positions rest_deltas;          // delta = L' x_rest, n by 3
+  std::vector<int> anchors;       // the anchor vertices, ascending
+  std::vector<int> anchor_bones;  // the bone each anchor follows
+  Positions anchor_rest;          // their rest positions, #anchors by 3
+  double anchor_weight = 0;
+  double node_weight = 0;
+};
+
+// Builds the system for `mesh` with its one-ring `adjacency`, joint `regions` and rigid zones
+// (`fixed_bone[i]` the bone vertex i belongs to wholly, -1 for none). A region vertex's row refers
+// to its joint nodes with options.joint_node_balance (or as one more neighbour, with
+// joint_node_one_neighbor). Anchors are the rigid-zone vertices at least
+// options.anchor_distance_factor region radii from every joint centre or, in a component with no
+// such vertex, its rigid-zone vertices within 90% of the farthest.
+LaplacianSystem BuildLaplacianSystem(const TriangleMesh& mesh, const VertexAdjacency& adjacency,
+                                     const JointRegions& regions,
+                                     const std::vector<int>& fixed_bone,
+                                     const ModelOptions& options);
+
+// A^T A ((n + m) square, column-major, compressed) for the vertex rows' squared weights w_i^2 (n).
+Eigen::SparseMatrix<double> NormalMatrix(const LaplacianSystem& system,
+                                         const Eigen::VectorXd& row_weights_squared);
+// A matrix with the pattern of every NormalMatrix of `system` (for the symbolic analysis).
+Eigen::SparseMatrix<double> NormalMatrixPattern(const LaplacianSystem& system);
+
+// out = L'^T r: `r` is n by 3 and `out` (n + m) by 3, both row-major. No allocation.
+void MultiplyLaplacianTranspose(const LaplacianSystem& system, const double* r, double* out);
+
+}  // namespace deform

@@ -1,0 +1,47 @@
+#include "core/model/model_options.h"
+
+#include <cmath>
+#include <limits>
+#include <string>
+
+namespace deform {
+
+ModelOptions ModelOptions::PlainLaplacian(ModelOptions base) {
+  base.use_joint_nodes = false;
+  base.uniform_material = true;
+  return base;
+}
+
+namespace {
+
+// INVALID_ARGUMENT "<name> must be finite and in (0, <max>], got <value>" unless it is.
+Status CheckInRange(double value, double max, const char* name) {
+  if (!std::isfinite(value) || !(value > 0) || value > max) {
+    return Status::InvalidArgument(std::string(name) + " must be finite and in (0, " +
+                                   std::to_string(max) + "], got " + std::to_string(value));
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status ValidateModelOptions(const ModelOptions& options) {
+  constexpr double kUnbounded = std::numeric_limits<double>::max();
+  DEFORM_RETURN_IF_ERROR(CheckInRange(options.joint_node_weight, kUnbounded, "joint_node_weight"));
+  DEFORM_RETURN_IF_ERROR(CheckInRange(options.anchor_weight, kUnbounded, "anchor_weight"));
+  if (!(options.anchor_distance_factor >= 0)) {
+    return Status::InvalidArgument("anchor_distance_factor must be at least 0, got " +
+                                   std::to_string(options.anchor_distance_factor));
+  }
+  DEFORM_RETURN_IF_ERROR(CheckInRange(options.joint_node_balance,
+                                      ModelOptions::kMaxJointNodeBalance, "joint_node_balance"));
+  if (options.linear_blend_segments < 1 ||
+      options.linear_blend_segments > ModelOptions::kMaxLinearBlendSegments) {
+    return Status::InvalidArgument("linear_blend_segments must be in [1, " +
+                                   std::to_string(ModelOptions::kMaxLinearBlendSegments) +
+                                   "], got " + std::to_string(options.linear_blend_segments));
+  }
+  return Status::Ok();
+}
+
+}  // namespace deform

@@ -1,0 +1,152 @@
+#include "core/solver/cholesky_factor.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <utility>
+
+#include "internal/row_pattern.h"
+
+namespace deform {
+
+StatusOr<CholeskyFactor> CholeskyFactor::Factorize(std::shared_ptr<const SymbolicCholesky> symbolic,
+                                                   const ColMajorMatrix& a) {
+  if (!symbolic) return Status::InvalidArgument("no symbolic analysis to factorise with");
+  DEFORM_RETURN_IF_ERROR(CheckAnalysedPattern(*symbolic, a));
+  DEFORM_ASSIGN_OR_RETURN(const ColumnFactor l,
+                          UpLookingCholesky(*symbolic, PermutedUpperValues(*symbolic, a)));
+  CholeskyFactor f;
+  f.PackSupernodes(*symbolic, l);
+  f.symbolic_ = std::move(symbolic);
+  return f;
+}
+
+Status CholeskyFactor::CheckAnalysedPattern(const SymbolicCholesky& s, const ColMajorMatrix& a) {
+  const int n = s.n_;
+  if (a.rows() != n || a.cols() != n || a.nonZeros() != s.a_nonzeros_ || !a.isCompressed() ||
+      !std::equal(s.a_column_pointers_.begin(), s.a_column_pointers_.end(), a.outerIndexPtr()) ||
+      !std::equal(s.a_row_indices_.begin(), s.a_row_indices_.end(), a.innerIndexPtr())) {
+    return Status::InvalidArgument("matrix pattern differs from the analysed one");
+  }
+  return Status::Ok();
+}
+
+// The values of C = P A P^T's upper triangle, in the analysed pattern.
+std::vector<double> CholeskyFactor::PermutedUpperValues(const SymbolicCholesky& s,
+                                                        const ColMajorMatrix& a) {
+  std::vector<double> c_values(s.c_row_indices_.size(), 0.0);
+  for (std::int64_t p = 0; p < s.a_nonzeros_; ++p) {
+    if (s.a_to_c_[p] >= 0) c_values[s.a_to_c_[p]] = a.valuePtr()[p];
+  }
+  return c_values;
+}
+
+// Up-looking factorisation (CSparse's cs_chol): row k of L from the rows above it.
+StatusOr<CholeskyFactor::ColumnFactor> CholeskyFactor::UpLookingCholesky(
+    const SymbolicCholesky& s, const std::vector<double>& c_values) {
+  const int n = s.n_;
+  ColumnFactor l{std::vector<int>(s.column_pointers_[n], 0),
+                 std::vector<double>(s.column_pointers_[n], 0.0)};
+  std::vector<std::int64_t> next(s.column_pointers_.begin(), s.column_pointers_.end() - 1);
+  std::vector<double> x(n, 0.0);
+  std::vector<int> stack(n), mark(n, -1);
+  for (int k = 0; k < n; ++k) {
+    const int top = solver_internal::RowPattern(k, s.c_column_pointers_, s.c_row_indices_,
+                                                s.elimination_tree_, &stack, &mark);
+    x[k] = 0;
+    for (int p = s.c_column_pointers_[k]; p < s.c_column_pointers_[k + 1]; ++p) {
+      if (s.c_row_indices_[p] <= k) x[s.c_row_indices_[p]] = c_values[p];
+    }
+    double d = x[k];
+    x[k] = 0;
+    for (int t = top; t < n; ++t) {
+      const int i = stack[t];
+      const double lki = x[i] / l.values[s.column_pointers_[i]];
+      x[i] = 0;
+      for (std::int64_t p = s.column_pointers_[i] + 1; p < next[i]; ++p) {
+        x[l.rows[p]] -= l.values[p] * lki;
+      }
+      d -= lki * lki;
+      const std::int64_t q = next[i]++;
+      l.rows[q] = k;
+      l.values[q] = lki;
+    }
+    if (!(d > 0) || !std::isfinite(d)) {
+      return Status::Internal("matrix is not positive definite (pivot " + std::to_string(k) +
+                              " is " + std::to_string(d) + ")");
+    }
+    const std::int64_t q = next[k]++;
+    l.rows[q] = k;
+    l.values[q] = std::sqrt(d);
+  }
+  return l;
+}
+
+// Packs `l` into supernodal blocks (the layout in the class comment).
+void CholeskyFactor::PackSupernodes(const SymbolicCholesky& s, const ColumnFactor& l) {
+  const int num_supernodes = static_cast<int>(s.supernode_columns_.size()) - 1;
+  row_pointers_.assign(num_supernodes + 1, 0);
+  value_pointers_.assign(num_supernodes + 1, 0);
+  for (int sn = 0; sn < num_supernodes; ++sn) {
+    const int first = s.supernode_columns_[sn];
+    const int width = s.supernode_columns_[sn + 1] - first;
+    const std::int64_t rows = s.column_pointers_[first + 1] - s.column_pointers_[first];
+    row_pointers_[sn + 1] = row_pointers_[sn] + rows;
+    value_pointers_[sn + 1] = value_pointers_[sn] + rows * width;
+  }
+  row_indices_.resize(row_pointers_.back());
+  values_.assign(value_pointers_.back() + kSolveValuePadding, 0.0);
+  for (int sn = 0; sn < num_supernodes; ++sn) {
+    const int first = s.supernode_columns_[sn];
+    const int width = s.supernode_columns_[sn + 1] - first;
+    const std::int64_t rows = row_pointers_[sn + 1] - row_pointers_[sn];
+    std::copy(l.rows.begin() + s.column_pointers_[first],
+              l.rows.begin() + s.column_pointers_[first + 1],
+              row_indices_.begin() + row_pointers_[sn]);
+    double* block = values_.data() + value_pointers_[sn];
+    for (int c = 0; c < width; ++c) {
+      // Column first + c holds the block's rows c.. (its pattern is the supernode's minus c rows).
+      const std::int64_t begin = s.column_pointers_[first + c];
+      for (std::int64_t k = c; k < rows; ++k) block[k * width + c] = l.values[begin + (k - c)];
+    }
+  }
+}
+
+std::size_t CholeskyFactor::WorkSize() const {
+  return symbolic_ ? static_cast<std::size_t>(
+                         SolveWorkSize(symbolic_->n_, symbolic_->max_supernode_width_))
+                   : 0;
+}
+
+Status CholeskyFactor::Solve3(const double* b, double* x, double* work) const {
+  return Solve3(b, x, work, BestSolveKernel());
+}
+
+Status CholeskyFactor::Solve3(const double* b, double* x, double* work, SolveKernel kernel) const {
+  if (!symbolic_) return Status::FailedPrecondition("the Cholesky factor is empty");
+  Solve3For(kernel)(View(), b, x, work);
+  return Status::Ok();
+}
+
+SupernodalFactorView CholeskyFactor::View() const {
+  const SymbolicCholesky& s = *symbolic_;
+  SupernodalFactorView view;
+  view.size = s.n_;
+  view.num_supernodes = static_cast<int>(s.supernode_columns_.size()) - 1;
+  view.supernode_columns = s.supernode_columns_.data();
+  view.permutation = s.permutation_.data();
+  view.row_pointers = row_pointers_.data();
+  view.value_pointers = value_pointers_.data();
+  view.row_indices = row_indices_.data();
+  view.values = values_.data();
+  return view;
+}
+
+std::size_t CholeskyFactor::bytes() const {
+  if (!symbolic_) return 0;
+  return values_.size() * sizeof(double) + row_indices_.size() * sizeof(int) +
+         (row_pointers_.size() + value_pointers_.size()) * sizeof(std::int64_t) +
+         symbolic_->supernode_columns_.size() * sizeof(int);
+}
+
+}  // namespace deform

@@ -1,0 +1,71 @@
+// The numeric half of the sparse Cholesky (sparse_cholesky.h): the factor L of one matrix with an
+// analysed pattern, stored by supernodes, and the three-column triangular solve.
+#pragma once
+
+#include <Eigen/SparseCore>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "core/base/status.h"
+#include "core/solver/supernodal_solve.h"
+#include "core/solver/symbolic_cholesky.h"
+
+namespace deform {
+
+class CholeskyFactor {
+ public:
+  // An empty factor (size 0): Solve3 refuses it. Factorize() makes usable ones.
+  CholeskyFactor() = default;
+
+  // `a` must have exactly the pattern that `symbolic` was analysed with. INTERNAL if `a` is not
+  // positive definite (names the pivot); INVALID_ARGUMENT for another pattern or a null `symbolic`.
+  static StatusOr<CholeskyFactor> Factorize(
+      std::shared_ptr<const SymbolicCholesky> symbolic,
+      const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& a);
+
+  int size() const { return symbolic_ ? symbolic_->size() : 0; }
+  // Solves A X = B for three right-hand sides stored interleaved: b[3 i + c] is row i, column c.
+  // `x` may equal `b`. `work` holds WorkSize() doubles. Allocation-free; const and thread-safe.
+  // Runs the fastest kernel this CPU supports (see supernodal_solve.h). FAILED_PRECONDITION, with
+  // nothing written, for an empty (default-constructed) factor.
+  Status Solve3(const double* b, double* x, double* work) const;
+  // The same with a chosen kernel, which must be available (for tests and benchmarks).
+  Status Solve3(const double* b, double* x, double* work, SolveKernel kernel) const;
+  // Doubles of scratch Solve3 needs (SolveWorkSize: a four-double row per unknown plus room for
+  // the widest supernode). The same for every factor of one symbolic analysis.
+  std::size_t WorkSize() const;
+  // Bytes one triangular pass reads: the supernodes' values, row indices and pointers.
+  std::size_t bytes() const;
+  // Non-zeros of L (the explicit zeros of the supernodes' diagonal blocks not counted).
+  std::int64_t nonzeros() const { return symbolic_ ? symbolic_->factor_nonzeros() : 0; }
+
+ private:
+  using ColMajorMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
+  // L column by column before it is packed: per column the diagonal first, then rows ascending.
+  struct ColumnFactor {
+    std::vector<int> rows;
+    std::vector<double> values;
+  };
+  // The steps of Factorize().
+  static Status CheckAnalysedPattern(const SymbolicCholesky& s, const ColMajorMatrix& a);
+  static std::vector<double> PermutedUpperValues(const SymbolicCholesky& s,
+                                                 const ColMajorMatrix& a);
+  static StatusOr<ColumnFactor> UpLookingCholesky(const SymbolicCholesky& s,
+                                                  const std::vector<double>& c_values);
+  void PackSupernodes(const SymbolicCholesky& s, const ColumnFactor& l);
+
+  SupernodalFactorView View() const;
+
+  std::shared_ptr<const SymbolicCholesky> symbolic_;
+  // Supernode s: its rows are row_indices_[row_pointers_[s] .. row_pointers_[s + 1]) (its own
+  // columns first, then the rows below, ascending); its values are a dense row-major block of
+  // (#rows) by (width) starting at values_[value_pointers_[s]], zero above the diagonal.
+  std::vector<std::int64_t> row_pointers_;
+  std::vector<std::int64_t> value_pointers_;
+  std::vector<int> row_indices_;
+  std::vector<double> values_;
+};
+
+}  // namespace deform
