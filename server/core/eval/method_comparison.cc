@@ -118,8 +118,10 @@ StatusOr<MethodRun> RunMethod(const DeformationModel& paper_model, Method method
 
   std::vector<RigidTransform> bones;
   ForwardKinematics(paper_model.skeleton(), pose, &bones);
+  Positions skinned;
+  LinearBlendSkinning(paper_model.mesh().vertices, paper_model.bone_weights(), bones, &skinned);
   run.quality = MeasureQuality(paper_model.mesh(), run.posed, paper_model.skeleton(), bones,
-                               paper_model.anchor_vertices(), paper_model.anchor_bones());
+                               skinned, paper_model.rigid_bones());
   return run;
 }
 

@@ -41,19 +41,16 @@ ClearanceStats SkinClearance(const Positions& rest, const Positions& posed,
 
 QualityReport MeasureQuality(const TriangleMesh& rest_mesh, const Positions& posed,
                              const Skeleton& skeleton, const std::vector<RigidTransform>& bones,
-                             const std::vector<int>& rigid_vertices,
-                             const std::vector<int>& rigid_bones) {
+                             const Positions& skinned, const std::vector<int>& rigid_bone) {
   QualityReport report;
   const double diagonal = BoundingBoxDiagonal(rest_mesh.vertices);
   const double rest_volume = EnclosedVolume(rest_mesh.vertices, rest_mesh.triangles);
   report.volume_change = (EnclosedVolume(posed, rest_mesh.triangles) - rest_volume) / rest_volume;
   report.clearance = SkinClearance(rest_mesh.vertices, posed, skeleton, bones);
-  for (size_t a = 0; a < rigid_vertices.size(); ++a) {
-    const int i = rigid_vertices[a];
-    const Eigen::Vector3d target =
-        bones[rigid_bones[a]].Apply(rest_mesh.vertices.row(i).transpose());
+  for (int i = 0; i < rest_mesh.num_vertices(); ++i) {
+    if (rigid_bone[i] < 0) continue;
     report.rigid_zone_error =
-        std::max(report.rigid_zone_error, (posed.row(i).transpose() - target).norm() / diagonal);
+        std::max(report.rigid_zone_error, (posed.row(i) - skinned.row(i)).norm() / diagonal);
   }
   report.max_displacement = (posed - rest_mesh.vertices).rowwise().norm().maxCoeff() / diagonal;
   return report;

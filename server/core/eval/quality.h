@@ -25,18 +25,19 @@ ClearanceStats SkinClearance(const Positions& rest, const Positions& posed,
 struct QualityReport {
   double volume_change = 0;  // (V_posed - V_rest) / V_rest, signed
   ClearanceStats clearance;
-  // max over the `rigid_vertices` of |x_i - (R_k v_i + t_k)| / bounding-box diagonal, k being the
-  // vertex's bone; 0 when no vertices are given.
+  // max over the rigid-zone vertices of |x_i - LBS_i| / bounding-box diagonal (LBS with the model's
+  // own weights: R_k v_i + t_k for a vertex of bone k's rigid zone); 0 when there are none.
   double rigid_zone_error = 0;
   // max over all vertices of |x_i - v_i| / bounding-box diagonal (meaningful for the rest pose).
   double max_displacement = 0;
 };
 
-// All measures at once. `rigid_vertices` / `rigid_bones`: vertices far from every joint and the
-// bone each should follow.
+// All measures at once.
+// `skinned` is linear blend skinning of the same pose with the model's own weights; the rigid-zone
+// error is the largest distance from it of the vertices with rigid_bone[i] >= 0 (those that follow
+// one bone alone), relative to the rest mesh's bounding-box diagonal.
 QualityReport MeasureQuality(const TriangleMesh& rest_mesh, const Positions& posed,
                              const Skeleton& skeleton, const std::vector<RigidTransform>& bones,
-                             const std::vector<int>& rigid_vertices,
-                             const std::vector<int>& rigid_bones);
+                             const Positions& skinned, const std::vector<int>& rigid_bone);
 
 }  // namespace deform

@@ -52,4 +52,23 @@ int ConnectedComponents(const VertexAdjacency& adjacency, std::vector<int>* comp
   return count;
 }
 
+bool IsClosed(const Triangles& triangles) {
+  std::vector<std::pair<int, int>> edges;
+  edges.reserve(3 * static_cast<std::size_t>(triangles.rows()));
+  for (int f = 0; f < triangles.rows(); ++f) {
+    for (int c = 0; c < 3; ++c) {
+      const int a = triangles(f, c), b = triangles(f, (c + 1) % 3);
+      edges.emplace_back(std::min(a, b), std::max(a, b));
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  for (std::size_t e = 0; e < edges.size();) {
+    std::size_t same = e;
+    while (same < edges.size() && edges[same] == edges[e]) ++same;
+    if (same - e < 2) return false;
+    e = same;
+  }
+  return true;
+}
+
 }  // namespace deform

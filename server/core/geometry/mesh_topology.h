@@ -21,4 +21,7 @@ VertexAdjacency BuildVertexAdjacency(const Triangles& triangles, int num_vertice
 // Component label (0-based, in order of the lowest vertex) of every vertex; returns the count.
 int ConnectedComponents(const VertexAdjacency& adjacency, std::vector<int>* component);
 
+// Whether every edge is shared by two triangles (no boundary): the mesh encloses a volume.
+bool IsClosed(const Triangles& triangles);
+
 }  // namespace deform

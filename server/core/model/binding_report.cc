@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
+#include <queue>
+#include <utility>
 
 namespace deform {
 namespace {
@@ -52,19 +55,31 @@ std::vector<std::vector<int>> Pieces(const VertexAdjacency& adjacency,
   return pieces;
 }
 
-// The smallest distance between a vertex of `piece` and one of `main` (the main piece sampled
-// with a stride so that the work stays below about 2e7 pairs).
-double PieceGap(const Positions& vertices, const std::vector<int>& piece,
-                const std::vector<int>& main) {
-  const std::size_t pairs = piece.size() * main.size();
-  const std::size_t stride = std::max<std::size_t>(1, pairs / 20'000'000 + 1);
-  double gap = std::numeric_limits<double>::infinity();
-  for (int i : piece) {
-    for (std::size_t m = 0; m < main.size(); m += stride) {
-      gap = std::min(gap, (vertices.row(i) - vertices.row(main[m])).norm());
+// Distance along the surface (over mesh edges) from `main` to every vertex; infinity where the
+// mesh does not connect them.
+std::vector<double> SurfaceDistanceFrom(const Positions& vertices, const VertexAdjacency& adjacency,
+                                        const std::vector<int>& main) {
+  std::vector<double> distance(vertices.rows(), std::numeric_limits<double>::infinity());
+  using Entry = std::pair<double, int>;
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> queue;
+  for (int i : main) {
+    distance[i] = 0;
+    queue.emplace(0.0, i);
+  }
+  while (!queue.empty()) {
+    const auto [d, i] = queue.top();
+    queue.pop();
+    if (d > distance[i]) continue;
+    for (int p = adjacency.offsets[i]; p < adjacency.offsets[i + 1]; ++p) {
+      const int j = adjacency.neighbors[p];
+      const double through = d + (vertices.row(i) - vertices.row(j)).norm();
+      if (through < distance[j]) {
+        distance[j] = through;
+        queue.emplace(through, j);
+      }
     }
   }
-  return gap;
+  return distance;
 }
 
 double Median(std::vector<double> values) {
@@ -91,16 +106,23 @@ void ReportBone(const TriangleMesh& mesh, const Skeleton& skeleton,
 
   const std::vector<std::vector<int>> pieces = Pieces(adjacency, rigid_bone, k, seen);
   for (const auto& piece : pieces) report->pieces.push_back(static_cast<int>(piece.size()));
-  for (std::size_t p = 1; p < pieces.size(); ++p) {
-    report->farthest_piece =
-        std::max(report->farthest_piece, PieceGap(mesh.vertices, pieces[p], pieces[0]));
+  if (pieces.size() > 1) {
+    const std::vector<double> along = SurfaceDistanceFrom(mesh.vertices, adjacency, pieces.front());
+    for (std::size_t p = 1; p < pieces.size(); ++p) {
+      double gap = std::numeric_limits<double>::infinity();
+      for (int i : pieces[p]) gap = std::min(gap, along[i]);
+      report->farthest_piece = std::max(report->farthest_piece, gap);
+    }
   }
   const double far_apart = std::max(2 * report->thickness, 0.05 * diagonal);
   if (pieces.size() > 1 && report->farthest_piece > far_apart) {
+    const std::string how_far =
+        std::isfinite(report->farthest_piece)
+            ? Format("%.3g", report->farthest_piece / diagonal) + " diagonals along the surface"
+            : std::string("not connected by the surface");
     warnings->push_back("bone " + report->name + ": its rigid zone falls into " +
-                        std::to_string(pieces.size()) + " pieces, one " +
-                        Format("%.3g", report->farthest_piece / diagonal) +
-                        " diagonals from the largest (a part bound to the wrong bone?)");
+                        std::to_string(pieces.size()) + " pieces, one " + how_far +
+                        " from the largest (a part bound to the wrong bone?)");
   }
   if (report->vertices == 0) {
     warnings->push_back("bone " + report->name + ": no vertex follows it");

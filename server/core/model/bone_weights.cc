@@ -9,8 +9,36 @@
 namespace deform {
 namespace {
 
-Status CheckEveryComponentHasFixedVertex(const VertexAdjacency& adjacency,
-                                         const std::vector<int>& fixed_bone) {
+// Drops weights below kDropBelow from `result.dense`'s rows, renormalises, and stores them
+// compressed, largest first.
+void Compress(BoneWeights* result) {
+  const int n = static_cast<int>(result->dense.rows());
+  result->offsets.assign(n + 1, 0);
+  result->bones.clear();
+  result->weights.clear();
+  std::vector<std::pair<double, int>> entries;
+  for (int i = 0; i < n; ++i) {
+    entries.clear();
+    for (int k = 0; k < result->num_bones; ++k) {
+      if (result->dense(i, k) >= BoneWeights::kDropBelow) {
+        entries.emplace_back(result->dense(i, k), k);
+      }
+    }
+    std::sort(entries.begin(), entries.end(), std::greater<>());
+    double sum = 0;
+    for (const auto& e : entries) sum += e.first;
+    for (const auto& e : entries) {
+      result->bones.push_back(e.second);
+      result->weights.push_back(e.first / sum);
+    }
+    result->offsets[i + 1] = static_cast<int>(result->bones.size());
+  }
+}
+
+}  // namespace
+
+Status CheckEveryComponentAnchored(const VertexAdjacency& adjacency,
+                                   const std::vector<int>& fixed_bone) {
   std::vector<int> component;
   const int count = ConnectedComponents(adjacency, &component);
   std::vector<int> first_vertex(count, -1), size(count, 0);
@@ -33,12 +61,10 @@ Status CheckEveryComponentHasFixedVertex(const VertexAdjacency& adjacency,
   return Status::Ok();
 }
 
-}  // namespace
-
 StatusOr<BoneWeights> HarmonicBoneWeights(const VertexAdjacency& adjacency,
                                           const std::vector<int>& fixed_bone, int num_bones) {
   const int n = static_cast<int>(fixed_bone.size());
-  DEFORM_RETURN_IF_ERROR(CheckEveryComponentHasFixedVertex(adjacency, fixed_bone));
+  DEFORM_RETURN_IF_ERROR(CheckEveryComponentAnchored(adjacency, fixed_bone));
 
   // Number the free vertices.
   std::vector<int> free_index(n, -1);
@@ -87,24 +113,20 @@ StatusOr<BoneWeights> HarmonicBoneWeights(const VertexAdjacency& adjacency,
     result.dense = result.dense.cwiseMax(0.0).cwiseMin(1.0);
   }
 
-  // Compress, dropping negligible weights and renormalising.
-  result.offsets.assign(n + 1, 0);
-  std::vector<std::pair<double, int>> entries;
-  for (int i = 0; i < n; ++i) {
-    entries.clear();
-    for (int k = 0; k < num_bones; ++k) {
-      if (result.dense(i, k) >= BoneWeights::kDropBelow)
-        entries.emplace_back(result.dense(i, k), k);
+  Compress(&result);
+  return result;
+}
+
+BoneWeights BoneWeightsFromSkinWeights(const SkinWeights& weights) {
+  BoneWeights result;
+  result.num_bones = weights.num_bones;
+  result.dense = Eigen::MatrixXd::Zero(weights.num_vertices(), weights.num_bones);
+  for (int i = 0; i < weights.num_vertices(); ++i) {
+    for (int e = weights.offsets[i]; e < weights.offsets[i + 1]; ++e) {
+      result.dense(i, weights.bones[e]) += weights.weights[e];
     }
-    std::sort(entries.begin(), entries.end(), std::greater<>());
-    double sum = 0;
-    for (const auto& e : entries) sum += e.first;
-    for (const auto& e : entries) {
-      result.bones.push_back(e.second);
-      result.weights.push_back(e.first / sum);
-    }
-    result.offsets[i + 1] = static_cast<int>(result.bones.size());
   }
+  Compress(&result);
   return result;
 }
 

@@ -6,6 +6,7 @@
 
 #include "core/base/status.h"
 #include "core/geometry/mesh_topology.h"
+#include "core/geometry/skin_weights.h"
 
 namespace deform {
 
@@ -29,5 +30,14 @@ struct BoneWeights {
 // connected component has free vertices but no fixed one (its weights would be undetermined).
 StatusOr<BoneWeights> HarmonicBoneWeights(const VertexAdjacency& adjacency,
                                           const std::vector<int>& fixed_bone, int num_bones);
+
+// INVALID_ARGUMENT naming a connected component of the mesh with no vertex in a rigid zone
+// (`fixed_bone[i]` >= 0): nothing could anchor it to the skeleton.
+Status CheckEveryComponentAnchored(const VertexAdjacency& adjacency,
+                                   const std::vector<int>& fixed_bone);
+
+// The rotation field of given skinning weights (normalised for this mesh: NormalizeSkinWeights),
+// in the same form as the harmonic field.
+BoneWeights BoneWeightsFromSkinWeights(const SkinWeights& weights);
 
 }  // namespace deform

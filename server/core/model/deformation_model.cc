@@ -11,7 +11,10 @@
 
 #include "core/geometry/mesh_topology.h"
 #include "core/geometry/skeleton_geometry.h"
+#include "core/geometry/triangle_bvh.h"
+#include "core/model/body_binding.h"
 #include "core/model/rotation_blend.h"
+#include "core/model/weight_binding.h"
 
 namespace deform {
 namespace {
@@ -28,8 +31,8 @@ std::uint64_t NextModelId() {
   return next.fetch_add(1, std::memory_order_relaxed);
 }
 
-// Rigid zones: outside every joint region, a vertex belongs wholly to its nearest bone (the bone
-// per vertex, -1 inside a region).
+// Rigid zones: outside every joint region, a vertex belongs wholly to the bone it is bound to (the
+// bone per vertex, -1 inside a region).
 std::vector<int> RigidZones(const JointRegions& regions, const std::vector<NearestBone>& nearest) {
   const int n = static_cast<int>(nearest.size());
   std::vector<int> fixed_bone(n, -1);
@@ -86,6 +89,12 @@ Eigen::Matrix3d LinearBlend(const BoneWeights& bw, int segments, int vertex,
 
 StatusOr<std::shared_ptr<const DeformationModel>> DeformationModel::Build(
     TriangleMesh mesh, Skeleton skeleton, const ModelOptions& options, const BuildHooks& hooks) {
+  return Build(std::move(mesh), std::move(skeleton), options, nullptr, hooks);
+}
+
+StatusOr<std::shared_ptr<const DeformationModel>> DeformationModel::Build(
+    TriangleMesh mesh, Skeleton skeleton, const ModelOptions& options, const SkinWeights* weights,
+    const BuildHooks& hooks) {
   const auto start = Clock::now();
   DEFORM_RETURN_IF_ERROR(ValidateMesh(mesh, options.limits));
   DEFORM_RETURN_IF_ERROR(ValidateModelOptions(options));
@@ -95,7 +104,7 @@ StatusOr<std::shared_ptr<const DeformationModel>> DeformationModel::Build(
   model->mesh_ = std::move(mesh);
   model->skeleton_ = std::move(skeleton);
   model->options_ = options;
-  DEFORM_RETURN_IF_ERROR(model->Precompute());
+  DEFORM_RETURN_IF_ERROR(model->Precompute(weights));
   model->precompute_seconds_ = SecondsSince(start);
   if (hooks.precomputed) hooks.precomputed();
   DEFORM_ASSIGN_OR_RETURN(model->default_factorization_, model->Factorize(Stiffness{}));
@@ -105,18 +114,68 @@ StatusOr<std::shared_ptr<const DeformationModel>> DeformationModel::Build(
   return std::shared_ptr<const DeformationModel>(std::move(model));
 }
 
-Status DeformationModel::Precompute() {
+Status DeformationModel::Precompute(const SkinWeights* weights) {
   diagonal_ = BoundingBoxDiagonal(mesh_.vertices);
   const VertexAdjacency adjacency = BuildVertexAdjacency(mesh_.triangles, mesh_.num_vertices());
-  const std::vector<NearestBone> nearest = NearestBones(mesh_.vertices, skeleton_);
-  DEFORM_ASSIGN_OR_RETURN(
-      regions_, ComputeJointRegions(mesh_, skeleton_, adjacency, nearest, options_.regions));
-  const std::vector<int> fixed_bone = RigidZones(regions_, nearest);
-  DEFORM_ASSIGN_OR_RETURN(bone_weights_,
-                          HarmonicBoneWeights(adjacency, fixed_bone, skeleton_.num_bones()));
-  system_ = BuildLaplacianSystem(mesh_, adjacency, regions_, fixed_bone, options_);
+  const TriangleBvh bvh(mesh_);
+  DEFORM_RETURN_IF_ERROR(CheckSkeletonAgainstMesh(mesh_, skeleton_, bvh));
+  if (weights != nullptr) {
+    DEFORM_RETURN_IF_ERROR(BindToWeights(*weights, adjacency));
+  } else {
+    DEFORM_RETURN_IF_ERROR(BindAutomatically(adjacency, bvh));
+  }
+  system_ = BuildLaplacianSystem(mesh_, adjacency, regions_, rigid_bones_, bone_weights_, options_);
+  BindingReport report = ReportBinding(mesh_, skeleton_, adjacency, bvh, bound_bones_, rigid_bones_,
+                                       system_.anchors, IsClosed(mesh_.triangles));
+  report.source = binding_report_.source;
+  report.seen_through_body = binding_report_.seen_through_body;
+  report.reached_along_surface = binding_report_.reached_along_surface;
+  report.straight_line = binding_report_.straight_line;
+  binding_report_ = std::move(report);
   DEFORM_ASSIGN_OR_RETURN(
       symbolic_, SymbolicCholesky::Analyze(NormalMatrixPattern(system_), options_.ordering));
+  return Status::Ok();
+}
+
+Status DeformationModel::BindAutomatically(const VertexAdjacency& adjacency,
+                                           const TriangleBvh& bvh) {
+  std::vector<NearestBone> bound;
+  if (options_.binding == BindingMethod::kThroughBody) {
+    BodyBinding binding = BindThroughBody(mesh_, skeleton_, adjacency, bvh);
+    binding_report_.source = "through the body";
+    binding_report_.seen_through_body = binding.seen_through_body;
+    binding_report_.reached_along_surface = binding.reached_along_surface;
+    binding_report_.straight_line = binding.straight_line;
+    bound = std::move(binding.bones);
+  } else {
+    bound = NearestBones(mesh_.vertices, skeleton_);
+    binding_report_.source = "straight line";
+    binding_report_.straight_line = mesh_.num_vertices();
+  }
+  DEFORM_ASSIGN_OR_RETURN(
+      regions_, ComputeJointRegions(mesh_, skeleton_, adjacency, bound, options_.regions));
+  rigid_bones_ = RigidZones(regions_, bound);
+  DEFORM_ASSIGN_OR_RETURN(bone_weights_,
+                          HarmonicBoneWeights(adjacency, rigid_bones_, skeleton_.num_bones()));
+  bound_bones_.resize(bound.size());
+  for (std::size_t i = 0; i < bound.size(); ++i) bound_bones_[i] = bound[i].bone;
+  return Status::Ok();
+}
+
+Status DeformationModel::BindToWeights(const SkinWeights& weights,
+                                       const VertexAdjacency& adjacency) {
+  DEFORM_ASSIGN_OR_RETURN(
+      const SkinWeights normalized,
+      NormalizeSkinWeights(weights, mesh_.num_vertices(), skeleton_.num_bones()));
+  const WeightBinding binding =
+      BindFromWeights(mesh_, skeleton_, normalized, options_.rigid_weight_tolerance);
+  DEFORM_RETURN_IF_ERROR(CheckEveryComponentAnchored(adjacency, binding.rigid_bone));
+  regions_ = RegionsFromWeightBinding(mesh_, skeleton_, adjacency, binding);
+  rigid_bones_ = binding.rigid_bone;
+  bound_bones_ = binding.main_bone;
+  bone_weights_ = BoneWeightsFromSkinWeights(normalized);
+  weights_given_ = true;
+  binding_report_.source = "given weights";
   return Status::Ok();
 }
 
@@ -265,8 +324,11 @@ void DeformationModel::AddConstraintTargets(const Pose& pose, DeformScratch* scr
   auto& rhs = scratch->solution;
   const double anchor2 = system_.anchor_weight * system_.anchor_weight;
   for (size_t a = 0; a < system_.anchors.size(); ++a) {
-    const Eigen::Vector3d target =
-        bones[system_.anchor_bones[a]].Apply(system_.anchor_rest.row(a).transpose());
+    const Eigen::Vector3d rest = system_.anchor_rest.row(a).transpose();
+    Eigen::Vector3d target = Eigen::Vector3d::Zero();
+    for (int e = system_.anchor_offsets[a]; e < system_.anchor_offsets[a + 1]; ++e) {
+      target += system_.anchor_weights[e] * bones[system_.anchor_bones[e]].Apply(rest);
+    }
     rhs.row(system_.anchors[a]) += anchor2 * target.transpose();
   }
   const double node2 = system_.node_weight * system_.node_weight;

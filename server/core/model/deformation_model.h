@@ -29,6 +29,8 @@
 #include "core/geometry/mesh.h"
 #include "core/geometry/pose.h"
 #include "core/geometry/skeleton.h"
+#include "core/geometry/skin_weights.h"
+#include "core/model/binding_report.h"
 #include "core/model/bone_weights.h"
 #include "core/model/joint_regions.h"
 #include "core/model/laplacian_system.h"
@@ -112,10 +114,25 @@ class DeformationModel {
   // check what parsing needs and return meshes that pass ValidateMesh (core/io/mesh_io.h); Build
   // checks again for direct callers (phantoms, tests, meshes made in code); the service adds only
   // its own limits (options.limits, the memory budget in hooks.validated) and checks nothing twice.
-  // INVALID_ARGUMENT also for a mesh component that cannot be anchored (no vertex in a rigid zone).
+  // INVALID_ARGUMENT also for a mesh component that cannot be anchored (no vertex in a rigid zone)
+  // and for a skeleton that cannot belong to the mesh (CheckSkeletonAgainstMesh: a joint farther
+  // than a diagonal from the surface, or none within the mesh's bounding box).
+  //
+  // Binding (which bones each vertex follows): with `weights` (a rig's own skinning weights, one
+  // row per vertex, bones in skeleton order; checked and normalised here), they are the rotation
+  // field; a vertex whose largest weight is at least 1 - options.rigid_weight_tolerance is in that
+  // bone's rigid zone, the others form the joint regions (weight_binding.h), and anchors follow
+  // the vertex's own weights, i.e. the rig's linear blend skinning. Without, options.binding (by
+  // default through the body, body_binding.h), harmonic weights inside the joint regions. What came
+  // of it is in binding_report().
   static StatusOr<std::shared_ptr<const DeformationModel>> Build(TriangleMesh mesh,
                                                                  Skeleton skeleton,
                                                                  const ModelOptions& options,
+                                                                 const BuildHooks& hooks = {});
+  static StatusOr<std::shared_ptr<const DeformationModel>> Build(TriangleMesh mesh,
+                                                                 Skeleton skeleton,
+                                                                 const ModelOptions& options,
+                                                                 const SkinWeights* weights,
                                                                  const BuildHooks& hooks = {});
 
   // A new factorisation for `stiffness`, reusing the symbolic analysis. INVALID_ARGUMENT for
@@ -160,8 +177,13 @@ class DeformationModel {
   const BoneWeights& bone_weights() const { return bone_weights_; }
   const JointRegions& joint_regions() const { return regions_; }
   const std::vector<int>& anchor_vertices() const { return system_.anchors; }
-  // The bone each anchor vertex follows rigidly (same order as anchor_vertices()).
-  const std::vector<int>& anchor_bones() const { return system_.anchor_bones; }
+  // Per vertex: the bone whose rigid zone it is in (it follows that bone alone), or -1.
+  const std::vector<int>& rigid_bones() const { return rigid_bones_; }
+  // Per vertex: the bone it is bound to (its rigid bone, the bone binding chose for it, or its
+  // largest given weight's bone).
+  const std::vector<int>& bound_bones() const { return bound_bones_; }
+  const BindingReport& binding_report() const { return binding_report_; }
+  bool weights_given() const { return weights_given_; }
   int num_joint_nodes() const { return system_.num_nodes; }
   double bounding_box_diagonal() const { return diagonal_; }
   // Seconds spent in Build() before the first numeric factorisation.
@@ -184,7 +206,10 @@ class DeformationModel {
   void AssembleOwnedRightHandSide(const MaterialFactorization& factorization, const Pose& pose,
                                   DeformScratch* scratch) const;
   void SolveOwnedInPlace(const MaterialFactorization& factorization, DeformScratch* scratch) const;
-  Status Precompute();
+  Status Precompute(const SkinWeights* weights);
+  // The binding steps of Precompute: set regions_, bone_weights_, rigid_bones_, bound_bones_.
+  Status BindAutomatically(const VertexAdjacency& adjacency, const TriangleBvh& bvh);
+  Status BindToWeights(const SkinWeights& weights, const VertexAdjacency& adjacency);
   // The vertex rows' weights w_i for `stiffness` (all 1 with uniform_material).
   StatusOr<Eigen::VectorXd> RowWeights(const Stiffness& stiffness) const;
   // The steps of AssembleRightHandSide: r = w^2 T delta into scratch->rotated_deltas (after the
@@ -199,6 +224,10 @@ class DeformationModel {
   double diagonal_ = 0;
   BoneWeights bone_weights_;
   JointRegions regions_;
+  std::vector<int> rigid_bones_;
+  std::vector<int> bound_bones_;
+  bool weights_given_ = false;
+  BindingReport binding_report_;
   LaplacianSystem system_;  // L', the rest deltas, the anchors and joint nodes
   std::shared_ptr<const SymbolicCholesky> symbolic_;
   std::shared_ptr<const MaterialFactorization> default_factorization_;

@@ -3,33 +3,10 @@
 #include <algorithm>
 #include <cstddef>
 
+#include "core/model/anchors.h"
+
 namespace deform {
 namespace {
-
-// Anchors: rigid-zone vertices far from every joint centre; per component, if none is far enough,
-// the rigid-zone vertices farthest from the joints (within 90% of the farthest).
-std::vector<int> ChooseAnchors(const VertexAdjacency& adjacency, const std::vector<int>& fixed_bone,
-                               const JointRegions& regions, double distance_factor) {
-  std::vector<int> component;
-  const int count = ConnectedComponents(adjacency, &component);
-  const int n = static_cast<int>(fixed_bone.size());
-  std::vector<double> farthest(count, -1.0);
-  std::vector<char> has_far(count, 0);
-  for (int i = 0; i < n; ++i) {
-    if (fixed_bone[i] < 0) continue;
-    const double s = regions.relative_distance[i];
-    farthest[component[i]] = std::max(farthest[component[i]], s);
-    if (s >= distance_factor) has_far[component[i]] = 1;
-  }
-  std::vector<int> anchors;
-  for (int i = 0; i < n; ++i) {
-    if (fixed_bone[i] < 0) continue;
-    const double s = regions.relative_distance[i];
-    const int c = component[i];
-    if (has_far[c] ? s >= distance_factor : s >= 0.9 * farthest[c]) anchors.push_back(i);
-  }
-  return anchors;
-}
 
 // L' (n by n + m): uniform weights over the one-ring plus the joint nodes of the vertex.
 RowMajorSparseMatrix BuildLaplacian(const VertexAdjacency& adjacency, const JointRegions& regions,
@@ -112,7 +89,7 @@ void MultiplySparseBy3(const Eigen::SparseMatrix<double, Eigen::RowMajor, int>& 
 
 LaplacianSystem BuildLaplacianSystem(const TriangleMesh& mesh, const VertexAdjacency& adjacency,
                                      const JointRegions& regions,
-                                     const std::vector<int>& fixed_bone,
+                                     const std::vector<int>& fixed_bone, const BoneWeights& weights,
                                      const ModelOptions& options) {
   LaplacianSystem system;
   system.num_vertices = mesh.num_vertices();
@@ -125,12 +102,18 @@ LaplacianSystem BuildLaplacianSystem(const TriangleMesh& mesh, const VertexAdjac
   system.laplacian_transpose.makeCompressed();
   system.rest_deltas = RestDeltas(mesh, regions, system.laplacian, system.num_nodes);
 
-  system.anchors = ChooseAnchors(adjacency, fixed_bone, regions, options.anchor_distance_factor);
-  system.anchor_bones.resize(system.anchors.size());
+  system.anchors = ChooseAnchors(adjacency, fixed_bone, regions, options.anchor_distance_factor,
+                                 options.anchor_min_fraction);
   system.anchor_rest.resize(static_cast<Eigen::Index>(system.anchors.size()), 3);
+  system.anchor_offsets.assign(1, 0);
   for (std::size_t a = 0; a < system.anchors.size(); ++a) {
-    system.anchor_bones[a] = fixed_bone[system.anchors[a]];
-    system.anchor_rest.row(a) = mesh.vertices.row(system.anchors[a]);
+    const int i = system.anchors[a];
+    for (int e = weights.offsets[i]; e < weights.offsets[i + 1]; ++e) {
+      system.anchor_bones.push_back(weights.bones[e]);
+      system.anchor_weights.push_back(weights.weights[e]);
+    }
+    system.anchor_offsets.push_back(static_cast<int>(system.anchor_bones.size()));
+    system.anchor_rest.row(a) = mesh.vertices.row(i);
   }
   system.anchor_weight = options.anchor_weight;
   system.node_weight = options.joint_node_weight;

@@ -3,7 +3,8 @@
 // m joint centre nodes, K bones; x holds the n vertices' positions, then the m nodes'):
 //
 //   vertex rows  w_i ((L' x)_i - T_i delta_i)    delta = L' x_rest, T_i the vertex's rotation blend
-//   anchor rows  anchor_weight (x_a - posed a)   an anchor vertex moves rigidly with its bone
+//   anchor rows  anchor_weight (x_a - posed a)   an anchor vertex follows its skinning weights
+//                                                (rigidly its bone's motion, at weight 1)
 //   node rows    node_weight (x_(n+c) - o_c')    joint node c follows its posed joint centre
 //
 // so that A^T A = L'^T W^2 L' + anchor_weight^2 sum e_a e_a^T + node_weight^2 sum e_c e_c^T and
@@ -17,6 +18,7 @@
 
 #include "core/geometry/mesh.h"
 #include "core/geometry/mesh_topology.h"
+#include "core/model/bone_weights.h"
 #include "core/model/joint_regions.h"
 #include "core/model/model_options.h"
 
@@ -32,23 +34,28 @@ struct LaplacianSystem {
   // by rows; and its transpose for A^T b.
   RowMajorSparseMatrix laplacian;
   RowMajorSparseMatrix laplacian_transpose;
-  Positions rest_deltas;          // delta = L' x_rest, n by 3
-  std::vector<int> anchors;       // the anchor vertices, ascending
-  std::vector<int> anchor_bones;  // the bone each anchor follows
-  Positions anchor_rest;          // their rest positions, #anchors by 3
+  Positions rest_deltas;     // delta = L' x_rest, n by 3
+  std::vector<int> anchors;  // the anchor vertices, ascending
+  // Anchor a's target is sum_e anchor_weights[e] B_(anchor_bones[e]) (rest a) over its entries
+  // e in [anchor_offsets[a], anchor_offsets[a + 1]): its own skinning weights (one entry of
+  // weight 1 for a vertex of a rigid zone bound automatically).
+  std::vector<int> anchor_offsets;
+  std::vector<int> anchor_bones;
+  std::vector<double> anchor_weights;
+  Positions anchor_rest;  // their rest positions, #anchors by 3
   double anchor_weight = 0;
   double node_weight = 0;
 };
 
-// Builds the system for `mesh` with its one-ring `adjacency`, joint `regions` and rigid zones
-// (`fixed_bone[i]` the bone vertex i belongs to wholly, -1 for none). A region vertex's row refers
+// Builds the system for `mesh` with its one-ring `adjacency`, joint `regions`, rigid zones
+// (`fixed_bone[i]` the bone vertex i belongs to wholly, -1 for none) and bone `weights` (what the
+// anchors follow). A region vertex's row refers
 // to its joint nodes with options.joint_node_balance (or as one more neighbour, with
-// joint_node_one_neighbor). Anchors are the rigid-zone vertices at least
-// options.anchor_distance_factor region radii from every joint centre or, in a component with no
-// such vertex, its rigid-zone vertices within 90% of the farthest.
+// joint_node_one_neighbor). Anchors: ChooseAnchors (anchors.h) with options.anchor_distance_factor
+// and options.anchor_min_fraction.
 LaplacianSystem BuildLaplacianSystem(const TriangleMesh& mesh, const VertexAdjacency& adjacency,
                                      const JointRegions& regions,
-                                     const std::vector<int>& fixed_bone,
+                                     const std::vector<int>& fixed_bone, const BoneWeights& weights,
                                      const ModelOptions& options);
 
 // A^T A ((n + m) square, column-major, compressed) for the vertex rows' squared weights w_i^2 (n).

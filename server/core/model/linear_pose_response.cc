@@ -254,15 +254,18 @@ class ResponseSolver {
 
  private:
   // The right-hand side rows of the anchors and joint nodes that follow `bone` += their weight^2 *
-  // target(their rest position).
+  // (an anchor's skinning weight on `bone`) * target(their rest position).
   template <typename Target>
   void AddConstraints(int bone, const Target& target) {
     const int n = system_.num_vertices;
     const double anchor2 = system_.anchor_weight * system_.anchor_weight;
     const double node2 = system_.node_weight * system_.node_weight;
     for (std::size_t a = 0; a < system_.anchors.size(); ++a) {
-      if (system_.anchor_bones[a] == bone) {
-        rhs_.row(system_.anchors[a]) += anchor2 * target(system_.anchor_rest.row(a));
+      for (int e = system_.anchor_offsets[a]; e < system_.anchor_offsets[a + 1]; ++e) {
+        if (system_.anchor_bones[e] == bone) {
+          rhs_.row(system_.anchors[a]) +=
+              (anchor2 * system_.anchor_weights[e]) * target(system_.anchor_rest.row(a));
+        }
       }
     }
     for (int c = 0; c < system_.num_nodes; ++c) {

@@ -33,6 +33,14 @@ Status ValidateModelOptions(const ModelOptions& options) {
     return Status::InvalidArgument("anchor_distance_factor must be at least 0, got " +
                                    std::to_string(options.anchor_distance_factor));
   }
+  if (!(options.rigid_weight_tolerance >= 0 && options.rigid_weight_tolerance < 0.5)) {
+    return Status::InvalidArgument("rigid_weight_tolerance must be in [0, 0.5), got " +
+                                   std::to_string(options.rigid_weight_tolerance));
+  }
+  if (!(options.anchor_min_fraction >= 0 && options.anchor_min_fraction <= 1)) {
+    return Status::InvalidArgument("anchor_min_fraction must be in [0, 1], got " +
+                                   std::to_string(options.anchor_min_fraction));
+  }
   DEFORM_RETURN_IF_ERROR(CheckInRange(options.joint_node_balance,
                                       ModelOptions::kMaxJointNodeBalance, "joint_node_balance"));
   if (options.linear_blend_segments < 1 ||

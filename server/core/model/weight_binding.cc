@@ -47,7 +47,7 @@ int NearestInnerJoint(const Skeleton& skeleton, const std::vector<char>& inner,
 }  // namespace
 
 WeightBinding BindFromWeights(const TriangleMesh& mesh, const Skeleton& skeleton,
-                              const SkinWeights& weights) {
+                              const SkinWeights& weights, double rigid_tolerance) {
   const int n = mesh.num_vertices();
   std::vector<char> inner(skeleton.num_joints(), 0);
   for (int j : skeleton.InnerJoints()) inner[j] = 1;
@@ -71,7 +71,7 @@ WeightBinding BindFromWeights(const TriangleMesh& mesh, const Skeleton& skeleton
       }
     }
     result.main_bone[i] = first;
-    if (first_weight >= 1 - kRigidTolerance || second < 0) {
+    if (first_weight >= 1 - rigid_tolerance || second < 0) {
       result.rigid_bone[i] = first;
       continue;
     }

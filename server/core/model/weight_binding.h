@@ -21,14 +21,12 @@ struct WeightBinding {
   std::vector<int> main_bone;     // per vertex: its largest weight's bone
 };
 
-// A vertex is rigid when one bone carries at least 1 - kRigidTolerance of its weight.
-inline constexpr double kRigidTolerance = 1e-6;
-
-// `weights` must be normalised for this mesh and skeleton (NormalizeSkinWeights). A blending
+// `weights` must be normalised for this mesh and skeleton (NormalizeSkinWeights). A vertex is
+// rigid when one bone carries at least 1 - rigid_tolerance of its weight. A blending
 // vertex's region: of the inner joints on the skeleton path between its two largest weights' bones
 // (the joint they share when they meet), the one nearest to the vertex.
 WeightBinding BindFromWeights(const TriangleMesh& mesh, const Skeleton& skeleton,
-                              const SkinWeights& weights);
+                              const SkinWeights& weights, double rigid_tolerance);
 
 // The joint regions of a weight binding: region c holds the vertices whose region_joint is c's
 // joint (one region per inner joint, in Skeleton::InnerJoints() order, possibly empty). Its radius
