@@ -172,6 +172,13 @@ CLI::App* AddPhantomCommand(CLI::App* app, PhantomArgs* args) {
   return command;
 }
 
+// --help and the like exit 0 through CLI11; a bad command line is one line on stderr, exit 2.
+int ParseFailure(const CLI::App& app, const CLI::ParseError& error) {
+  if (error.get_exit_code() == 0) return app.exit(error);
+  std::cerr << "deformctl: " << error.what() << "\n";
+  return 2;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -186,10 +193,7 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    if (e.get_exit_code() == 0) return app.exit(e);
-    std::cerr << "deformctl: " << e.what() << "\n";
-    return 2;
+    return ParseFailure(app, e);
   }
-  if (*deform_command) return RunDeform(deform_args);
-  return RunPhantom(phantom_args);
+  return *deform_command ? RunDeform(deform_args) : RunPhantom(phantom_args);
 }

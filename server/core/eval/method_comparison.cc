@@ -101,11 +101,10 @@ void RunSkinningMethod(const DeformationModel& paper_model, Method method, const
 }  // namespace
 
 StatusOr<Method> MethodFromName(std::string_view name) {
-  if (name == "paper") return Method::kPaper;
-  if (name == "paper-linear") return Method::kPaperLinear;
-  if (name == "laplacian") return Method::kLaplacian;
-  if (name == "lbs") return Method::kLbs;
-  if (name == "dqs") return Method::kDqs;
+  for (Method method :
+       {Method::kPaper, Method::kPaperLinear, Method::kLaplacian, Method::kLbs, Method::kDqs}) {
+    if (name == MethodName(method)) return method;
+  }
   return Status::InvalidArgument("unknown method '" + std::string(name) +
                                  "' (known: paper, paper-linear, laplacian, lbs, dqs)");
 }
