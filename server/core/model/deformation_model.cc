@@ -125,9 +125,8 @@ StatusOr<std::shared_ptr<const MaterialFactorization>> DeformationModel::Factori
   const auto start = Clock::now();
   auto result = std::make_shared<MaterialFactorization>();
   result->model_id_ = id_;
-  result->stiffness_ = stiffness;
-  DEFORM_ASSIGN_OR_RETURN(result->row_weights_, RowWeights(stiffness));
-  result->row_weights_squared_ = result->row_weights_.array().square();
+  DEFORM_ASSIGN_OR_RETURN(const Eigen::VectorXd row_weights, RowWeights(stiffness));
+  result->row_weights_squared_ = row_weights.array().square();
   DEFORM_ASSIGN_OR_RETURN(
       result->factor_, CholeskyFactor::Factorize(
                            symbolic_, deform::NormalMatrix(system_, result->row_weights_squared_)));
