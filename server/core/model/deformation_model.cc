@@ -65,13 +65,14 @@ Eigen::Matrix3d LinearBlend(const BoneWeights& bw, int segments, int vertex,
   const int begin = bw.offsets[vertex], end = bw.offsets[vertex + 1];
   if (end - begin == 2 && segments > 1) {
     // The pair's knots (ordered by bone index, as the response numbers them) around h_b.
-    const auto [a, b, h] =
+    const BonePair pair =
         OrderedPair(bw.bones[begin], bw.weights[begin], bw.bones[begin + 1], bw.weights[begin + 1]);
-    const PairSegment segment = SegmentOf(h, segments);
+    const PairSegment segment = SegmentOf(pair.h, segments);
     const auto knot = [&](int j) -> Eigen::Matrix3d {
-      if (j == 0) return bone_rotations[a];
-      if (j == segments) return bone_rotations[b];
-      return PairKnot(bones[a].rotation, bones[b].rotation, static_cast<double>(j) / segments)
+      if (j == 0) return bone_rotations[pair.a];
+      if (j == segments) return bone_rotations[pair.b];
+      return PairKnot(bones[pair.a].rotation, bones[pair.b].rotation,
+                      static_cast<double>(j) / segments)
           .toRotationMatrix();
     };
     return (1 - segment.upper_weight) * knot(segment.lower) +
