@@ -104,71 +104,90 @@ void ReportAgainstBound(benchmark::State& state, std::size_t bytes,
   state.counters["x_cache_bound"] = median_ms / cache_bound_ms;
 }
 
+// What the frame benchmarks work on: a mesh's model, its benchmark pose, the model's default
+// factorisation and a scratch.
+struct FrameSetup {
+  std::shared_ptr<const DeformationModel> model;
+  Pose pose;
+  const MaterialFactorization* factorization = nullptr;
+  DeformScratch scratch;
+};
+
+// The setup for `mesh` with `blend`, or null with the benchmark skipped when the mesh could not be
+// loaded.
+std::unique_ptr<FrameSetup> SetUpFrames(benchmark::State& state, const BenchMesh& mesh,
+                                        RotationBlend blend = RotationBlend::kQuaternion) {
+  auto model = ModelFor(mesh, blend);
+  if (!model) {
+    state.SkipWithError("mesh could not be loaded");
+    return nullptr;
+  }
+  auto setup = std::make_unique<FrameSetup>();
+  setup->pose = PoseFor(*model, mesh);
+  setup->factorization = model->default_factorization().get();
+  setup->scratch = model->MakeScratch();
+  setup->model = std::move(model);
+  return setup;
+}
+
 // A whole frame: kinematics, rotation blend, right-hand side and both triangular passes.
 void BM_Frame(benchmark::State& state, BenchMesh mesh) {
-  auto model = ModelFor(mesh);
-  if (!model) return state.SkipWithError("mesh could not be loaded");
-  const Pose pose = PoseFor(*model, mesh);
-  DeformScratch scratch = model->MakeScratch();
-  const auto& factorization = *model->default_factorization();
-  const auto seconds = TimeEach(state, [&] { model->Deform(factorization, pose, &scratch); });
-  ReportAgainstBound(state, factorization.factor().bytes(), seconds);
-  state.counters["vertices"] = model->mesh().num_vertices();
+  auto frames = SetUpFrames(state, mesh);
+  if (!frames) return;
+  const auto seconds = TimeEach(state, [&] {
+    frames->model->Deform(*frames->factorization, frames->pose, &frames->scratch);
+  });
+  ReportAgainstBound(state, frames->factorization->factor().bytes(), seconds);
+  state.counters["vertices"] = frames->model->mesh().num_vertices();
 }
 
 // A whole frame of the linear rotation blend (METHOD.md's fast path): kinematics and one pass over
 // the precomputed response, no solve. Compare with Frame/ of the same mesh in the same run.
 void BM_LinearBlendFrame(benchmark::State& state, BenchMesh mesh) {
-  auto model = ModelFor(mesh, RotationBlend::kLinear);
-  if (!model) return state.SkipWithError("mesh could not be loaded");
-  const auto& factorization = *model->default_factorization();
-  const LinearPoseResponse* response = factorization.linear_response();
+  auto frames = SetUpFrames(state, mesh, RotationBlend::kLinear);
+  if (!frames) return;
+  const LinearPoseResponse* response = frames->factorization->linear_response();
   if (response == nullptr) return state.SkipWithError("no linear response (larger than factor)");
-  const Pose pose = PoseFor(*model, mesh);
-  DeformScratch scratch = model->MakeScratch();
-  const auto seconds = TimeEach(state, [&] { model->Deform(factorization, pose, &scratch); });
+  const auto seconds = TimeEach(state, [&] {
+    frames->model->Deform(*frames->factorization, frames->pose, &frames->scratch);
+  });
   ReportAgainstBound(state, response->bytes(), seconds, 1, "response_MB");
 }
 
 // The two triangular passes alone (what the memory-read bound limits), with the given kernel.
 void BM_TriangularSolve(benchmark::State& state, BenchMesh mesh, SolveKernel kernel) {
   if (!SolveKernelAvailable(kernel)) return state.SkipWithError("kernel not available here");
-  auto model = ModelFor(mesh);
-  if (!model) return state.SkipWithError("mesh could not be loaded");
-  const Pose pose = PoseFor(*model, mesh);
-  DeformScratch scratch = model->MakeScratch();
-  const auto& factorization = *model->default_factorization();
-  model->AssembleRightHandSide(factorization, pose, &scratch);
+  auto frames = SetUpFrames(state, mesh);
+  if (!frames) return;
+  const CholeskyFactor& factor = frames->factorization->factor();
+  DeformScratch& scratch = frames->scratch;
+  frames->model->AssembleRightHandSide(*frames->factorization, frames->pose, &scratch);
   const auto rhs = scratch.solution;
   const auto seconds = TimeEach(state, [&] {
-    benchmark::DoNotOptimize(factorization.factor().Solve3(rhs.data(), scratch.solution.data(),
-                                                           scratch.solve_work.data(), kernel));
+    benchmark::DoNotOptimize(
+        factor.Solve3(rhs.data(), scratch.solution.data(), scratch.solve_work.data(), kernel));
   });
-  ReportAgainstBound(state, factorization.factor().bytes(), seconds);
+  ReportAgainstBound(state, factor.bytes(), seconds);
 }
 
 // The right-hand side alone: kinematics, rotation blend and the product with L'^T.
 void BM_RightHandSide(benchmark::State& state, BenchMesh mesh) {
-  auto model = ModelFor(mesh);
-  if (!model) return state.SkipWithError("mesh could not be loaded");
-  const Pose pose = PoseFor(*model, mesh);
-  DeformScratch scratch = model->MakeScratch();
-  const auto& factorization = *model->default_factorization();
-  const auto seconds =
-      TimeEach(state, [&] { model->AssembleRightHandSide(factorization, pose, &scratch); });
+  auto frames = SetUpFrames(state, mesh);
+  if (!frames) return;
+  const auto seconds = TimeEach(state, [&] {
+    frames->model->AssembleRightHandSide(*frames->factorization, frames->pose, &frames->scratch);
+  });
   state.counters["median_ms"] = Median(seconds) * 1e3;
 }
 
 // Baseline: Eigen's SimplicialLLT (AMD ordering) on the same system, three columns at once.
 void BM_EigenBaselineSolve(benchmark::State& state, BenchMesh mesh) {
-  auto model = ModelFor(mesh);
-  if (!model) return state.SkipWithError("mesh could not be loaded");
-  const Pose pose = PoseFor(*model, mesh);
-  const auto& factorization = *model->default_factorization();
-  Eigen::SimplicialLLT<Eigen::SparseMatrix<double>> llt(model->NormalMatrix(factorization));
-  DeformScratch scratch = model->MakeScratch();
-  model->AssembleRightHandSide(factorization, pose, &scratch);
-  const Eigen::MatrixXd rhs = scratch.solution;
+  auto frames = SetUpFrames(state, mesh);
+  if (!frames) return;
+  Eigen::SimplicialLLT<Eigen::SparseMatrix<double>> llt(
+      frames->model->NormalMatrix(*frames->factorization));
+  frames->model->AssembleRightHandSide(*frames->factorization, frames->pose, &frames->scratch);
+  const Eigen::MatrixXd rhs = frames->scratch.solution;
   Eigen::MatrixXd x(rhs.rows(), 3);
   const auto seconds = TimeEach(state, [&] {
     x = llt.solve(rhs);
@@ -229,6 +248,30 @@ std::vector<BenchMesh> AvailableMeshes() {
   return meshes;
 }
 
+// Registers benchmark `name`/<mesh> of `function`(state, mesh, extra...), timed in milliseconds.
+template <typename Function, typename... Extra>
+benchmark::internal::Benchmark* RegisterFor(const BenchMesh& mesh, const std::string& name,
+                                            Function function, Extra... extra) {
+  return benchmark::RegisterBenchmark((name + "/" + mesh.name).c_str(), function, mesh, extra...)
+      ->Unit(benchmark::kMillisecond);
+}
+
+// Every benchmark of one mesh (the 133k arm with fewer precomputation iterations).
+void RegisterBenchmarks(const BenchMesh& mesh) {
+  const bool large = mesh.name == "arm_132946";
+  RegisterFor(mesh, "Precompute", BM_Precompute)->Iterations(large ? 1 : 3);
+  RegisterFor(mesh, "Factorize", BM_Factorize)->Iterations(large ? 2 : 5);
+  RegisterFor(mesh, "Frame", BM_Frame)->MinTime(1.0);
+  RegisterFor(mesh, "LinearBlendFrame", BM_LinearBlendFrame)->MinTime(1.0);
+  RegisterFor(mesh, "RightHandSide", BM_RightHandSide)->MinTime(0.5);
+  RegisterFor(mesh, "TriangularSolve", BM_TriangularSolve, BestSolveKernel())->MinTime(1.0);
+  if (BestSolveKernel() != SolveKernel::kBaseline) {
+    RegisterFor(mesh, "TriangularSolveBaselineKernel", BM_TriangularSolve, SolveKernel::kBaseline)
+        ->MinTime(1.0);
+  }
+  RegisterFor(mesh, "EigenBaselineSolve", BM_EigenBaselineSolve)->MinTime(1.0);
+}
+
 }  // namespace
 }  // namespace deform::bench
 
@@ -238,39 +281,7 @@ int main(int argc, char** argv) {
   benchmark::AddCustomContext("dram_read_GBps_at_start",
                               std::to_string(MeasureReadBandwidth(std::size_t{1} << 30) / 1e9));
   benchmark::AddCustomContext("solve_kernel", deform::SolveKernelName(deform::BestSolveKernel()));
-  for (const BenchMesh& mesh : AvailableMeshes()) {
-    const bool large = mesh.name == "arm_132946";
-    benchmark::RegisterBenchmark(("Precompute/" + mesh.name).c_str(), BM_Precompute, mesh)
-        ->Unit(benchmark::kMillisecond)
-        ->Iterations(large ? 1 : 3);
-    benchmark::RegisterBenchmark(("Factorize/" + mesh.name).c_str(), BM_Factorize, mesh)
-        ->Unit(benchmark::kMillisecond)
-        ->Iterations(large ? 2 : 5);
-    benchmark::RegisterBenchmark(("Frame/" + mesh.name).c_str(), BM_Frame, mesh)
-        ->Unit(benchmark::kMillisecond)
-        ->MinTime(1.0);
-    benchmark::RegisterBenchmark(("LinearBlendFrame/" + mesh.name).c_str(), BM_LinearBlendFrame,
-                                 mesh)
-        ->Unit(benchmark::kMillisecond)
-        ->MinTime(1.0);
-    benchmark::RegisterBenchmark(("RightHandSide/" + mesh.name).c_str(), BM_RightHandSide, mesh)
-        ->Unit(benchmark::kMillisecond)
-        ->MinTime(0.5);
-    benchmark::RegisterBenchmark(("TriangularSolve/" + mesh.name).c_str(), BM_TriangularSolve, mesh,
-                                 deform::BestSolveKernel())
-        ->Unit(benchmark::kMillisecond)
-        ->MinTime(1.0);
-    if (deform::BestSolveKernel() != deform::SolveKernel::kBaseline) {
-      benchmark::RegisterBenchmark(("TriangularSolveBaselineKernel/" + mesh.name).c_str(),
-                                   BM_TriangularSolve, mesh, deform::SolveKernel::kBaseline)
-          ->Unit(benchmark::kMillisecond)
-          ->MinTime(1.0);
-    }
-    benchmark::RegisterBenchmark(("EigenBaselineSolve/" + mesh.name).c_str(), BM_EigenBaselineSolve,
-                                 mesh)
-        ->Unit(benchmark::kMillisecond)
-        ->MinTime(1.0);
-  }
+  for (const BenchMesh& mesh : AvailableMeshes()) RegisterBenchmarks(mesh);
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
   return 0;

@@ -23,6 +23,7 @@
 namespace {
 
 using deform::Status;
+using deform::StatusOr;
 
 struct DeformArgs {
   std::string mesh_path;
@@ -47,9 +48,48 @@ int Fail(const Status& status) {
   return 1;
 }
 
+// The paper's options with the command line's region radius factor and ordering.
+StatusOr<deform::ModelOptions> ModelOptionsFrom(const DeformArgs& args) {
+  deform::ModelOptions options = deform::ModelOptions::Paper();
+  options.regions.radius_factor = args.radius_factor;
+  DEFORM_ASSIGN_OR_RETURN(options.ordering, deform::OrderingFromName(args.ordering));
+  return options;
+}
+
+nlohmann::ordered_json DeformReport(const DeformArgs& args, const deform::ModelInput& input,
+                                    deform::Method method, const deform::MethodRun& run,
+                                    int clamped) {
+  const auto& q = run.quality;
+  nlohmann::ordered_json out;
+  out["mesh"] = input.description;
+  out["method"] = deform::MethodName(method);
+  out["pose"] = args.pose;
+  out["vertices"] = input.mesh.num_vertices();
+  out["triangles"] = input.mesh.num_triangles();
+  out["joint_nodes"] = run.joint_nodes;
+  out["anchors"] = run.anchors;
+  out["clamped_angles"] = clamped;
+  out["volume_change"] = q.volume_change;
+  out["clearance_min"] = q.clearance.min;
+  out["clearance_p01"] = q.clearance.p01;
+  out["sink_fraction"] = q.clearance.sink_fraction;
+  out["rigid_zone_error"] = q.rigid_zone_error;
+  out["max_displacement"] = q.max_displacement;
+  out["precompute_ms"] = run.precompute_seconds * 1e3;
+  out["factor_ms"] = run.factor_seconds * 1e3;
+  out["factor_bytes"] = run.factor_bytes;
+  if (method == deform::Method::kPaperLinear) out["response_bytes"] = run.response_bytes;
+  out["solve_ms"] = run.solve_seconds * 1e3;
+  out["frame_ms"] = run.frame_seconds * 1e3;
+  out["repeat"] = args.repeat;
+  return out;
+}
+
 int RunDeform(const DeformArgs& args) {
   auto method = deform::MethodFromName(args.method);
   if (!method.ok()) return Fail(method.status());
+  auto options = ModelOptionsFrom(args);
+  if (!options.ok()) return Fail(options.status());
   auto input = deform::LoadModelInput(args.mesh_path, args.skeleton_path, args.phantom_vertices);
   if (!input.ok()) return Fail(input.status());
   auto terms = deform::ParsePoseSpec(args.pose, input->skeleton);
@@ -57,50 +97,16 @@ int RunDeform(const DeformArgs& args) {
   deform::Pose pose;
   auto clamped = deform::PoseFromTerms(input->skeleton, *terms, &pose);
   if (!clamped.ok()) return Fail(clamped.status());
-
-  deform::ModelOptions options = deform::ModelOptions::Paper();
-  options.regions.radius_factor = args.radius_factor;
-  if (args.ordering == "metis") {
-    options.ordering = deform::Ordering::kMetis;
-  } else if (args.ordering == "amd") {
-    options.ordering = deform::Ordering::kAmd;
-  } else if (args.ordering == "natural") {
-    options.ordering = deform::Ordering::kNatural;
-  }
-  auto model = deform::DeformationModel::Build(input->mesh, input->skeleton, options);
+  auto model = deform::DeformationModel::Build(input->mesh, input->skeleton, *options);
   if (!model.ok()) return Fail(model.status());
   auto run = deform::RunMethod(**model, *method, pose, args.repeat);
   if (!run.ok()) return Fail(run.status());
-
   if (!args.out_path.empty()) {
-    deform::TriangleMesh posed{run->posed, input->mesh.triangles};
-    const Status written = deform::WriteMeshFile(posed, args.out_path);
+    const Status written =
+        deform::WriteMeshFile({run->posed, input->mesh.triangles}, args.out_path);
     if (!written.ok()) return Fail(written);
   }
-  const auto& q = run->quality;
-  nlohmann::ordered_json out;
-  out["mesh"] = input->description;
-  out["method"] = deform::MethodName(*method);
-  out["pose"] = args.pose;
-  out["vertices"] = input->mesh.num_vertices();
-  out["triangles"] = input->mesh.num_triangles();
-  out["joint_nodes"] = run->joint_nodes;
-  out["anchors"] = run->anchors;
-  out["clamped_angles"] = *clamped;
-  out["volume_change"] = q.volume_change;
-  out["clearance_min"] = q.clearance.min;
-  out["clearance_p01"] = q.clearance.p01;
-  out["sink_fraction"] = q.clearance.sink_fraction;
-  out["rigid_zone_error"] = q.rigid_zone_error;
-  out["max_displacement"] = q.max_displacement;
-  out["precompute_ms"] = run->precompute_seconds * 1e3;
-  out["factor_ms"] = run->factor_seconds * 1e3;
-  out["factor_bytes"] = run->factor_bytes;
-  if (*method == deform::Method::kPaperLinear) out["response_bytes"] = run->response_bytes;
-  out["solve_ms"] = run->solve_seconds * 1e3;
-  out["frame_ms"] = run->frame_seconds * 1e3;
-  out["repeat"] = args.repeat;
-  std::cout << out.dump() << std::endl;
+  std::cout << DeformReport(args, *input, *method, *run, *clamped).dump() << std::endl;
   return 0;
 }
 
@@ -123,6 +129,56 @@ int RunPhantom(const PhantomArgs& args) {
   return 0;
 }
 
+// An option whose default --help shows.
+template <typename T>
+CLI::Option* AddWithDefault(CLI::App* command, const std::string& name, T* value,
+                            const std::string& description) {
+  return command->add_option(name, *value, description)->capture_default_str();
+}
+
+CLI::App* AddDeformCommand(CLI::App* app, DeformArgs* args) {
+  CLI::App* command =
+      app->add_subcommand("deform", "Pose a mesh and print quality and timings as JSON");
+  command->add_option("--mesh", args->mesh_path,
+                      "Mesh file (.obj .ply .stl .off); default: the built-in knee phantom");
+  command->add_option("--skeleton", args->skeleton_path,
+                      "Skeleton file (.tgf or JSON); required with --mesh");
+  AddWithDefault(command, "--phantom-vertices", &args->phantom_vertices,
+                 "Resolution of the phantom");
+  AddWithDefault(command, "--pose", &args->pose,
+                 "JOINT:AXIS:DEGREES[,...], e.g. knee:flexion:90 or 1:x:90");
+  AddWithDefault(command, "--method", &args->method,
+                 "paper | paper-linear (linear rotation blend, no per-frame solve) | laplacian | "
+                 "lbs | dqs");
+  command->add_option("--out", args->out_path,
+                      "Write the deformed mesh (format from the extension)");
+  AddWithDefault(command, "--repeat", &args->repeat,
+                 "Frames to time; solve_ms (the triangular solve) and frame_ms (the whole frame) "
+                 "are their medians")
+      ->check(CLI::Range(1, 100000));
+  AddWithDefault(command, "--radius-factor", &args->radius_factor,
+                 "Joint region radius in limb radii");
+  AddWithDefault(command, "--ordering", &args->ordering,
+                 "Fill-reducing ordering: auto | metis | amd | natural");
+  return command;
+}
+
+CLI::App* AddPhantomCommand(CLI::App* app, PhantomArgs* args) {
+  CLI::App* command =
+      app->add_subcommand("phantom", "Write the built-in knee phantom and its skeleton");
+  command->add_option("--out", args->out_path, "Mesh file to write")->required();
+  command->add_option("--skeleton-out", args->skeleton_out_path, "Skeleton JSON file to write");
+  AddWithDefault(command, "--vertices", &args->vertices, "Approximate vertex count");
+  return command;
+}
+
+// --help and the like exit 0 through CLI11; a bad command line is one line on stderr, exit 2.
+int ParseFailure(const CLI::App& app, const CLI::ParseError& error) {
+  if (error.get_exit_code() == 0) return app.exit(error);
+  std::cerr << "deformctl: " << error.what() << "\n";
+  return 2;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -130,60 +186,14 @@ int main(int argc, char** argv) {
   CLI::App app{
       "deformctl: joint-aware Laplacian deformation of a limb mesh, from the command line"};
   app.require_subcommand(1);
-
   DeformArgs deform_args;
-  CLI::App* deform_cmd =
-      app.add_subcommand("deform", "Pose a mesh and print quality and timings as JSON");
-  deform_cmd->add_option("--mesh", deform_args.mesh_path,
-                         "Mesh file (.obj .ply .stl .off); default: the built-in knee phantom");
-  deform_cmd->add_option("--skeleton", deform_args.skeleton_path,
-                         "Skeleton file (.tgf or JSON); required with --mesh");
-  deform_cmd
-      ->add_option("--phantom-vertices", deform_args.phantom_vertices, "Resolution of the phantom")
-      ->capture_default_str();
-  deform_cmd
-      ->add_option("--pose", deform_args.pose,
-                   "JOINT:AXIS:DEGREES[,...], e.g. knee:flexion:90 or 1:x:90")
-      ->capture_default_str();
-  deform_cmd
-      ->add_option("--method", deform_args.method,
-                   "paper | paper-linear (linear rotation blend, no per-frame solve) | laplacian | "
-                   "lbs | dqs")
-      ->capture_default_str();
-  deform_cmd->add_option("--out", deform_args.out_path,
-                         "Write the deformed mesh (format from the extension)");
-  deform_cmd
-      ->add_option("--repeat", deform_args.repeat,
-                   "Frames to time; solve_ms (the triangular solve) and frame_ms (the whole frame) "
-                   "are their medians")
-      ->capture_default_str()
-      ->check(CLI::Range(1, 100000));
-  deform_cmd
-      ->add_option("--radius-factor", deform_args.radius_factor,
-                   "Joint region radius in limb radii")
-      ->capture_default_str();
-  deform_cmd
-      ->add_option("--ordering", deform_args.ordering,
-                   "Fill-reducing ordering: auto | metis | amd | natural")
-      ->capture_default_str()
-      ->check(CLI::IsMember({"auto", "metis", "amd", "natural"}));
-
   PhantomArgs phantom_args;
-  CLI::App* phantom_cmd =
-      app.add_subcommand("phantom", "Write the built-in knee phantom and its skeleton");
-  phantom_cmd->add_option("--out", phantom_args.out_path, "Mesh file to write")->required();
-  phantom_cmd->add_option("--skeleton-out", phantom_args.skeleton_out_path,
-                          "Skeleton JSON file to write");
-  phantom_cmd->add_option("--vertices", phantom_args.vertices, "Approximate vertex count")
-      ->capture_default_str();
-
+  const CLI::App* deform_command = AddDeformCommand(&app, &deform_args);
+  AddPhantomCommand(&app, &phantom_args);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    if (e.get_exit_code() == 0) return app.exit(e);
-    std::cerr << "deformctl: " << e.what() << "\n";
-    return 2;
+    return ParseFailure(app, e);
   }
-  if (*deform_cmd) return RunDeform(deform_args);
-  return RunPhantom(phantom_args);
+  return *deform_command ? RunDeform(deform_args) : RunPhantom(phantom_args);
 }

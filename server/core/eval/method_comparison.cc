@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -17,14 +18,93 @@ double Median(std::vector<double> values) {
   return values[values.size() / 2];
 }
 
+// Runs `frame` `repeat` times; each run's wall time in seconds.
+template <typename Frame>
+std::vector<double> TimeFrames(int repeat, Frame&& frame) {
+  std::vector<double> seconds;
+  seconds.reserve(repeat);
+  for (int r = 0; r < repeat; ++r) {
+    const auto start = Clock::now();
+    frame();
+    seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
+  }
+  return seconds;
+}
+
+bool Solves(Method method) {
+  return method == Method::kPaper || method == Method::kPaperLinear || method == Method::kLaplacian;
+}
+
+// The model `method` solves with: a variant of the paper model when it needs one (the same regions,
+// so the same harmonic weights, anchors and ordering), or null when the paper model serves.
+StatusOr<std::shared_ptr<const DeformationModel>> VariantFor(const DeformationModel& paper_model,
+                                                             Method method) {
+  ModelOptions options = paper_model.options();
+  if (method == Method::kLaplacian) {
+    options = ModelOptions::PlainLaplacian(paper_model.options());
+  } else if (method == Method::kPaperLinear) {
+    options.rotation_blend = RotationBlend::kLinear;
+  }
+  if (method != Method::kLaplacian &&
+      options.rotation_blend == paper_model.options().rotation_blend) {
+    return std::shared_ptr<const DeformationModel>();
+  }
+  return DeformationModel::Build(paper_model.mesh(), paper_model.skeleton(), options);
+}
+
+// Paper, paper-linear and laplacian: `repeat` frames of the model's Deform().
+Status RunSolvingMethod(const DeformationModel& paper_model, Method method, const Pose& pose,
+                        int repeat, MethodRun* run) {
+  DEFORM_ASSIGN_OR_RETURN(const std::shared_ptr<const DeformationModel> variant,
+                          VariantFor(paper_model, method));
+  const DeformationModel& model = variant ? *variant : paper_model;
+  const MaterialFactorization& factorization = *model.default_factorization();
+  run->precompute_seconds = model.precompute_seconds();
+  run->factor_seconds = factorization.factor_seconds();
+  run->factor_bytes = factorization.factor().bytes();
+  if (factorization.linear_response() != nullptr) {
+    run->response_bytes = factorization.linear_response()->bytes();
+  }
+  run->joint_nodes = model.num_joint_nodes();
+  run->anchors = static_cast<int>(model.anchor_vertices().size());
+  DeformScratch scratch = model.MakeScratch();
+  std::vector<double> solve_seconds;
+  solve_seconds.reserve(repeat);
+  run->frame_seconds = Median(TimeFrames(repeat, [&] {
+    DeformTimings timings;
+    model.Deform(factorization, pose, &scratch, &timings);
+    solve_seconds.push_back(timings.solve);
+  }));
+  run->solve_seconds = Median(solve_seconds);
+  run->posed = scratch.positions();
+  return Status::Ok();
+}
+
+// LBS and DQS with the paper model's harmonic weights: `repeat` frames, each the whole frame.
+void RunSkinningMethod(const DeformationModel& paper_model, Method method, const Pose& pose,
+                       int repeat, MethodRun* run) {
+  std::vector<RigidTransform> bones;
+  run->frame_seconds = Median(TimeFrames(repeat, [&] {
+    ForwardKinematics(paper_model.skeleton(), pose, &bones);
+    if (method == Method::kLbs) {
+      LinearBlendSkinning(paper_model.mesh().vertices, paper_model.bone_weights(), bones,
+                          &run->posed);
+    } else {
+      DualQuaternionSkinning(paper_model.mesh().vertices, paper_model.bone_weights(), bones,
+                             &run->posed);
+    }
+  }));
+  run->solve_seconds = run->frame_seconds;
+  run->precompute_seconds = paper_model.precompute_seconds();
+}
+
 }  // namespace
 
 StatusOr<Method> MethodFromName(std::string_view name) {
-  if (name == "paper") return Method::kPaper;
-  if (name == "paper-linear") return Method::kPaperLinear;
-  if (name == "laplacian") return Method::kLaplacian;
-  if (name == "lbs") return Method::kLbs;
-  if (name == "dqs") return Method::kDqs;
+  for (Method method :
+       {Method::kPaper, Method::kPaperLinear, Method::kLaplacian, Method::kLbs, Method::kDqs}) {
+    if (name == MethodName(method)) return method;
+  }
   return Status::InvalidArgument("unknown method '" + std::string(name) +
                                  "' (known: paper, paper-linear, laplacian, lbs, dqs)");
 }
@@ -55,67 +135,11 @@ StatusOr<MethodRun> RunMethod(const DeformationModel& paper_model, Method method
                               int repeat) {
   repeat = std::max(1, repeat);
   MethodRun run;
-  run.precompute_seconds = paper_model.precompute_seconds();
-  std::vector<double> frame_seconds;
-  frame_seconds.reserve(repeat);
-
-  if (method == Method::kPaper || method == Method::kPaperLinear || method == Method::kLaplacian) {
-    // A variant of the paper model when the method needs one: the same regions (so the same
-    // harmonic weights), anchors and ordering.
-    std::shared_ptr<const DeformationModel> variant;
-    const DeformationModel* model = &paper_model;
-    ModelOptions variant_options = paper_model.options();
-    if (method == Method::kLaplacian) {
-      variant_options = ModelOptions::PlainLaplacian(paper_model.options());
-    } else if (method == Method::kPaperLinear) {
-      variant_options.rotation_blend = RotationBlend::kLinear;
-    }
-    if (method == Method::kLaplacian ||
-        variant_options.rotation_blend != paper_model.options().rotation_blend) {
-      DEFORM_ASSIGN_OR_RETURN(
-          variant,
-          DeformationModel::Build(paper_model.mesh(), paper_model.skeleton(), variant_options));
-      model = variant.get();
-      run.precompute_seconds = model->precompute_seconds();
-    }
-    const auto& factorization = *model->default_factorization();
-    run.factor_seconds = factorization.factor_seconds();
-    run.factor_bytes = factorization.factor().bytes();
-    if (factorization.linear_response() != nullptr) {
-      run.response_bytes = factorization.linear_response()->bytes();
-    }
-    run.joint_nodes = model->num_joint_nodes();
-    run.anchors = static_cast<int>(model->anchor_vertices().size());
-    DeformScratch scratch = model->MakeScratch();
-    std::vector<double> solve_seconds;
-    solve_seconds.reserve(repeat);
-    for (int r = 0; r < repeat; ++r) {
-      const auto start = Clock::now();
-      DeformTimings timings;
-      model->Deform(factorization, pose, &scratch, &timings);
-      frame_seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
-      solve_seconds.push_back(timings.solve);
-    }
-    run.solve_seconds = Median(solve_seconds);
-    run.posed = scratch.positions();
+  if (Solves(method)) {
+    DEFORM_RETURN_IF_ERROR(RunSolvingMethod(paper_model, method, pose, repeat, &run));
   } else {
-    std::vector<RigidTransform> bones;
-    for (int r = 0; r < repeat; ++r) {
-      const auto start = Clock::now();
-      ForwardKinematics(paper_model.skeleton(), pose, &bones);
-      if (method == Method::kLbs) {
-        LinearBlendSkinning(paper_model.mesh().vertices, paper_model.bone_weights(), bones,
-                            &run.posed);
-      } else {
-        DualQuaternionSkinning(paper_model.mesh().vertices, paper_model.bone_weights(), bones,
-                               &run.posed);
-      }
-      frame_seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
-    }
+    RunSkinningMethod(paper_model, method, pose, repeat, &run);
   }
-  run.frame_seconds = Median(frame_seconds);
-  if (method == Method::kLbs || method == Method::kDqs) run.solve_seconds = run.frame_seconds;
-
   std::vector<RigidTransform> bones;
   ForwardKinematics(paper_model.skeleton(), pose, &bones);
   Positions skinned;

@@ -19,8 +19,10 @@ enum class Method {
   kDqs,          // dual quaternion skinning with the harmonic weights
 };
 
-StatusOr<Method> MethodFromName(std::string_view name);
+// "paper", "paper-linear", "laplacian", "lbs", "dqs".
 const char* MethodName(Method method);
+// The method MethodName() names; INVALID_ARGUMENT listing the names for any other text.
+StatusOr<Method> MethodFromName(std::string_view name);
 
 struct MethodRun {
   Positions posed;  // #V by 3

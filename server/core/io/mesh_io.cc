@@ -25,17 +25,20 @@
 namespace deform {
 namespace {
 
-// Each format's names, in the order MeshFormatFromName tries them.
+// Each format's names and reader, in the order MeshFormatFromName tries them.
 struct FormatNames {
   MeshFormat format;
   const char* name;   // as MeshFormatName
   const char* label;  // as FormatLabel
+  // Checks and reads the format's bytes into the importer (mesh_io_internal.h).
+  Status (*read)(std::string_view bytes, const MeshLimits& limits,
+                 mesh_io_internal::SoupImporter* importer);
 };
 
-constexpr FormatNames kFormats[] = {{MeshFormat::kObj, "obj", "OBJ"},
-                                    {MeshFormat::kPly, "ply", "PLY"},
-                                    {MeshFormat::kStl, "stl", "STL"},
-                                    {MeshFormat::kOff, "off", "OFF"}};
+constexpr FormatNames kFormats[] = {{MeshFormat::kObj, "obj", "OBJ", &mesh_io_internal::ReadObj},
+                                    {MeshFormat::kPly, "ply", "PLY", &mesh_io_internal::ReadPly},
+                                    {MeshFormat::kStl, "stl", "STL", &mesh_io_internal::ReadStl},
+                                    {MeshFormat::kOff, "off", "OFF", &mesh_io_internal::ReadOff}};
 
 const FormatNames* FindFormat(MeshFormat format) {
   for (const FormatNames& names : kFormats) {
@@ -62,21 +65,10 @@ StatusOr<TriangleMesh> ReadMeshUnguarded(std::string_view bytes, MeshFormat form
   if (bytes.empty()) {
     return Status::InvalidArgument(std::string("the ") + FormatLabel(format) + " data is empty");
   }
+  const FormatNames* names = FindFormat(format);
+  if (names == nullptr) return Status::InvalidArgument("unknown mesh format");
   SoupImporter importer(limits);
-  switch (format) {
-    case MeshFormat::kObj:
-      DEFORM_RETURN_IF_ERROR(ReadObj(bytes, limits, &importer));
-      break;
-    case MeshFormat::kPly:
-      DEFORM_RETURN_IF_ERROR(ReadPly(bytes, limits, &importer));
-      break;
-    case MeshFormat::kStl:
-      DEFORM_RETURN_IF_ERROR(ReadStl(bytes, limits, &importer));
-      break;
-    case MeshFormat::kOff:
-      DEFORM_RETURN_IF_ERROR(ReadOff(bytes, limits, &importer));
-      break;
-  }
+  DEFORM_RETURN_IF_ERROR(names->read(bytes, limits, &importer));
   if (importer.exceeded_vertex_limit()) {
     return TooManyVertices(std::string("the ") + FormatLabel(format) + " data",
                            limits.max_vertices);

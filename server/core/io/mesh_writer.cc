@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <type_traits>
 
@@ -183,27 +184,31 @@ void WriteStl(const TriangleMesh& mesh, FileWriter* writer) {
   }
 }
 
+// Each format's writer.
+struct FormatWriter {
+  MeshFormat format;
+  void (*write)(const TriangleMesh& mesh, FileWriter* writer);
+};
+
+constexpr FormatWriter kWriters[] = {{MeshFormat::kObj, &WriteObj},
+                                     {MeshFormat::kPly, &WritePly},
+                                     {MeshFormat::kStl, &WriteStl},
+                                     {MeshFormat::kOff, &WriteOff}};
+
 }  // namespace
 
 Status WriteMeshAs(const TriangleMesh& mesh, MeshFormat format, const std::string& path) {
   const Status writable = CheckWritable(mesh);
   if (!writable.ok()) return writable.WithContext("cannot write " + path);
+  const auto writer_of_format =
+      std::find_if(std::begin(kWriters), std::end(kWriters),
+                   [format](const FormatWriter& writer) { return writer.format == format; });
+  if (writer_of_format == std::end(kWriters)) {
+    return Status::InvalidArgument("cannot write " + path + ": unknown mesh format");
+  }
   FileWriter writer(path);
   DEFORM_RETURN_IF_ERROR(writer.OpenStatus());
-  switch (format) {
-    case MeshFormat::kObj:
-      WriteObj(mesh, &writer);
-      break;
-    case MeshFormat::kPly:
-      WritePly(mesh, &writer);
-      break;
-    case MeshFormat::kStl:
-      WriteStl(mesh, &writer);
-      break;
-    case MeshFormat::kOff:
-      WriteOff(mesh, &writer);
-      break;
-  }
+  writer_of_format->write(mesh, &writer);
   return writer.Close();
 }
 

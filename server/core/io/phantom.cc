@@ -64,6 +64,50 @@ StatusOr<Skeleton> PhantomSkeleton() {
   return Skeleton::Create(std::move(joints), {{0, 1}, {1, 2}});
 }
 
+// Rings of `segments` vertices along y between the two poles: the top pole (vertex 0), ring r's
+// vertex s at 1 + r * segments + s, the bottom pole last.
+Positions PhantomVertices(int rings, int segments) {
+  Positions vertices(static_cast<Eigen::Index>(rings) * segments + 2, 3);
+  int v = 0;
+  vertices.row(v++) << 0, kTopY, 0;
+  for (int ring = 0; ring < rings; ++ring) {
+    const double y = kTopY - (kTopY - kBottomY) * (ring + 1.0) / (rings + 1.0);
+    for (int s = 0; s < segments; ++s) {
+      const double theta = 2 * M_PI * s / segments;
+      const double r = SurfaceRadius(y, theta);
+      vertices.row(v++) << r * std::sin(theta), y, r * std::cos(theta);
+    }
+  }
+  vertices.row(v) << 0, kBottomY, 0;
+  return vertices;
+}
+
+// Outward-facing triangles (counter-clockwise seen from outside) over PhantomVertices' layout.
+Triangles PhantomTriangles(int rings, int segments) {
+  const int bottom_pole = rings * segments + 1;
+  const auto ring_vertex = [segments](int ring, int s) {
+    return 1 + ring * segments + (s % segments);
+  };
+  Triangles triangles(2 * segments * rings, 3);
+  int f = 0;
+  for (int s = 0; s < segments; ++s) {
+    triangles.row(f++) << 0, ring_vertex(0, s), ring_vertex(0, s + 1);
+  }
+  for (int ring = 0; ring + 1 < rings; ++ring) {
+    for (int s = 0; s < segments; ++s) {
+      const int a = ring_vertex(ring, s), b = ring_vertex(ring, s + 1);
+      const int c = ring_vertex(ring + 1, s), d = ring_vertex(ring + 1, s + 1);
+      triangles.row(f++) << a, d, b;
+      triangles.row(f++) << a, c, d;
+    }
+  }
+  for (int s = 0; s < segments; ++s) {
+    triangles.row(f++) << bottom_pole, ring_vertex(rings - 1, s + 1), ring_vertex(rings - 1, s);
+  }
+  triangles.conservativeResize(f, 3);
+  return triangles;
+}
+
 }  // namespace
 
 StatusOr<KneePhantom> MakeKneePhantom(int target_vertices) {
@@ -77,43 +121,9 @@ StatusOr<KneePhantom> MakeKneePhantom(int target_vertices) {
   const int segments =
       std::max(8, static_cast<int>(std::lround(std::sqrt(target_vertices / kAspect))));
   const int rings = std::max(4, (target_vertices - 2) / segments);
-
   KneePhantom phantom;
-  TriangleMesh& mesh = phantom.mesh;
-  mesh.vertices.resize(static_cast<Eigen::Index>(rings) * segments + 2, 3);
-  int v = 0;
-  mesh.vertices.row(v++) << 0, kTopY, 0;  // top pole
-  for (int ring = 0; ring < rings; ++ring) {
-    const double y = kTopY - (kTopY - kBottomY) * (ring + 1.0) / (rings + 1.0);
-    for (int s = 0; s < segments; ++s) {
-      const double theta = 2 * M_PI * s / segments;
-      const double r = SurfaceRadius(y, theta);
-      mesh.vertices.row(v++) << r * std::sin(theta), y, r * std::cos(theta);
-    }
-  }
-  const int bottom_pole = v;
-  mesh.vertices.row(v++) << 0, kBottomY, 0;
-
-  // Outward-facing triangles (counter-clockwise seen from outside).
-  auto ring_vertex = [&](int ring, int s) { return 1 + ring * segments + (s % segments); };
-  mesh.triangles.resize(2 * segments * rings, 3);
-  int f = 0;
-  for (int s = 0; s < segments; ++s) {
-    mesh.triangles.row(f++) << 0, ring_vertex(0, s), ring_vertex(0, s + 1);
-  }
-  for (int ring = 0; ring + 1 < rings; ++ring) {
-    for (int s = 0; s < segments; ++s) {
-      const int a = ring_vertex(ring, s), b = ring_vertex(ring, s + 1);
-      const int c = ring_vertex(ring + 1, s), d = ring_vertex(ring + 1, s + 1);
-      mesh.triangles.row(f++) << a, d, b;
-      mesh.triangles.row(f++) << a, c, d;
-    }
-  }
-  for (int s = 0; s < segments; ++s) {
-    mesh.triangles.row(f++) << bottom_pole, ring_vertex(rings - 1, s + 1),
-        ring_vertex(rings - 1, s);
-  }
-  mesh.triangles.conservativeResize(f, 3);
+  phantom.mesh.vertices = PhantomVertices(rings, segments);
+  phantom.mesh.triangles = PhantomTriangles(rings, segments);
   DEFORM_ASSIGN_OR_RETURN(phantom.skeleton, PhantomSkeleton());
   return phantom;
 }

@@ -2,10 +2,49 @@
 
 #include <cmath>
 #include <fstream>
+#include <initializer_list>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/base/text.h"
 
 namespace deform {
+
+namespace {
+
+// A TGF joint line's fields after the line's start: "index x y z [extra...]".
+StatusOr<Joint> TgfJoint(std::istringstream* fields, const std::string& where, std::size_t index) {
+  std::string label;
+  double x, y, z;
+  if (!(*fields >> label >> x >> y >> z)) {
+    return Status::InvalidArgument(where + ": expected 'index x y z'");
+  }
+  Joint joint;
+  joint.rest_position = {x, y, z};
+  if (!joint.rest_position.allFinite()) {
+    return Status::InvalidArgument(where + ": non-finite joint position");
+  }
+  joint.name = "joint" + std::to_string(index);
+  return joint;
+}
+
+// A TGF bone line: "a b [flags...]", 1-based joints, as 0-based (head, tail).
+StatusOr<std::pair<int, int>> TgfBone(std::istringstream* fields, const std::string& where,
+                                      std::size_t num_joints) {
+  long long a, b;
+  if (!(*fields >> a >> b)) return Status::InvalidArgument(where + ": expected 'a b'");
+  const long long last = static_cast<long long>(num_joints);
+  if (a < 1 || b < 1 || a > last || b > last) {
+    return Status::InvalidArgument(where + ": bone joint index out of range 1.." +
+                                   std::to_string(num_joints));
+  }
+  return std::make_pair(static_cast<int>(a - 1), static_cast<int>(b - 1));
+}
+
+}  // namespace
 
 StatusOr<Skeleton> ParseTgf(std::string_view text) {
   std::istringstream in{std::string(text)};
@@ -13,39 +52,21 @@ StatusOr<Skeleton> ParseTgf(std::string_view text) {
   std::vector<Joint> joints;
   std::vector<std::pair<int, int>> bones;
   int section = 0;  // 0 joints, 1 bones, 2 done
-  int line_number = 0;
-  while (std::getline(in, line) && section < 2) {
-    ++line_number;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.find_first_not_of(" \t") == std::string::npos) continue;
-    if (line[line.find_first_not_of(" \t")] == '#') {
+  for (int line_number = 1; std::getline(in, line) && section < 2; ++line_number) {
+    const std::string_view content = Trim(line);
+    if (content.empty()) continue;
+    if (content.front() == '#') {
       ++section;
       continue;
     }
     std::istringstream fields(line);
     const std::string where = "TGF line " + std::to_string(line_number);
     if (section == 0) {
-      std::string index;
-      Joint joint;
-      double x, y, z;
-      if (!(fields >> index >> x >> y >> z)) {
-        return Status::InvalidArgument(where + ": expected 'index x y z'");
-      }
-      joint.rest_position = {x, y, z};
-      if (!joint.rest_position.allFinite()) {
-        return Status::InvalidArgument(where + ": non-finite joint position");
-      }
-      joint.name = "joint" + std::to_string(joints.size());
+      DEFORM_ASSIGN_OR_RETURN(Joint joint, TgfJoint(&fields, where, joints.size()));
       joints.push_back(std::move(joint));
     } else {
-      long long a, b;
-      if (!(fields >> a >> b)) return Status::InvalidArgument(where + ": expected 'a b'");
-      if (a < 1 || b < 1 || a > static_cast<long long>(joints.size()) ||
-          b > static_cast<long long>(joints.size())) {
-        return Status::InvalidArgument(where + ": bone joint index out of range 1.." +
-                                       std::to_string(joints.size()));
-      }
-      bones.emplace_back(static_cast<int>(a - 1), static_cast<int>(b - 1));
+      DEFORM_ASSIGN_OR_RETURN(const auto bone, TgfBone(&fields, where, joints.size()));
+      bones.push_back(bone);
     }
   }
   if (section == 0) return Status::InvalidArgument("TGF has no '#' line after the joints");
@@ -79,6 +100,57 @@ StatusOr<int> JsonJointReference(const nlohmann::json& value, const std::vector<
   return Status::InvalidArgument("bone references unknown joint " + value.dump());
 }
 
+// Whether `value` is an object with a string "name" and every key of `required`.
+bool IsNamedObject(const nlohmann::json& value, std::initializer_list<const char*> required) {
+  if (!value.is_object() || !value.contains("name") || !value["name"].is_string()) return false;
+  for (const char* key : required) {
+    if (!value.contains(key)) return false;
+  }
+  return true;
+}
+
+// dof[key] into *degrees when present; INVALID_ARGUMENT when it is not a number.
+Status ReadOptionalDegrees(const nlohmann::json& dof, const char* key, const std::string& where,
+                           double* degrees) {
+  if (!dof.contains(key)) return Status::Ok();
+  if (!dof[key].is_number()) {
+    return Status::InvalidArgument(where + ": dof '" + key + "' not a number");
+  }
+  *degrees = dof[key].get<double>();
+  return Status::Ok();
+}
+
+StatusOr<DegreeOfFreedom> DegreeOfFreedomFromJson(const nlohmann::json& value,
+                                                  const std::string& where) {
+  if (!IsNamedObject(value, {"axis"})) {
+    return Status::InvalidArgument(where + ": each dof needs 'name' and 'axis'");
+  }
+  DegreeOfFreedom dof;
+  dof.name = value["name"].get<std::string>();
+  DEFORM_ASSIGN_OR_RETURN(dof.axis, JsonVector(value["axis"], where + " dof axis"));
+  DEFORM_RETURN_IF_ERROR(ReadOptionalDegrees(value, "min", where, &dof.min_degrees));
+  DEFORM_RETURN_IF_ERROR(ReadOptionalDegrees(value, "max", where, &dof.max_degrees));
+  return dof;
+}
+
+// Joint `index` of the document.
+StatusOr<Joint> JointFromJson(const nlohmann::json& value, std::size_t index) {
+  const std::string where = "joint " + std::to_string(index);
+  if (!IsNamedObject(value, {"position"})) {
+    return Status::InvalidArgument(where + " needs 'name' (string) and 'position'");
+  }
+  Joint joint;
+  joint.name = value["name"].get<std::string>();
+  DEFORM_ASSIGN_OR_RETURN(joint.rest_position, JsonVector(value["position"], where + " position"));
+  if (!value.contains("dofs")) return joint;
+  if (!value["dofs"].is_array()) return Status::InvalidArgument(where + " 'dofs' must be an array");
+  for (const auto& d : value["dofs"]) {
+    DEFORM_ASSIGN_OR_RETURN(DegreeOfFreedom dof, DegreeOfFreedomFromJson(d, where));
+    joint.dofs.push_back(std::move(dof));
+  }
+  return joint;
+}
+
 StatusOr<Skeleton> ParseSkeletonJsonValue(const nlohmann::json& doc) {
   if (!doc.is_object() || !doc.contains("joints") || !doc["joints"].is_array() ||
       !doc.contains("bones") || !doc["bones"].is_array()) {
@@ -86,37 +158,7 @@ StatusOr<Skeleton> ParseSkeletonJsonValue(const nlohmann::json& doc) {
   }
   std::vector<Joint> joints;
   for (const auto& j : doc["joints"]) {
-    const std::string where = "joint " + std::to_string(joints.size());
-    if (!j.is_object() || !j.contains("name") || !j["name"].is_string() ||
-        !j.contains("position")) {
-      return Status::InvalidArgument(where + " needs 'name' (string) and 'position'");
-    }
-    Joint joint;
-    joint.name = j["name"].get<std::string>();
-    DEFORM_ASSIGN_OR_RETURN(joint.rest_position, JsonVector(j["position"], where + " position"));
-    if (j.contains("dofs")) {
-      if (!j["dofs"].is_array()) return Status::InvalidArgument(where + " 'dofs' must be an array");
-      for (const auto& d : j["dofs"]) {
-        if (!d.is_object() || !d.contains("name") || !d["name"].is_string() ||
-            !d.contains("axis")) {
-          return Status::InvalidArgument(where + ": each dof needs 'name' and 'axis'");
-        }
-        DegreeOfFreedom dof;
-        dof.name = d["name"].get<std::string>();
-        DEFORM_ASSIGN_OR_RETURN(dof.axis, JsonVector(d["axis"], where + " dof axis"));
-        if (d.contains("min")) {
-          if (!d["min"].is_number())
-            return Status::InvalidArgument(where + ": dof 'min' not a number");
-          dof.min_degrees = d["min"].get<double>();
-        }
-        if (d.contains("max")) {
-          if (!d["max"].is_number())
-            return Status::InvalidArgument(where + ": dof 'max' not a number");
-          dof.max_degrees = d["max"].get<double>();
-        }
-        joint.dofs.push_back(std::move(dof));
-      }
-    }
+    DEFORM_ASSIGN_OR_RETURN(Joint joint, JointFromJson(j, joints.size()));
     joints.push_back(std::move(joint));
   }
   std::vector<std::pair<int, int>> bones;

@@ -9,29 +9,61 @@
 namespace deform {
 namespace {
 
-// Drops weights below kDropBelow from `result.dense`'s rows, renormalises, and stores them
-// compressed, largest first.
-void Compress(BoneWeights* result) {
-  const int n = static_cast<int>(result->dense.rows());
-  result->offsets.assign(n + 1, 0);
-  result->bones.clear();
-  result->weights.clear();
+Status SolveFreeVertices(const VertexAdjacency& adjacency, const std::vector<int>& fixed_bone,
+                         const std::vector<int>& free_index, int num_free, Eigen::MatrixXd* dense) {
+  const int n = static_cast<int>(fixed_bone.size());
+  const int num_bones = static_cast<int>(dense->cols());
+  std::vector<Eigen::Triplet<double>> triplets;
+  Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(num_free, num_bones);
+  for (int i = 0; i < n; ++i) {
+    const int fi = free_index[i];
+    if (fi < 0) continue;
+    triplets.emplace_back(fi, fi, adjacency.degree(i));
+    for (int p = adjacency.offsets[i]; p < adjacency.offsets[i + 1]; ++p) {
+      const int u = adjacency.neighbors[p];
+      if (free_index[u] >= 0) {
+        triplets.emplace_back(fi, free_index[u], -1.0);
+      } else {
+        rhs(fi, fixed_bone[u]) += 1.0;
+      }
+    }
+  }
+  Eigen::SparseMatrix<double> laplacian(num_free, num_free);
+  laplacian.setFromTriplets(triplets.begin(), triplets.end());
+  Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> llt(
+      laplacian);
+  if (llt.info() != Eigen::Success) {
+    return Status::Internal("harmonic weight system could not be factorised");
+  }
+  const Eigen::MatrixXd solution = llt.solve(rhs);
+  for (int i = 0; i < n; ++i) {
+    if (free_index[i] >= 0) dense->row(i) = solution.row(free_index[i]);
+  }
+  // Round-off can leave tiny negatives; the exact solution lies in [0, 1].
+  *dense = dense->cwiseMax(0.0).cwiseMin(1.0);
+  return Status::Ok();
+}
+
+// The compressed per-vertex lists of `weights` from its dense field: weights below kDropBelow
+// dropped, the rest renormalised, largest first.
+void CompressWeights(BoneWeights* weights) {
+  const int n = static_cast<int>(weights->dense.rows());
+  weights->offsets.assign(n + 1, 0);
   std::vector<std::pair<double, int>> entries;
   for (int i = 0; i < n; ++i) {
     entries.clear();
-    for (int k = 0; k < result->num_bones; ++k) {
-      if (result->dense(i, k) >= BoneWeights::kDropBelow) {
-        entries.emplace_back(result->dense(i, k), k);
-      }
+    for (int k = 0; k < weights->num_bones; ++k) {
+      const double h = weights->dense(i, k);
+      if (h >= BoneWeights::kDropBelow) entries.emplace_back(h, k);
     }
     std::sort(entries.begin(), entries.end(), std::greater<>());
     double sum = 0;
     for (const auto& e : entries) sum += e.first;
     for (const auto& e : entries) {
-      result->bones.push_back(e.second);
-      result->weights.push_back(e.first / sum);
+      weights->bones.push_back(e.second);
+      weights->weights.push_back(e.first / sum);
     }
-    result->offsets[i + 1] = static_cast<int>(result->bones.size());
+    weights->offsets[i + 1] = static_cast<int>(weights->bones.size());
   }
 }
 
@@ -61,59 +93,30 @@ Status CheckEveryComponentAnchored(const VertexAdjacency& adjacency,
   return Status::Ok();
 }
 
+// The harmonic field on the free vertices (free_index[i] >= 0, numbered 0..num_free - 1): the
+// graph Laplacian restricted to them, L_ff h_f = -L_fb h_b = the sum of fixed neighbours' values.
+// Writes their rows of `dense` (the fixed rows are already set).
 StatusOr<BoneWeights> HarmonicBoneWeights(const VertexAdjacency& adjacency,
                                           const std::vector<int>& fixed_bone, int num_bones) {
   const int n = static_cast<int>(fixed_bone.size());
   DEFORM_RETURN_IF_ERROR(CheckEveryComponentAnchored(adjacency, fixed_bone));
-
-  // Number the free vertices.
-  std::vector<int> free_index(n, -1);
-  int num_free = 0;
-  for (int i = 0; i < n; ++i) {
-    if (fixed_bone[i] < 0) free_index[i] = num_free++;
-  }
-
   BoneWeights result;
   result.num_bones = num_bones;
   result.dense = Eigen::MatrixXd::Zero(n, num_bones);
+  std::vector<int> free_index(n, -1);
+  int num_free = 0;
   for (int i = 0; i < n; ++i) {
-    if (fixed_bone[i] >= 0) result.dense(i, fixed_bone[i]) = 1.0;
+    if (fixed_bone[i] < 0) {
+      free_index[i] = num_free++;
+    } else {
+      result.dense(i, fixed_bone[i]) = 1.0;
+    }
   }
-
   if (num_free > 0) {
-    // Graph Laplacian restricted to the free vertices: L_ff h_f = -L_fb h_b = sum of fixed
-    // neighbours' values.
-    std::vector<Eigen::Triplet<double>> triplets;
-    Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(num_free, num_bones);
-    for (int i = 0; i < n; ++i) {
-      const int fi = free_index[i];
-      if (fi < 0) continue;
-      triplets.emplace_back(fi, fi, adjacency.degree(i));
-      for (int p = adjacency.offsets[i]; p < adjacency.offsets[i + 1]; ++p) {
-        const int u = adjacency.neighbors[p];
-        if (free_index[u] >= 0) {
-          triplets.emplace_back(fi, free_index[u], -1.0);
-        } else {
-          rhs(fi, fixed_bone[u]) += 1.0;
-        }
-      }
-    }
-    Eigen::SparseMatrix<double> laplacian(num_free, num_free);
-    laplacian.setFromTriplets(triplets.begin(), triplets.end());
-    Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> llt(
-        laplacian);
-    if (llt.info() != Eigen::Success) {
-      return Status::Internal("harmonic weight system could not be factorised");
-    }
-    const Eigen::MatrixXd solution = llt.solve(rhs);
-    for (int i = 0; i < n; ++i) {
-      if (free_index[i] >= 0) result.dense.row(i) = solution.row(free_index[i]);
-    }
-    // Round-off can leave tiny negatives; the exact solution lies in [0, 1].
-    result.dense = result.dense.cwiseMax(0.0).cwiseMin(1.0);
+    DEFORM_RETURN_IF_ERROR(
+        SolveFreeVertices(adjacency, fixed_bone, free_index, num_free, &result.dense));
   }
-
-  Compress(&result);
+  CompressWeights(&result);
   return result;
 }
 
@@ -126,7 +129,7 @@ BoneWeights BoneWeightsFromSkinWeights(const SkinWeights& weights) {
       result.dense(i, weights.bones[e]) += weights.weights[e];
     }
   }
-  Compress(&result);
+  CompressWeights(&result);
   return result;
 }
 

@@ -68,13 +68,14 @@ Eigen::Matrix3d LinearBlend(const BoneWeights& bw, int segments, int vertex,
   const int begin = bw.offsets[vertex], end = bw.offsets[vertex + 1];
   if (end - begin == 2 && segments > 1) {
     // The pair's knots (ordered by bone index, as the response numbers them) around h_b.
-    const auto [a, b, h] =
+    const BonePair pair =
         OrderedPair(bw.bones[begin], bw.weights[begin], bw.bones[begin + 1], bw.weights[begin + 1]);
-    const PairSegment segment = SegmentOf(h, segments);
+    const PairSegment segment = SegmentOf(pair.h, segments);
     const auto knot = [&](int j) -> Eigen::Matrix3d {
-      if (j == 0) return bone_rotations[a];
-      if (j == segments) return bone_rotations[b];
-      return PairKnot(bones[a].rotation, bones[b].rotation, static_cast<double>(j) / segments)
+      if (j == 0) return bone_rotations[pair.a];
+      if (j == segments) return bone_rotations[pair.b];
+      return PairKnot(bones[pair.a].rotation, bones[pair.b].rotation,
+                      static_cast<double>(j) / segments)
           .toRotationMatrix();
     };
     return (1 - segment.upper_weight) * knot(segment.lower) +
@@ -184,9 +185,8 @@ StatusOr<std::shared_ptr<const MaterialFactorization>> DeformationModel::Factori
   const auto start = Clock::now();
   auto result = std::make_shared<MaterialFactorization>();
   result->model_id_ = id_;
-  result->stiffness_ = stiffness;
-  DEFORM_ASSIGN_OR_RETURN(result->row_weights_, RowWeights(stiffness));
-  result->row_weights_squared_ = result->row_weights_.array().square();
+  DEFORM_ASSIGN_OR_RETURN(const Eigen::VectorXd row_weights, RowWeights(stiffness));
+  result->row_weights_squared_ = row_weights.array().square();
   DEFORM_ASSIGN_OR_RETURN(
       result->factor_, CholeskyFactor::Factorize(
                            symbolic_, deform::NormalMatrix(system_, result->row_weights_squared_)));

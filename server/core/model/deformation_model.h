@@ -45,9 +45,6 @@ namespace deform {
 // every stream that deforms with it.
 class MaterialFactorization {
  public:
-  const Stiffness& stiffness() const { return stiffness_; }
-  // Per-vertex row weights w_i (n) that this factorisation was built with.
-  const Eigen::VectorXd& row_weights() const { return row_weights_; }
   const CholeskyFactor& factor() const { return factor_; }
   // With RotationBlend::kLinear, the precomputed response that replaces the per-frame solve, when
   // a frame reads less from it than a solve reads from the factor (its doubles against twice the
@@ -59,9 +56,7 @@ class MaterialFactorization {
 
  private:
   friend class DeformationModel;
-  Stiffness stiffness_;
-  Eigen::VectorXd row_weights_;
-  Eigen::VectorXd row_weights_squared_;
+  Eigen::VectorXd row_weights_squared_;  // w_i^2 (n) for the stiffness it was built for
   CholeskyFactor factor_;
   std::unique_ptr<const LinearPoseResponse> linear_response_;
   double factor_seconds_ = 0;

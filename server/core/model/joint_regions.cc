@@ -57,6 +57,76 @@ double LimbRadius(const TriangleMesh& mesh, const Skeleton& skeleton,
   return Median(distances);
 }
 
+// The checks of `options`: explicit radii for inner joints only, positive and finite, and a
+// positive, finite radius factor.
+Status CheckRegionOptions(const Skeleton& skeleton, const std::vector<int>& inner,
+                          const JointRegionOptions& options) {
+  for (const auto& [joint, radius] : options.explicit_radius) {
+    if (joint < 0 || joint >= skeleton.num_joints()) {
+      return Status::InvalidArgument("joint region radius given for unknown joint " +
+                                     std::to_string(joint));
+    }
+    if (std::find(inner.begin(), inner.end(), joint) == inner.end()) {
+      return Status::InvalidArgument("joint '" + skeleton.joint(joint).name +
+                                     "' is not an inner joint, so it has no region");
+    }
+    if (!std::isfinite(radius) || radius <= 0) {
+      return Status::InvalidArgument("joint region radius of '" + skeleton.joint(joint).name +
+                                     "' must be positive and finite");
+    }
+  }
+  if (!std::isfinite(options.radius_factor) || options.radius_factor <= 0) {
+    return Status::InvalidArgument("joint region radius factor must be positive and finite");
+  }
+  return Status::Ok();
+}
+
+// Joint `joint`'s region without its vertices: centre, limb radius and radius (an explicit one, or
+// the factor times the limb radius).
+JointRegion MeasureRegion(const TriangleMesh& mesh, const Skeleton& skeleton,
+                          const std::vector<NearestBone>& nearest, int joint,
+                          const JointRegionOptions& options) {
+  JointRegion region;
+  region.joint = joint;
+  region.centre = skeleton.joint(joint).rest_position;
+  region.limb_radius = LimbRadius(mesh, skeleton, nearest, joint);
+  region.radius = options.radius_factor * region.limb_radius;
+  for (const auto& [j, radius] : options.explicit_radius) {
+    if (j == joint) region.radius = radius;
+  }
+  return region;
+}
+
+// Joint region `region`'s vertices: within its radius and bound to one of its joint's bones.
+std::vector<int> RegionVertices(const TriangleMesh& mesh, const Skeleton& skeleton,
+                                const std::vector<NearestBone>& nearest,
+                                const JointRegion& region) {
+  std::vector<int> vertices;
+  for (int i = 0; i < mesh.num_vertices(); ++i) {
+    const double d = (mesh.vertices.row(i).transpose() - region.centre).norm();
+    if (d <= region.radius && BoneTouchesJoint(skeleton, nearest[i].bone, region.joint)) {
+      vertices.push_back(i);
+    }
+  }
+  return vertices;
+}
+
+// The vertices of region `index` with a one-ring neighbour outside it.
+std::vector<int> SeamVertices(const VertexAdjacency& adjacency, const std::vector<int>& vertices,
+                              const std::vector<std::vector<int>>& memberships, int index) {
+  std::vector<int> seam;
+  for (int i : vertices) {
+    for (int p = adjacency.offsets[i]; p < adjacency.offsets[i + 1]; ++p) {
+      const auto& m = memberships[adjacency.neighbors[p]];
+      if (std::find(m.begin(), m.end(), index) == m.end()) {
+        seam.push_back(i);
+        break;
+      }
+    }
+  }
+  return seam;
+}
+
 }  // namespace
 
 int FindJointRegion(const JointRegions& regions, int joint) {
@@ -82,40 +152,11 @@ StatusOr<JointRegions> ComputeJointRegions(const TriangleMesh& mesh, const Skele
                                            const JointRegionOptions& options) {
   const int n = mesh.num_vertices();
   const std::vector<int> inner = skeleton.InnerJoints();
-  for (const auto& [joint, radius] : options.explicit_radius) {
-    if (joint < 0 || joint >= skeleton.num_joints()) {
-      return Status::InvalidArgument("joint region radius given for unknown joint " +
-                                     std::to_string(joint));
-    }
-    if (std::find(inner.begin(), inner.end(), joint) == inner.end()) {
-      return Status::InvalidArgument("joint '" + skeleton.joint(joint).name +
-                                     "' is not an inner joint, so it has no region");
-    }
-    if (!std::isfinite(radius) || radius <= 0) {
-      return Status::InvalidArgument("joint region radius of '" + skeleton.joint(joint).name +
-                                     "' must be positive and finite");
-    }
-  }
-  if (!std::isfinite(options.radius_factor) || options.radius_factor <= 0) {
-    return Status::InvalidArgument("joint region radius factor must be positive and finite");
-  }
-
+  DEFORM_RETURN_IF_ERROR(CheckRegionOptions(skeleton, inner, options));
   std::vector<JointRegion> regions;
   for (int joint : inner) {
-    JointRegion region;
-    region.joint = joint;
-    region.centre = skeleton.joint(joint).rest_position;
-    region.limb_radius = LimbRadius(mesh, skeleton, nearest, joint);
-    region.radius = options.radius_factor * region.limb_radius;
-    for (const auto& [j, radius] : options.explicit_radius) {
-      if (j == joint) region.radius = radius;
-    }
-    for (int i = 0; i < n; ++i) {
-      const double d = (mesh.vertices.row(i).transpose() - region.centre).norm();
-      if (d <= region.radius && BoneTouchesJoint(skeleton, nearest[i].bone, joint)) {
-        region.vertices.push_back(i);
-      }
-    }
+    JointRegion region = MeasureRegion(mesh, skeleton, nearest, joint, options);
+    region.vertices = RegionVertices(mesh, skeleton, nearest, region);
     regions.push_back(std::move(region));
   }
   return AssembleJointRegions(mesh, adjacency, std::move(regions));
@@ -129,7 +170,7 @@ JointRegions AssembleJointRegions(const TriangleMesh& mesh, const VertexAdjacenc
   result.nearest_region.assign(n, -1);
   std::vector<std::vector<int>> memberships(n);
   for (int index = 0; index < static_cast<int>(regions.size()); ++index) {
-    JointRegion& region = regions[index];
+    const JointRegion& region = regions[index];
     for (int i = 0; i < n; ++i) {
       const double d = (mesh.vertices.row(i).transpose() - region.centre).norm();
       if (region.radius > 0 && d / region.radius < result.relative_distance[i]) {
@@ -140,17 +181,8 @@ JointRegions AssembleJointRegions(const TriangleMesh& mesh, const VertexAdjacenc
     for (int i : region.vertices) memberships[i].push_back(index);
   }
   for (int index = 0; index < static_cast<int>(regions.size()); ++index) {
-    JointRegion& region = regions[index];
-    region.seam_vertices.clear();
-    for (int i : region.vertices) {
-      for (int p = adjacency.offsets[i]; p < adjacency.offsets[i + 1]; ++p) {
-        const auto& m = memberships[adjacency.neighbors[p]];
-        if (std::find(m.begin(), m.end(), index) == m.end()) {
-          region.seam_vertices.push_back(i);
-          break;
-        }
-      }
-    }
+    regions[index].seam_vertices =
+        SeamVertices(adjacency, regions[index].vertices, memberships, index);
   }
   result.regions = std::move(regions);
   result.membership_offsets.assign(n + 1, 0);

@@ -182,21 +182,22 @@ void AddBlendTerms(const BoneWeights& bw, int segments, ResponseSlots* slots) {
         terms.emplace_back(slots->bone_slot[bw.bones[p]], bw.weights[p]);
       continue;
     }
-    const auto [a, b, h] =
+    const BonePair pair =
         OrderedPair(bw.bones[begin], bw.weights[begin], bw.bones[begin + 1], bw.weights[begin + 1]);
-    const auto [it, inserted] =
-        first_knot.emplace(std::make_pair(a, b), static_cast<int>(slots->knots.size()));
-    if (inserted) {
+    const auto inserted =
+        first_knot.emplace(std::make_pair(pair.a, pair.b), static_cast<int>(slots->knots.size()));
+    if (inserted.second) {
       for (int j = 1; j < segments; ++j) {
-        slots->knots.push_back({a, b, static_cast<double>(j) / segments});
+        slots->knots.push_back({pair.a, pair.b, static_cast<double>(j) / segments});
       }
     }
+    const int pair_first_knot = inserted.first->second;
     const auto slot_of_knot = [&](int j) {
-      if (j == 0) return slots->bone_slot[a];
-      if (j == segments) return slots->bone_slot[b];
-      return slots->num_bone_slots() + it->second + j - 1;
+      if (j == 0) return slots->bone_slot[pair.a];
+      if (j == segments) return slots->bone_slot[pair.b];
+      return slots->num_bone_slots() + pair_first_knot + j - 1;
     };
-    const PairSegment segment = SegmentOf(h, segments);
+    const PairSegment segment = SegmentOf(pair.h, segments);
     terms = {{slot_of_knot(segment.lower), 1 - segment.upper_weight},
              {slot_of_knot(segment.lower + 1), segment.upper_weight}};
   }

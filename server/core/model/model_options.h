@@ -89,7 +89,6 @@ struct ModelOptions {
   static ModelOptions Paper() { return {}; }
   // The plain Laplacian baseline: `base` with no joint node and every row weight 1.
   static ModelOptions PlainLaplacian(ModelOptions base);
-  static ModelOptions PlainLaplacian() { return PlainLaplacian(Paper()); }
 };
 
 // The checks Build() applies to the options (the region radii are checked where the regions are

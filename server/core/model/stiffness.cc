@@ -21,10 +21,13 @@ Status CheckJointMaterial(const JointMaterial& material, const std::string& what
   return Status::Ok();
 }
 
-StatusOr<Eigen::VectorXd> MaterialRowWeights(const JointRegions& regions, const Skeleton& skeleton,
-                                             int num_vertices,
-                                             const JointMaterial& default_material,
-                                             const Stiffness& stiffness) {
+namespace {
+
+// The per-joint profiles: `default_material` for every region, replaced by the stiffness's.
+StatusOr<std::vector<JointMaterial>> RegionMaterials(const JointRegions& regions,
+                                                     const Skeleton& skeleton,
+                                                     const JointMaterial& default_material,
+                                                     const Stiffness& stiffness) {
   DEFORM_RETURN_IF_ERROR(CheckJointMaterial(default_material, "default material"));
   std::vector<JointMaterial> materials(regions.regions.size(), default_material);
   for (const auto& [joint, material] : stiffness.joint_materials) {
@@ -32,11 +35,18 @@ StatusOr<Eigen::VectorXd> MaterialRowWeights(const JointRegions& regions, const 
     DEFORM_RETURN_IF_ERROR(CheckJointMaterial(material, "joint " + std::to_string(joint)));
     materials[r] = material;
   }
+  return materials;
+}
 
+// The weights of the profiles alone: the largest soft or seam weight of the regions a vertex is
+// in, else the rigid weight of its nearest region (`default_rigid` when there is none).
+Eigen::VectorXd ProfileWeights(const JointRegions& regions,
+                               const std::vector<JointMaterial>& materials, double default_rigid,
+                               int num_vertices) {
   Eigen::VectorXd w(num_vertices);
   for (int i = 0; i < num_vertices; ++i) {
     const int nearest = regions.nearest_region[i];
-    w[i] = nearest >= 0 ? materials[nearest].rigid : default_material.rigid;
+    w[i] = nearest >= 0 ? materials[nearest].rigid : default_rigid;
   }
   std::vector<double> inside(num_vertices, 0.0);
   for (int r = 0; r < static_cast<int>(regions.regions.size()); ++r) {
@@ -48,7 +58,18 @@ StatusOr<Eigen::VectorXd> MaterialRowWeights(const JointRegions& regions, const 
   for (int i = 0; i < num_vertices; ++i) {
     if (inside[i] > 0) w[i] = inside[i];
   }
+  return w;
+}
 
+}  // namespace
+
+StatusOr<Eigen::VectorXd> MaterialRowWeights(const JointRegions& regions, const Skeleton& skeleton,
+                                             int num_vertices,
+                                             const JointMaterial& default_material,
+                                             const Stiffness& stiffness) {
+  DEFORM_ASSIGN_OR_RETURN(const std::vector<JointMaterial> materials,
+                          RegionMaterials(regions, skeleton, default_material, stiffness));
+  Eigen::VectorXd w = ProfileWeights(regions, materials, default_material.rigid, num_vertices);
   for (const auto& [joint, weight] : stiffness.region_weights) {
     DEFORM_ASSIGN_OR_RETURN(const int r, RegionOfJoint(regions, skeleton, joint));
     DEFORM_RETURN_IF_ERROR(

@@ -68,6 +68,15 @@ const char* OrderingName(Ordering ordering) {
   return "unknown";
 }
 
+StatusOr<Ordering> OrderingFromName(std::string_view name) {
+  for (Ordering ordering :
+       {Ordering::kNatural, Ordering::kAmd, Ordering::kMetis, Ordering::kAuto}) {
+    if (name == OrderingName(ordering)) return ordering;
+  }
+  return Status::InvalidArgument("unknown ordering '" + std::string(name) +
+                                 "' (known: natural, amd, metis, auto)");
+}
+
 StatusOr<std::vector<int>> FillReducingOrdering(const ColMajorMatrix& a, Ordering ordering) {
   const int n = static_cast<int>(a.cols());
   std::vector<int> identity(n);

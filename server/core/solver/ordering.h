@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/SparseCore>
+#include <string_view>
 #include <vector>
 
 #include "core/base/status.h"
@@ -19,6 +20,8 @@ enum class Ordering {
 
 // "natural", "amd", "metis", "auto".
 const char* OrderingName(Ordering ordering);
+// The ordering OrderingName() names; INVALID_ARGUMENT listing the names for any other text.
+StatusOr<Ordering> OrderingFromName(std::string_view name);
 
 // The permutation `ordering` chooses for the pattern of `a` (square, both triangles stored,
 // column-major), as permutation[new] = old. Deterministic from run to run. INVALID_ARGUMENT for

@@ -22,10 +22,7 @@ namespace {
 TEST(ReadMeshTest, BinaryStlCubeOf36CornersWeldsToEightVertices) {
   const std::string bytes = BinaryStl(Cube());
   ASSERT_EQ(bytes.size(), 84u + 50u * 12u);
-  const StatusOr<TriangleMesh> mesh = ReadMesh(bytes, MeshFormat::kStl);
-  ASSERT_TRUE(mesh.ok()) << mesh.status().ToString();
-  EXPECT_EQ(mesh->num_vertices(), 8);
-  EXPECT_EQ(mesh->num_triangles(), 12);
+  ExpectMeshSize(ReadMesh(bytes, MeshFormat::kStl), 8, 12);
 }
 
 TEST(ReadMeshTest, BinaryStlWhoseHeaderStartsWithSolidIsStillBinary) {
@@ -61,35 +58,23 @@ TEST(ReadMeshTest, BinaryStlWithNaNCornerIsInvalid) {
                 "non-finite vertex coordinate");
 }
 
-TEST(ReadMeshTest, AsciiStlFacetsMustBeTriangles) {
-  const std::string stl =
-      "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
-      "vertex 5 5 5\nendloop\nendfacet\nendsolid x\n";
-  EXPECT_STATUS(ReadMesh(stl, MeshFormat::kStl).status(), StatusCode::kInvalidArgument,
-                "expected 'endloop'");
-}
-
-TEST(ReadMeshTest, AsciiStlMalformedVertexLineIsInvalid) {
-  // OpenMesh read a blank line as a repeat of the previous vertex.
-  const std::string stl =
-      "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n\nvertex 1 0 0\nvertex 0 1 0\n"
-      "endloop\nendfacet\nendsolid x\n";
-  EXPECT_STATUS(ReadMesh(stl, MeshFormat::kStl).status(), StatusCode::kInvalidArgument,
-                "STL line 5: expected 'vertex <x> <y> <z>'");
-  const std::string nan_stl =
-      "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex nan 0 0\nvertex 0 1 0\n"
-      "endloop\nendfacet\nendsolid x\n";
-  EXPECT_STATUS(ReadMesh(nan_stl, MeshFormat::kStl).status(), StatusCode::kInvalidArgument,
-                "non-finite");
-}
-
-TEST(ReadMeshTest, AsciiStlEndloopLineMustBeExact) {
-  // OpenMesh starts a facet at any line containing "outer", so this would misread silently.
-  const std::string stl =
-      "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
-      "endloop outer\nendfacet\nendsolid x\n";
-  EXPECT_STATUS(ReadMesh(stl, MeshFormat::kStl).status(), StatusCode::kInvalidArgument,
-                "expected 'endloop'");
+TEST(ReadMeshTest, MalformedAsciiStlIsNamed) {
+  const std::string facet_start = "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n";
+  const std::string facet_end = "endloop\nendfacet\nendsolid x\n";
+  ExpectRefusals(
+      MeshFormat::kStl,
+      {{"a facet of four vertices",
+        facet_start + "vertex 1 0 0\nvertex 0 1 0\nvertex 5 5 5\n" + facet_end,
+        "expected 'endloop'"},
+       // OpenMesh read a blank line as a repeat of the previous vertex.
+       {"a blank vertex line", facet_start + "\nvertex 1 0 0\nvertex 0 1 0\n" + facet_end,
+        "STL line 5: expected 'vertex <x> <y> <z>'"},
+       {"a NaN coordinate", facet_start + "vertex nan 0 0\nvertex 0 1 0\n" + facet_end,
+        "non-finite"},
+       // OpenMesh starts a facet at any line containing "outer", so this would misread silently.
+       {"an endloop line with more on it",
+        facet_start + "vertex 1 0 0\nvertex 0 1 0\nendloop outer\nendfacet\nendsolid x\n",
+        "expected 'endloop'"}});
 }
 
 TEST(ReadMeshTest, StlThatIsNeitherAsciiNorBinaryIsInvalid) {

@@ -224,6 +224,13 @@ inline std::vector<std::array<double, 3>> SortedPositions(const TriangleMesh& me
   return rows;
 }
 
+// Expects `mesh` read, with these sizes.
+inline void ExpectMeshSize(const StatusOr<TriangleMesh>& mesh, int vertices, int triangles) {
+  ASSERT_TRUE(mesh.ok()) << mesh.status().ToString();
+  EXPECT_EQ(mesh->num_vertices(), vertices);
+  EXPECT_EQ(mesh->num_triangles(), triangles);
+}
+
 inline void ExpectSamePositionsToFloatPrecision(const std::vector<std::array<double, 3>>& expected,
                                                 const std::vector<std::array<double, 3>>& actual) {
   ASSERT_EQ(expected.size(), actual.size());
@@ -244,3 +251,24 @@ inline void ExpectSamePositionsToFloatPrecision(const std::vector<std::array<dou
     EXPECT_EQ(status_.code(), (expected_code)) << status_.ToString();                      \
     EXPECT_THAT(status_.message(), ::testing::HasSubstr(substring)) << status_.ToString(); \
   } while (0)
+
+namespace deform::mesh_io_test {
+
+// Malformed input and what its refusal says: reading `bytes` fails with `code` and a message that
+// contains `message`. `what` names the case in failures (and says what it once did to OpenMesh).
+struct Refusal {
+  std::string what;
+  std::string bytes;
+  std::string message;
+  StatusCode code = StatusCode::kInvalidArgument;
+};
+
+// Reads each refusal's bytes as `format` and checks that it is refused as it says.
+inline void ExpectRefusals(MeshFormat format, const std::vector<Refusal>& refusals) {
+  for (const Refusal& refusal : refusals) {
+    SCOPED_TRACE(refusal.what);
+    EXPECT_STATUS(ReadMesh(refusal.bytes, format).status(), refusal.code, refusal.message);
+  }
+}
+
+}  // namespace deform::mesh_io_test

@@ -101,6 +101,14 @@ TEST_P(SparseCholeskyTest, RefactorisationReusesTheAnalysis) {
   EXPECT_LT((x1 - x2).norm(), 1e-12 * x2.norm());
 }
 
+TEST(Ordering, NamesRoundTrip) {
+  for (Ordering ordering :
+       {Ordering::kNatural, Ordering::kAmd, Ordering::kMetis, Ordering::kAuto}) {
+    EXPECT_EQ(*OrderingFromName(OrderingName(ordering)), ordering);
+  }
+  EXPECT_EQ(OrderingFromName("colamd").status().code(), StatusCode::kInvalidArgument);
+}
+
 TEST(CholeskyFactor, AnEmptyFactorRefusesToSolve) {
   const CholeskyFactor empty;
   EXPECT_EQ(empty.size(), 0);

@@ -117,6 +117,13 @@ inline void ZeroPadding(const Planar& p, int width) {
   for (int k = width; k < RoundUp4(width); ++k) p.x[k] = p.y[k] = p.z[k] = 0;
 }
 
+// (*sx, *sy, *sz) += r * (x, y, z).
+inline void MultiplyAdd3(Vec4 r, Vec4 x, Vec4 y, Vec4 z, Vec4* sx, Vec4* sy, Vec4* sz) {
+  *sx += r * x;
+  *sy += r * y;
+  *sz += r * z;
+}
+
 // sums[4 j + c] = sum over k < n of row_j[k] * p.c[k], for the four rows j and the columns c
 // (sums[4 j + 3] = 0: the layout of four solution rows). `n` is a multiple of four: the callers
 // pass a tile's start column or a padded width.
@@ -130,22 +137,10 @@ inline void Dot4x3(const double* __restrict r0, const double* __restrict r1,
   Vec4 c0 = a0, c1 = a0, c2 = a0, d0 = a0, d1 = a0, d2 = a0;
   for (int k = 0; k < n; k += 4) {
     const Vec4 x = Load4(px + k), y = Load4(py + k), z = Load4(pz + k);
-    Vec4 r = Load4(r0 + k);
-    a0 += r * x;
-    a1 += r * y;
-    a2 += r * z;
-    r = Load4(r1 + k);
-    b0 += r * x;
-    b1 += r * y;
-    b2 += r * z;
-    r = Load4(r2 + k);
-    c0 += r * x;
-    c1 += r * y;
-    c2 += r * z;
-    r = Load4(r3 + k);
-    d0 += r * x;
-    d1 += r * y;
-    d2 += r * z;
+    MultiplyAdd3(Load4(r0 + k), x, y, z, &a0, &a1, &a2);
+    MultiplyAdd3(Load4(r1 + k), x, y, z, &b0, &b1, &b2);
+    MultiplyAdd3(Load4(r2 + k), x, y, z, &c0, &c1, &c2);
+    MultiplyAdd3(Load4(r3 + k), x, y, z, &d0, &d1, &d2);
   }
   const Vec4 zero = Splat4(0);
   Store4(sums, Sum4x4(a0, a1, a2, zero));
@@ -436,13 +431,69 @@ inline void DispatchNarrow(int width, Kernel&& kernel) {
   }
 }
 
+// Supernode sn's block of the factor (see SupernodalFactorView).
+struct SupernodeBlock {
+  int first;              // its first column
+  int width;              // its number of columns
+  const int* rows;        // its row indices
+  std::int64_t num_rows;  // their number
+  const double* values;   // its dense row-major (num_rows) x (width) block
+};
+
+inline SupernodeBlock BlockOf(const SupernodalFactorView& f, int sn) {
+  const int first = f.supernode_columns[sn];
+  return SupernodeBlock{
+      first, f.supernode_columns[sn + 1] - first, f.row_indices + f.row_pointers[sn],
+      f.row_pointers[sn + 1] - f.row_pointers[sn], f.values + f.value_pointers[sn]};
+}
+
+// L y = P b, one pass over the factor (y holds P b on entry).
+inline void ForwardPass(const SupernodalFactorView& f, double* __restrict y,
+                        double* planar_buffer) {
+  for (int sn = 0; sn < f.num_supernodes; ++sn) {
+    const SupernodeBlock s = BlockOf(f, sn);
+    const Planar p = PlanarOf(planar_buffer, s.width);
+    ForwardDiagonal(s.values, s.width, Row(y, s.first), p);
+    if (s.width > 4) {
+      ForwardUpdate(s.values, s.rows, s.width, s.num_rows, p, y);
+    } else {
+      DispatchNarrow(s.width, [&](auto w) {
+        ForwardUpdateNarrow<decltype(w)::value>(s.values, s.rows, s.num_rows, p, y);
+      });
+    }
+  }
+}
+
+// L^T z = y in place, one pass over the factor backwards.
+inline void BackwardPass(const SupernodalFactorView& f, double* __restrict y,
+                         double* planar_buffer) {
+  for (int sn = f.num_supernodes - 1; sn >= 0; --sn) {
+    const SupernodeBlock s = BlockOf(f, sn);
+    const Planar p = PlanarOf(planar_buffer, s.width);
+    double* ys = Row(y, s.first);
+    for (int k = 0; k < s.width; ++k) {
+      const double* t = Row(ys, k);
+      p.x[k] = t[0];
+      p.y[k] = t[1];
+      p.z[k] = t[2];
+    }
+    if (s.width > 4) {
+      BackwardUpdate(s.values, s.rows, s.width, s.num_rows, p, y);
+    } else {
+      DispatchNarrow(s.width, [&](auto w) {
+        BackwardUpdateNarrow<decltype(w)::value>(s.values, s.rows, s.num_rows, p, y);
+      });
+    }
+    BackwardDiagonal(s.values, s.width, ys, p);
+  }
+}
+
 void Solve3Impl(const SupernodalFactorView& f, const double* b, double* x, double* work) {
   const int n = f.size;
   // The solution rows start at the first 32-byte boundary of `work`.
   const std::uintptr_t misalignment = reinterpret_cast<std::uintptr_t>(work) % 32;
   double* __restrict y = work + (misalignment ? (32 - misalignment) / sizeof(double) : 0);
   double* const planar_buffer = y + kRowStride * static_cast<std::ptrdiff_t>(n);
-
   for (int i = 0; i < n; ++i) {
     const double* source = b + 3 * static_cast<std::ptrdiff_t>(f.permutation[i]);
     double* t = Row(y, i);
@@ -451,50 +502,8 @@ void Solve3Impl(const SupernodalFactorView& f, const double* b, double* x, doubl
     t[2] = source[2];
     t[3] = 0;
   }
-
-  // L y = P b, one pass over the factor.
-  for (int sn = 0; sn < f.num_supernodes; ++sn) {
-    const int first = f.supernode_columns[sn];
-    const int width = f.supernode_columns[sn + 1] - first;
-    const int* rows = f.row_indices + f.row_pointers[sn];
-    const std::int64_t num_rows = f.row_pointers[sn + 1] - f.row_pointers[sn];
-    const double* block = f.values + f.value_pointers[sn];
-    const Planar p = PlanarOf(planar_buffer, width);
-    ForwardDiagonal(block, width, Row(y, first), p);
-    if (width > 4) {
-      ForwardUpdate(block, rows, width, num_rows, p, y);
-    } else {
-      DispatchNarrow(width, [&](auto w) {
-        ForwardUpdateNarrow<decltype(w)::value>(block, rows, num_rows, p, y);
-      });
-    }
-  }
-
-  // L^T z = y, one pass over the factor backwards.
-  for (int sn = f.num_supernodes - 1; sn >= 0; --sn) {
-    const int first = f.supernode_columns[sn];
-    const int width = f.supernode_columns[sn + 1] - first;
-    const int* rows = f.row_indices + f.row_pointers[sn];
-    const std::int64_t num_rows = f.row_pointers[sn + 1] - f.row_pointers[sn];
-    const double* block = f.values + f.value_pointers[sn];
-    const Planar p = PlanarOf(planar_buffer, width);
-    double* ys = Row(y, first);
-    for (int k = 0; k < width; ++k) {
-      const double* t = Row(ys, k);
-      p.x[k] = t[0];
-      p.y[k] = t[1];
-      p.z[k] = t[2];
-    }
-    if (width > 4) {
-      BackwardUpdate(block, rows, width, num_rows, p, y);
-    } else {
-      DispatchNarrow(width, [&](auto w) {
-        BackwardUpdateNarrow<decltype(w)::value>(block, rows, num_rows, p, y);
-      });
-    }
-    BackwardDiagonal(block, width, ys, p);
-  }
-
+  ForwardPass(f, y, planar_buffer);
+  BackwardPass(f, y, planar_buffer);
   for (int i = 0; i < n; ++i) {
     double* target = x + 3 * static_cast<std::ptrdiff_t>(f.permutation[i]);
     const double* t = Row(y, i);
