@@ -8,12 +8,13 @@
 // Thread safety: every method may be called from any thread, including from inside a task.
 #pragma once
 
-#include <condition_variable>
 #include <deque>
 #include <functional>
-#include <mutex>
 #include <thread>
 #include <vector>
+
+#include "service/annotated_mutex.h"
+#include "service/thread_annotations.h"
 
 namespace deform::service {
 
@@ -41,29 +42,31 @@ class WorkerPool {
   WorkerPool(const WorkerPool&) = delete;
   WorkerPool& operator=(const WorkerPool&) = delete;
 
-  int size() const { return static_cast<int>(threads_.size()); }
+  int size() const { return thread_count_; }
 
   // Queues `task` at urgent priority. Allocation-free. Ignored after Shutdown() has finished.
-  void PostUrgent(UrgentTask* task);
+  void PostUrgent(UrgentTask* task) DEFORM_EXCLUDES(mutex_);
   // Queues `task` at background priority.
-  void PostBackground(std::function<void()> task);
+  void PostBackground(std::function<void()> task) DEFORM_EXCLUDES(mutex_);
 
   // Runs every task already queued (and those they post), then joins the workers. Idempotent.
-  void Shutdown();
+  void Shutdown() DEFORM_EXCLUDES(mutex_, join_mutex_);
 
  private:
-  void WorkerLoop();
+  void WorkerLoop() DEFORM_EXCLUDES(mutex_);
 
-  std::mutex mutex_;
-  std::condition_variable wake_;
-  UrgentTask* urgent_head_ = nullptr;             // guarded by mutex_
-  UrgentTask* urgent_tail_ = nullptr;             // guarded by mutex_
-  std::deque<std::function<void()>> background_;  // guarded by mutex_
-  int running_background_ = 0;                    // guarded by mutex_
-  int max_background_ = 1;
-  bool stopping_ = false;  // guarded by mutex_
-  std::vector<std::thread> threads_;
-  std::mutex join_mutex_;
+  Mutex mutex_;
+  CondVar wake_;
+  UrgentTask* urgent_head_ DEFORM_GUARDED_BY(mutex_) = nullptr;
+  UrgentTask* urgent_tail_ DEFORM_GUARDED_BY(mutex_) = nullptr;
+  std::deque<std::function<void()>> background_ DEFORM_GUARDED_BY(mutex_);
+  int running_background_ DEFORM_GUARDED_BY(mutex_) = 0;
+  int max_background_ = 1;  // set by the constructor, then read-only
+  bool stopping_ DEFORM_GUARDED_BY(mutex_) = false;
+
+  int thread_count_ = 0;  // set by the constructor, then read-only
+  Mutex join_mutex_;      // serialises Shutdown()
+  std::vector<std::thread> threads_ DEFORM_GUARDED_BY(join_mutex_);
 };
 
 }  // namespace deform::service
