@@ -15,6 +15,7 @@
 #include "core/model/deformation_model.h"
 #include "service/pose_input.h"
 #include "service/proto_conversion.h"
+#include "service/shared_reactor.h"
 #include "service/status_mapping.h"
 
 namespace deform::service {
@@ -32,7 +33,8 @@ double Milliseconds(Clock::duration duration) {
 
 class DeformStreamReactor final
     : public grpc::ServerBidiReactor<v1::DeformRequest, v1::DeformResponse>,
-      private UrgentTask,
+      public SharedReactor<DeformStreamReactor>,
+      public UrgentTask,
       private Drainable {
  public:
   explicit DeformStreamReactor(ServiceCore* core)
@@ -64,7 +66,7 @@ class DeformStreamReactor final
   void Refactor(const Stiffness& stiffness, std::uint64_t version);
 
   // All *Locked helpers require mutex_.
-  // Marks the task queued if idle and takes a hold for the queue; true if the caller must post it.
+  // Marks the task queued if idle; true if the caller must post it.
   bool ScheduleLocked();
   void StartRefactorLocked(Stiffness stiffness, std::uint64_t version);
   void AdoptFactorizationLocked();
@@ -74,8 +76,6 @@ class DeformStreamReactor final
   // Starts the next write, or Finish when due. Never more than one write in flight.
   void PumpLocked();
   bool NothingPendingLocked() const;
-  // True when the last hold is gone: the caller deletes the reactor after unlocking.
-  bool ReleaseHoldLocked() { return --holds_ == 0; }
 
   ServiceCore* const core_;
   const std::uint64_t stream_id_;
@@ -102,7 +102,6 @@ class DeformStreamReactor final
 
   std::mutex mutex_;
   // Everything below is guarded by mutex_.
-  int holds_ = 1;  // gRPC's (released in OnDone), the urgent queue's, each refactorisation's
   bool started_ = false;
   TaskState task_state_ = TaskState::kIdle;
   PoseInput pending_;
@@ -242,7 +241,7 @@ void DeformStreamReactor::HandlePose() {
     }
     StartRead(&request_);
   }
-  if (post) core_->pool.PostUrgent(this);
+  if (post) core_->pool.PostUrgent(SharedFromThis());
 }
 
 void DeformStreamReactor::HandleStiffness() {
@@ -280,9 +279,9 @@ void DeformStreamReactor::HandleStiffness() {
 
 void DeformStreamReactor::StartRefactorLocked(Stiffness stiffness, std::uint64_t version) {
   refactor_running_ = true;
-  ++holds_;
-  core_->pool.PostBackground(
-      [this, stiffness = std::move(stiffness), version] { Refactor(stiffness, version); });
+  core_->pool.PostBackground([self = SharedFromThis(), stiffness = std::move(stiffness), version] {
+    self->Refactor(stiffness, version);
+  });
 }
 
 void DeformStreamReactor::Refactor(const Stiffness& stiffness, std::uint64_t version) {
@@ -295,40 +294,35 @@ void DeformStreamReactor::Refactor(const Stiffness& stiffness, std::uint64_t ver
       skip ? StatusOr<std::shared_ptr<const MaterialFactorization>>(
                  Status::FailedPrecondition("stream ending"))
            : model_->Factorize(stiffness);
-  bool remove;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    refactor_running_ = false;
-    if (!stopping_) {
-      if (result.ok()) {
-        if (next_factorization_ != nullptr) {
-          AddNoticeLocked(v1::Notice::KIND_STIFFNESS_REJECTED, 0, next_version_,
-                          "stiffness version " + std::to_string(next_version_) +
-                              " superseded by version " + std::to_string(version) +
-                              " before it was applied");
-        }
-        next_factor_ms_ = (*result)->factor_seconds() * 1e3;
-        next_factorization_ = std::move(*result);
-        next_version_ = version;
-        // Between two solves now: switch at once. During a solve: the worker switches after it.
-        if (task_state_ != TaskState::kRunning) AdoptFactorizationLocked();
-      } else {
-        spdlog::info("{} stiffness version {} rejected: {}", log_context_, version,
-                     result.status().message());
-        AddNoticeLocked(
-            v1::Notice::KIND_STIFFNESS_REJECTED, 0, version,
-            "stiffness version " + std::to_string(version) + ": " + result.status().message());
+  std::lock_guard<std::mutex> lock(mutex_);
+  refactor_running_ = false;
+  if (!stopping_) {
+    if (result.ok()) {
+      if (next_factorization_ != nullptr) {
+        AddNoticeLocked(v1::Notice::KIND_STIFFNESS_REJECTED, 0, next_version_,
+                        "stiffness version " + std::to_string(next_version_) +
+                            " superseded by version " + std::to_string(version) +
+                            " before it was applied");
       }
-      if (has_queued_stiffness_) {
-        has_queued_stiffness_ = false;
-        StartRefactorLocked(std::move(queued_stiffness_), queued_version_);
-        queued_stiffness_ = Stiffness();
-      }
+      next_factor_ms_ = (*result)->factor_seconds() * 1e3;
+      next_factorization_ = std::move(*result);
+      next_version_ = version;
+      // Between two solves now: switch at once. During a solve: the worker switches after it.
+      if (task_state_ != TaskState::kRunning) AdoptFactorizationLocked();
+    } else {
+      spdlog::info("{} stiffness version {} rejected: {}", log_context_, version,
+                   result.status().message());
+      AddNoticeLocked(
+          v1::Notice::KIND_STIFFNESS_REJECTED, 0, version,
+          "stiffness version " + std::to_string(version) + ": " + result.status().message());
     }
-    PumpLocked();
-    remove = ReleaseHoldLocked();
+    if (has_queued_stiffness_) {
+      has_queued_stiffness_ = false;
+      StartRefactorLocked(std::move(queued_stiffness_), queued_version_);
+      queued_stiffness_ = Stiffness();
+    }
   }
-  if (remove) delete this;
+  PumpLocked();
 }
 
 void DeformStreamReactor::AdoptFactorizationLocked() {
@@ -344,7 +338,6 @@ void DeformStreamReactor::AdoptFactorizationLocked() {
 bool DeformStreamReactor::ScheduleLocked() {
   if (task_state_ != TaskState::kIdle) return false;
   task_state_ = TaskState::kQueued;
-  ++holds_;
   return true;
 }
 
@@ -406,18 +399,15 @@ void DeformStreamReactor::RunUrgent() {
   }
   if (next_factorization_ != nullptr && !stopping_) AdoptFactorizationLocked();
   bool post = false;
-  bool remove = false;
   if (has_pending_ && !stopping_) {
-    task_state_ = TaskState::kQueued;  // keeps the queue's hold; back of the queue for fairness
+    task_state_ = TaskState::kQueued;  // back of the queue, for fairness
     post = true;
   } else {
     task_state_ = TaskState::kIdle;
-    remove = ReleaseHoldLocked();
   }
   PumpLocked();
   lock.unlock();
-  if (post) core_->pool.PostUrgent(this);
-  if (remove) delete this;
+  if (post) core_->pool.PostUrgent(SharedFromThis());
 }
 
 void DeformStreamReactor::AddNoticeLocked(v1::Notice::Kind kind, std::uint64_t sequence,
@@ -500,22 +490,20 @@ void DeformStreamReactor::Drain() {
 void DeformStreamReactor::OnDone() {
   if (registered_) core_->streams.Remove(this);
   if (entry_ != nullptr) entry_->open_streams.fetch_sub(1);
-  bool remove;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     spdlog::info("{} closed ({}): {} frames written, {} poses rejected", log_context_,
                  finish_status_.ok() ? std::string("OK") : finish_status_.error_message(),
                  frames_written_, poses_rejected_);
-    remove = ReleaseHoldLocked();
   }
-  if (remove) delete this;
+  ReleaseTransportReference();  // last: may free the reactor
 }
 
 }  // namespace
 
 grpc::ServerBidiReactor<v1::DeformRequest, v1::DeformResponse>* NewDeformStreamReactor(
     ServiceCore* core) {
-  return new DeformStreamReactor(core);
+  return DeformStreamReactor::Create(core);
 }
 
 }  // namespace deform::service

@@ -1,5 +1,5 @@
-// The Deform RPC: one reactor per stream (deletes itself when the last of gRPC and the workers
-// is done with it).
+// The Deform RPC: one reactor per stream, owned by shared_ptrs (gRPC's until OnDone, and each
+// posted worker task's; shared_reactor.h): freed when the last of them is done with it.
 //
 // Per stream: a shared_ptr to the mesh entry (keeps the model alive after UnloadMesh; frames then
 // carry mesh_unloaded), its own DeformScratch and frame buffers, its current factorisation and

@@ -16,6 +16,7 @@
 #include "core/io/skeleton_io.h"
 #include "service/mesh_loader.h"
 #include "service/proto_conversion.h"
+#include "service/shared_reactor.h"
 #include "service/status_mapping.h"
 
 namespace deform::service {
@@ -59,7 +60,8 @@ double MillisecondsSince(Clock::time_point start) {
 }
 
 class LoadMeshReactor final
-    : public grpc::ServerBidiReactor<v1::LoadMeshRequest, v1::LoadMeshResponse> {
+    : public grpc::ServerBidiReactor<v1::LoadMeshRequest, v1::LoadMeshResponse>,
+      public SharedReactor<LoadMeshReactor> {
  public:
   explicit LoadMeshReactor(ServiceCore* core)
       : core_(core), log_context_("load=" + std::to_string(core->next_load_id.fetch_add(1))) {
@@ -85,7 +87,6 @@ class LoadMeshReactor final
                          const MeshEntry* entry = nullptr);
   void RequestFinishLocked(const grpc::Status& status);
   void PumpLocked();
-  bool ReleaseHoldLocked() { return --holds_ == 0; }
 
   ServiceCore* const core_;
   std::string log_context_;
@@ -101,7 +102,6 @@ class LoadMeshReactor final
 
   std::mutex mutex_;
   // Guarded by mutex_.
-  int holds_ = 1;  // gRPC's (released in OnDone) and the build's
   std::deque<v1::LoadMeshResponse> outbox_;
   v1::LoadMeshResponse in_flight_;
   bool write_in_flight_ = false;
@@ -212,8 +212,7 @@ Status LoadMeshReactor::HandleEndOfInput() {
   std::lock_guard<std::mutex> lock(mutex_);
   AddProgressLocked(v1::LoadMeshResponse::STAGE_RECEIVED, MillisecondsSince(start_));
   PumpLocked();
-  ++holds_;
-  core_->pool.PostBackground([this] { Build(); });
+  core_->pool.PostBackground([self = SharedFromThis()] { self->Build(); });
   return Status::Ok();
 }
 
@@ -226,25 +225,20 @@ void LoadMeshReactor::Build() {
   StatusOr<std::shared_ptr<const MeshEntry>> entry =
       skip ? StatusOr<std::shared_ptr<const MeshEntry>>(Status::FailedPrecondition("cancelled"))
            : ParseAndBuild();
-  bool remove;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (entry.ok()) {
-      if (cancelled_) {
-        // Nobody is waiting for it: the mesh would be unreachable.
-        (void)core_->registry.Unload((*entry)->id);
-      } else {
-        AddProgressLocked(v1::LoadMeshResponse::STAGE_READY, MillisecondsSince(start_), entry->get());
-        RequestFinishLocked(grpc::Status::OK);
-      }
-    } else if (!skip) {
-      spdlog::warn("{} failed: {}", log_context_, entry.status().ToString());
-      RequestFinishLocked(ToGrpcStatus(entry.status()));
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (entry.ok()) {
+    if (cancelled_) {
+      // Nobody is waiting for it: the mesh would be unreachable.
+      (void)core_->registry.Unload((*entry)->id);
+    } else {
+      AddProgressLocked(v1::LoadMeshResponse::STAGE_READY, MillisecondsSince(start_), entry->get());
+      RequestFinishLocked(grpc::Status::OK);
     }
-    PumpLocked();
-    remove = ReleaseHoldLocked();
+  } else if (!skip) {
+    spdlog::warn("{} failed: {}", log_context_, entry.status().ToString());
+    RequestFinishLocked(ToGrpcStatus(entry.status()));
   }
-  if (remove) delete this;
+  PumpLocked();
 }
 
 StatusOr<std::shared_ptr<const MeshEntry>> LoadMeshReactor::ParseAndBuild() {
@@ -353,19 +347,14 @@ void LoadMeshReactor::OnCancel() {
 }
 
 void LoadMeshReactor::OnDone() {
-  bool remove;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    remove = ReleaseHoldLocked();
-  }
-  if (remove) delete this;
+  ReleaseTransportReference();  // last: may free the reactor
 }
 
 }  // namespace
 
 grpc::ServerBidiReactor<v1::LoadMeshRequest, v1::LoadMeshResponse>* NewLoadMeshReactor(
     ServiceCore* core) {
-  return new LoadMeshReactor(core);
+  return LoadMeshReactor::Create(core);
 }
 
 }  // namespace deform::service

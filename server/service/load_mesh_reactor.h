@@ -1,4 +1,5 @@
-// The LoadMesh RPC: one reactor per call (deletes itself when gRPC and the worker are done).
+// The LoadMesh RPC: one reactor per call, owned by shared_ptrs (gRPC's until OnDone, and the
+// build task's; shared_reactor.h): freed when both are done with it.
 //
 // Reads the header, then the upload's chunks into memory (checking the announced size and the
 // upload limit as they come), then on half-close sends RECEIVED and hands parsing, validation and

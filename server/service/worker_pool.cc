@@ -13,18 +13,31 @@ WorkerPool::WorkerPool(int threads) {
   for (int i = 0; i < threads; ++i) threads_.emplace_back([this] { WorkerLoop(); });
 }
 
-WorkerPool::~WorkerPool() { Shutdown(); }
-
-void WorkerPool::PostUrgent(UrgentTask* task) {
+WorkerPool::~WorkerPool() {
+  Shutdown();
+  // Tasks posted after Shutdown() never ran; drop them one by one (the urgent chain iteratively,
+  // not by recursive destruction).
+  std::shared_ptr<UrgentTask> head;
+  std::deque<std::function<void()>> background;
   {
     MutexLock lock(&mutex_);
-    task->next_urgent_ = nullptr;
+    head = std::move(urgent_head_);
+    urgent_tail_ = nullptr;
+    background.swap(background_);
+  }
+  while (head != nullptr) head = std::move(head->next_urgent_);
+}
+
+void WorkerPool::PostUrgent(std::shared_ptr<UrgentTask> task) {
+  {
+    MutexLock lock(&mutex_);
+    UrgentTask* const queued = task.get();
     if (urgent_tail_ != nullptr) {
-      urgent_tail_->next_urgent_ = task;
+      urgent_tail_->next_urgent_ = std::move(task);
     } else {
-      urgent_head_ = task;
+      urgent_head_ = std::move(task);
     }
-    urgent_tail_ = task;
+    urgent_tail_ = queued;
   }
   wake_.NotifyOne();
 }
@@ -54,12 +67,12 @@ void WorkerPool::WorkerLoop() {
   while (true) {
     const bool can_run_background = !background_.empty() && running_background_ < max_background_;
     if (urgent_head_ != nullptr) {
-      UrgentTask* task = urgent_head_;
-      urgent_head_ = task->next_urgent_;
+      std::shared_ptr<UrgentTask> task = std::move(urgent_head_);
+      urgent_head_ = std::move(task->next_urgent_);
       if (urgent_head_ == nullptr) urgent_tail_ = nullptr;
-      task->next_urgent_ = nullptr;
       lock.Unlock();
       task->RunUrgent();
+      task = nullptr;  // the queue's reference goes outside the lock
       lock.Lock();
       continue;
     }
