@@ -5,8 +5,7 @@
 #include <grpcpp/health_check_service_interface.h>
 #include <spdlog/spdlog.h>
 
-#include <mutex>
-
+#include "service/annotated_mutex.h"
 #include "service/deform_service.h"
 #include "service/mesh_loader.h"
 #include "service/service_core.h"
@@ -22,8 +21,8 @@ struct DeformServer::Impl {
   DeformServiceImpl service;
   std::unique_ptr<grpc::Server> server;
   int port = 0;
-  std::mutex shutdown_mutex;
-  bool shut_down = false;
+  Mutex shutdown_mutex;  // serialises Shutdown()
+  bool shut_down DEFORM_GUARDED_BY(shutdown_mutex) = false;
 };
 
 DeformServer::DeformServer(const ServerOptions& options) : impl_(std::make_unique<Impl>(options)) {}
@@ -73,7 +72,7 @@ StatusOr<std::shared_ptr<const MeshEntry>> DeformServer::Preload(ModelInput inpu
 }
 
 void DeformServer::Shutdown(std::chrono::milliseconds grace) {
-  std::lock_guard<std::mutex> lock(impl_->shutdown_mutex);
+  MutexLock lock(&impl_->shutdown_mutex);
   if (impl_->shut_down) return;
   impl_->shut_down = true;
   if (impl_->server != nullptr) {

@@ -2,38 +2,44 @@
 
 #include <spdlog/spdlog.h>
 
-#include <array>
 #include <chrono>
 #include <cstdint>
-#include <deque>
 #include <memory>
-#include <mutex>
+#include <optional>
 #include <string>
 #include <utility>
 
-#include "core/geometry/pose.h"
 #include "core/model/deformation_model.h"
+#include "service/annotated_mutex.h"
+#include "service/deform_outbox.h"
+#include "service/frame_solver.h"
+#include "service/grpc_stream_sink.h"
+#include "service/pending_pose_slot.h"
 #include "service/pose_input.h"
 #include "service/proto_conversion.h"
+#include "service/shared_reactor.h"
 #include "service/status_mapping.h"
+#include "service/stiffness_switch.h"
+#include "service/stream_write_pump.h"
+#include "service/thread_annotations.h"
 
 namespace deform::service {
 namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// Unwritten notices beyond which new KIND_POSE_REJECTED notices are dropped (a client flooding bad
-// poses without reading must not grow the server's memory).
-constexpr std::size_t kMaxPendingNotices = 1024;
-
-double Milliseconds(Clock::duration duration) {
-  return std::chrono::duration<double, std::milli>(duration).count();
-}
-
+// The reactor coordinates the stream's parts; each part states its own contract:
+//  PendingPoseSlot (latest wins, skipped poses, the solve task's state), StiffnessSwitch (the
+//  factorisation in use and the refactorisations), DeformOutbox (notices and frame slots, in
+//  order), StreamWritePump (one write in flight, the finish), FrameSolver (the solve itself).
+// The first four are guarded by mutex_; the solver and the pose it solves belong to the solve
+// task, the request buffers to the reader (one read outstanding at a time).
 class DeformStreamReactor final
     : public grpc::ServerBidiReactor<v1::DeformRequest, v1::DeformResponse>,
-      private UrgentTask,
-      private Drainable {
+      public SharedReactor<DeformStreamReactor>,
+      public UrgentTask,
+      private Drainable,
+      private StreamWriteSource<v1::DeformResponse> {
  public:
   explicit DeformStreamReactor(ServiceCore* core)
       : core_(core), stream_id_(core->next_stream_id.fetch_add(1)) {
@@ -41,41 +47,36 @@ class DeformStreamReactor final
     StartRead(&request_);
   }
 
-  void OnReadDone(bool ok) override;
-  void OnWriteDone(bool ok) override;
-  void OnCancel() override;
-  void OnDone() override;
+  void OnReadDone(bool ok) DEFORM_EXCLUDES(mutex_) override;
+  void OnWriteDone(bool ok) DEFORM_EXCLUDES(mutex_) override;
+  void OnCancel() DEFORM_EXCLUDES(mutex_) override;
+  void OnDone() DEFORM_EXCLUDES(mutex_) override;
 
  private:
-  enum class TaskState { kIdle, kQueued, kRunning };
-
   // Reactions' helpers (gRPC threads).
-  void HandleStart();
-  void HandlePose();
-  void HandleStiffness();
-  void FailLocked(grpc::StatusCode code, const std::string& message);
+  void HandleStart() DEFORM_EXCLUDES(mutex_);
+  void HandlePose() DEFORM_EXCLUDES(mutex_);
+  void HandleStiffness() DEFORM_EXCLUDES(mutex_);
+  void Fail(grpc::StatusCode code, const std::string& message) DEFORM_EXCLUDES(mutex_);
+  void FailLocked(grpc::StatusCode code, const std::string& message) DEFORM_REQUIRES(mutex_);
 
   // UrgentTask: one solve on a worker.
-  void RunUrgent() override;
+  void RunUrgent() DEFORM_EXCLUDES(mutex_) override;
   // Drainable.
-  void Drain() override;
+  void Drain() DEFORM_EXCLUDES(mutex_) override;
 
-  // Background refactorisation for stiffness version `version`.
-  void Refactor(const Stiffness& stiffness, std::uint64_t version);
+  // Posts the background refactorisation of `update`.
+  void StartRefactorLocked(StiffnessSwitch::Update update) DEFORM_REQUIRES(mutex_);
+  // On a worker: the refactorisation, then its result handed to the stream.
+  void Refactor(const StiffnessSwitch::Update& update) DEFORM_EXCLUDES(mutex_);
+  // Switches the finished factorisation in, with its KIND_STIFFNESS_APPLIED notice. Only between
+  // two solves.
+  void ApplyNextFactorizationLocked() DEFORM_REQUIRES(mutex_);
 
-  // All *Locked helpers require mutex_.
-  // Marks the task queued if idle and takes a hold for the queue; true if the caller must post it.
-  bool ScheduleLocked();
-  void StartRefactorLocked(Stiffness stiffness, std::uint64_t version);
-  void AdoptFactorizationLocked();
-  void AddNoticeLocked(v1::Notice::Kind kind, std::uint64_t sequence, std::uint64_t version,
-                       const std::string& message, double factor_ms = 0);
-  void RequestFinishLocked(const grpc::Status& status);
-  // Starts the next write, or Finish when due. Never more than one write in flight.
-  void PumpLocked();
-  bool NothingPendingLocked() const;
-  // True when the last hold is gone: the caller deletes the reactor after unlocking.
-  bool ReleaseHoldLocked() { return --holds_ == 0; }
+  // StreamWriteSource: the outbox's messages; the pump calls these under mutex_.
+  const v1::DeformResponse* TakeNextWrite() override;
+  void WriteCompleted(bool ok) override;
+  bool ReadyToFinish() override;
 
   ServiceCore* const core_;
   const std::uint64_t stream_id_;
@@ -83,65 +84,36 @@ class DeformStreamReactor final
 
   // Set by HandleStart before any worker can see the stream; read-only afterwards.
   std::shared_ptr<const MeshEntry> entry_;
-  const DeformationModel* model_ = nullptr;
-  bool registered_ = false;  // in core_->streams
+  const DeformationModel* model_ = nullptr;  // non-null once started
+  bool registered_ = false;                  // in core_->streams
 
   // Reader-owned (one read outstanding at a time).
   v1::DeformRequest request_;
   PoseInput staging_;
   std::uint64_t last_stiffness_version_ = 0;
 
-  // Worker-owned while task_state_ == kRunning (and the factorisation: see
-  // AdoptFactorizationLocked).
-  PoseInput working_;
-  Pose pose_;
-  DeformScratch scratch_;
-  std::shared_ptr<const MaterialFactorization> factorization_;
-  std::uint64_t version_ = 0;
-  v1::DeformResponse* working_frame_ = nullptr;
+  // Solve-task-owned (between PendingPoseSlot::BeginRun and EndRun).
+  std::optional<FrameSolver> solver_;  // emplaced by HandleStart
+  PoseInput solving_;
+  std::shared_ptr<const MaterialFactorization> solve_factorization_;
 
-  std::mutex mutex_;
-  // Everything below is guarded by mutex_.
-  int holds_ = 1;  // gRPC's (released in OnDone), the urgent queue's, each refactorisation's
-  bool started_ = false;
-  TaskState task_state_ = TaskState::kIdle;
-  PoseInput pending_;
-  bool has_pending_ = false;
-  std::uint64_t skipped_ = 0;  // poses replaced in the pending slot since the last solve
-
-  bool refactor_running_ = false;
-  bool has_queued_stiffness_ = false;
-  Stiffness queued_stiffness_;
-  std::uint64_t queued_version_ = 0;
-  std::shared_ptr<const MaterialFactorization> next_factorization_;  // done, not yet switched in
-  std::uint64_t next_version_ = 0;
-  double next_factor_ms_ = 0;
-
-  std::array<v1::DeformResponse, 3> frames_;  // working, ready, writing (pointers rotate)
-  v1::DeformResponse* ready_frame_ = nullptr;
-  v1::DeformResponse* writing_frame_ = nullptr;
-  bool has_ready_frame_ = false;
-  std::deque<v1::DeformResponse> notices_;
-  std::size_t notices_before_frame_ = 0;  // notices queued before the ready frame was
-  v1::DeformResponse notice_in_flight_;
-  bool write_in_flight_ = false;
-  bool frame_in_flight_ = false;
-
-  bool finish_requested_ = false;
-  bool stopping_ = false;  // finishing with an error: no more solves or writes
-  bool finish_called_ = false;
-  grpc::Status finish_status_;
-
-  std::uint64_t frames_written_ = 0;
-  std::uint64_t poses_rejected_ = 0;
+  GrpcStreamSink<v1::DeformRequest, v1::DeformResponse> sink_{this};
+  Mutex mutex_;
+  PendingPoseSlot poses_ DEFORM_GUARDED_BY(mutex_);
+  StiffnessSwitch stiffness_ DEFORM_GUARDED_BY(mutex_);
+  DeformOutbox outbox_ DEFORM_GUARDED_BY(mutex_);
+  StreamWritePump<v1::DeformResponse> pump_ DEFORM_GUARDED_BY(mutex_){
+      this, &sink_, FinishRule::kErrorOverridesGraceful};
+  std::uint64_t frames_written_ DEFORM_GUARDED_BY(mutex_) = 0;
+  std::uint64_t poses_rejected_ DEFORM_GUARDED_BY(mutex_) = 0;
 };
 
 void DeformStreamReactor::OnReadDone(bool ok) {
   if (!ok) {
     // The client half-closed (or the call ended): finish once everything pending is written.
-    std::lock_guard<std::mutex> lock(mutex_);
-    RequestFinishLocked(grpc::Status::OK);
-    PumpLocked();
+    MutexLock lock(&mutex_);
+    pump_.RequestFinish(grpc::Status::OK);
+    pump_.Pump();
     return;
   }
   switch (request_.action_case()) {
@@ -157,35 +129,33 @@ void DeformStreamReactor::OnReadDone(bool ok) {
     case v1::DeformRequest::ACTION_NOT_SET:
       break;
   }
-  std::lock_guard<std::mutex> lock(mutex_);
-  FailLocked(grpc::StatusCode::INVALID_ARGUMENT,
-             "empty DeformRequest (no start, pose or stiffness)");
+  Fail(grpc::StatusCode::INVALID_ARGUMENT, "empty DeformRequest (no start, pose or stiffness)");
+}
+
+void DeformStreamReactor::Fail(grpc::StatusCode code, const std::string& message) {
+  MutexLock lock(&mutex_);
+  FailLocked(code, message);
 }
 
 void DeformStreamReactor::FailLocked(grpc::StatusCode code, const std::string& message) {
   spdlog::warn("{} ending: {}", log_context_, message);
-  RequestFinishLocked(grpc::Status(code, message));
-  PumpLocked();
+  pump_.RequestFinish(grpc::Status(code, message));
+  pump_.Pump();
 }
 
 void DeformStreamReactor::HandleStart() {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (started_) {
-      FailLocked(grpc::StatusCode::INVALID_ARGUMENT, "`start` sent twice on one stream");
-      return;
-    }
+  if (model_ != nullptr) {
+    Fail(grpc::StatusCode::INVALID_ARGUMENT, "`start` sent twice on one stream");
+    return;
   }
   const std::string mesh_id = request_.start().mesh_id();
   auto entry = core_->registry.Find(mesh_id);
   if (!entry.ok()) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    FailLocked(ToGrpcCode(entry.status().code()), entry.status().message());
+    Fail(ToGrpcCode(entry.status().code()), entry.status().message());
     return;
   }
   if (!core_->streams.Add(this)) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    FailLocked(grpc::StatusCode::UNAVAILABLE, "the server is shutting down");
+    Fail(grpc::StatusCode::UNAVAILABLE, "the server is shutting down");
     return;
   }
   registered_ = true;
@@ -193,329 +163,203 @@ void DeformStreamReactor::HandleStart() {
   entry_->open_streams.fetch_add(1);
   model_ = entry_->model.get();
   log_context_ += " mesh=" + entry_->id;
-
-  // Everything a solve needs, sized once.
-  scratch_ = model_->MakeScratch();
-  pose_ = Pose::Rest(model_->skeleton());
-  factorization_ = model_->default_factorization();
-  const std::size_t position_bytes = static_cast<std::size_t>(model_->mesh().num_vertices()) * 12;
-  for (v1::DeformResponse& response : frames_) {
-    v1::DeformFrame* frame = response.mutable_frame();
-    frame->mutable_positions()->resize(position_bytes);
-    frame->mutable_timings();
-  }
-  working_frame_ = &frames_[0];
+  solver_.emplace(*model_);  // everything a solve needs, sized once
   spdlog::info("{} opened", log_context_);
 
-  std::lock_guard<std::mutex> lock(mutex_);
-  ready_frame_ = &frames_[1];
-  writing_frame_ = &frames_[2];
-  started_ = true;
-  if (!finish_requested_) StartRead(&request_);
+  MutexLock lock(&mutex_);
+  stiffness_.Reset(model_->default_factorization());
+  outbox_.AllocateFrames(model_->mesh().num_vertices());
+  if (!pump_.finish_requested()) StartRead(&request_);
 }
 
 void DeformStreamReactor::HandlePose() {
   if (model_ == nullptr) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    FailLocked(grpc::StatusCode::INVALID_ARGUMENT, "the first DeformRequest must be `start`");
+    Fail(grpc::StatusCode::INVALID_ARGUMENT, "the first DeformRequest must be `start`");
     return;
   }
   const Status converted = PoseInputFromProto(request_.pose(), model_->skeleton(), &staging_);
   staging_.arrival = Clock::now();
   bool post = false;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (finish_requested_) return;
+    MutexLock lock(&mutex_);
+    if (pump_.finish_requested()) return;
     if (!converted.ok()) {
       ++poses_rejected_;
-      if (notices_.size() < kMaxPendingNotices) {
-        AddNoticeLocked(
-            v1::Notice::KIND_POSE_REJECTED, request_.pose().sequence(), version_,
-            "pose " + std::to_string(request_.pose().sequence()) + ": " + converted.message());
-        PumpLocked();
+      if (!outbox_.notice_backlog_full()) {
+        const std::uint64_t sequence = request_.pose().sequence();
+        outbox_.AddNotice(v1::Notice::KIND_POSE_REJECTED, sequence, stiffness_.current_version(),
+                          "pose " + std::to_string(sequence) + ": " + converted.message());
+        pump_.Pump();
       }
     } else {
-      if (has_pending_) ++skipped_;
-      std::swap(staging_, pending_);
-      has_pending_ = true;
-      post = ScheduleLocked();
+      post = poses_.Offer(&staging_);
     }
     StartRead(&request_);
   }
-  if (post) core_->pool.PostUrgent(this);
+  if (post) core_->pool.PostUrgent(SharedFromThis());
 }
 
 void DeformStreamReactor::HandleStiffness() {
   if (model_ == nullptr) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    FailLocked(grpc::StatusCode::INVALID_ARGUMENT, "the first DeformRequest must be `start`");
+    Fail(grpc::StatusCode::INVALID_ARGUMENT, "the first DeformRequest must be `start`");
     return;
   }
   const std::uint64_t version = ++last_stiffness_version_;
   auto stiffness = StiffnessFromProto(request_.stiffness(), *model_);
-  std::lock_guard<std::mutex> lock(mutex_);
-  if (finish_requested_) return;
+  MutexLock lock(&mutex_);
+  if (pump_.finish_requested()) return;
   if (!stiffness.ok()) {
     spdlog::info("{} stiffness version {} rejected: {}", log_context_, version,
                  stiffness.status().message());
-    AddNoticeLocked(
+    outbox_.AddNotice(
         v1::Notice::KIND_STIFFNESS_REJECTED, 0, version,
         "stiffness version " + std::to_string(version) + ": " + stiffness.status().message());
-  } else if (refactor_running_) {
-    if (has_queued_stiffness_) {
-      AddNoticeLocked(v1::Notice::KIND_STIFFNESS_REJECTED, 0, queued_version_,
-                      "stiffness version " + std::to_string(queued_version_) +
-                          " superseded by version " + std::to_string(version) +
-                          " before its refactorisation started");
+  } else if (stiffness_.refactor_running()) {
+    if (const auto superseded = stiffness_.Wait({std::move(*stiffness), version})) {
+      outbox_.AddNotice(v1::Notice::KIND_STIFFNESS_REJECTED, 0, *superseded,
+                        "stiffness version " + std::to_string(*superseded) +
+                            " superseded by version " + std::to_string(version) +
+                            " before its refactorisation started");
     }
-    queued_stiffness_ = std::move(*stiffness);
-    queued_version_ = version;
-    has_queued_stiffness_ = true;
   } else {
-    StartRefactorLocked(std::move(*stiffness), version);
+    StartRefactorLocked({std::move(*stiffness), version});
   }
-  PumpLocked();
+  pump_.Pump();
   StartRead(&request_);
 }
 
-void DeformStreamReactor::StartRefactorLocked(Stiffness stiffness, std::uint64_t version) {
-  refactor_running_ = true;
-  ++holds_;
+void DeformStreamReactor::StartRefactorLocked(StiffnessSwitch::Update update) {
+  stiffness_.RefactorStarted();
   core_->pool.PostBackground(
-      [this, stiffness = std::move(stiffness), version] { Refactor(stiffness, version); });
+      [self = SharedFromThis(), update = std::move(update)] { self->Refactor(update); });
 }
 
-void DeformStreamReactor::Refactor(const Stiffness& stiffness, std::uint64_t version) {
+void DeformStreamReactor::Refactor(const StiffnessSwitch::Update& update) {
   bool skip;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
-    skip = stopping_;
+    MutexLock lock(&mutex_);
+    skip = pump_.failing();
   }
   StatusOr<std::shared_ptr<const MaterialFactorization>> result =
       skip ? StatusOr<std::shared_ptr<const MaterialFactorization>>(
                  Status::FailedPrecondition("stream ending"))
-           : model_->Factorize(stiffness);
-  bool remove;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    refactor_running_ = false;
-    if (!stopping_) {
-      if (result.ok()) {
-        if (next_factorization_ != nullptr) {
-          AddNoticeLocked(v1::Notice::KIND_STIFFNESS_REJECTED, 0, next_version_,
-                          "stiffness version " + std::to_string(next_version_) +
+           : model_->Factorize(update.stiffness);
+  const std::uint64_t version = update.version;
+  MutexLock lock(&mutex_);
+  stiffness_.RefactorEnded();
+  if (!pump_.failing()) {
+    if (result.ok()) {
+      if (const auto superseded = stiffness_.SetNext(std::move(*result), version)) {
+        outbox_.AddNotice(v1::Notice::KIND_STIFFNESS_REJECTED, 0, *superseded,
+                          "stiffness version " + std::to_string(*superseded) +
                               " superseded by version " + std::to_string(version) +
                               " before it was applied");
-        }
-        next_factor_ms_ = (*result)->factor_seconds() * 1e3;
-        next_factorization_ = std::move(*result);
-        next_version_ = version;
-        // Between two solves now: switch at once. During a solve: the worker switches after it.
-        if (task_state_ != TaskState::kRunning) AdoptFactorizationLocked();
-      } else {
-        spdlog::info("{} stiffness version {} rejected: {}", log_context_, version,
-                     result.status().message());
-        AddNoticeLocked(
-            v1::Notice::KIND_STIFFNESS_REJECTED, 0, version,
-            "stiffness version " + std::to_string(version) + ": " + result.status().message());
       }
-      if (has_queued_stiffness_) {
-        has_queued_stiffness_ = false;
-        StartRefactorLocked(std::move(queued_stiffness_), queued_version_);
-        queued_stiffness_ = Stiffness();
-      }
+      // Between two solves now: switch at once. During a solve: the solve task switches after it.
+      if (!poses_.running()) ApplyNextFactorizationLocked();
+    } else {
+      spdlog::info("{} stiffness version {} rejected: {}", log_context_, version,
+                   result.status().message());
+      outbox_.AddNotice(
+          v1::Notice::KIND_STIFFNESS_REJECTED, 0, version,
+          "stiffness version " + std::to_string(version) + ": " + result.status().message());
     }
-    PumpLocked();
-    remove = ReleaseHoldLocked();
+    if (auto waiting = stiffness_.TakeWaiting()) StartRefactorLocked(std::move(*waiting));
   }
-  if (remove) delete this;
+  pump_.Pump();
 }
 
-void DeformStreamReactor::AdoptFactorizationLocked() {
-  factorization_ = std::move(next_factorization_);
-  next_factorization_ = nullptr;
-  version_ = next_version_;
-  spdlog::info("{} stiffness version {} applied (factorisation {:.2f} ms)", log_context_, version_,
-               next_factor_ms_);
-  AddNoticeLocked(v1::Notice::KIND_STIFFNESS_APPLIED, 0, version_,
-                  "stiffness version " + std::to_string(version_) + " applied", next_factor_ms_);
-}
-
-bool DeformStreamReactor::ScheduleLocked() {
-  if (task_state_ != TaskState::kIdle) return false;
-  task_state_ = TaskState::kQueued;
-  ++holds_;
-  return true;
+void DeformStreamReactor::ApplyNextFactorizationLocked() {
+  const std::uint64_t version = stiffness_.ApplyNext();
+  const double factor_ms = stiffness_.current()->factor_seconds() * 1e3;
+  spdlog::info("{} stiffness version {} applied (factorisation {:.2f} ms)", log_context_, version,
+               factor_ms);
+  outbox_.AddNotice(v1::Notice::KIND_STIFFNESS_APPLIED, 0, version,
+                    "stiffness version " + std::to_string(version) + " applied", factor_ms);
 }
 
 void DeformStreamReactor::RunUrgent() {
-  std::unique_lock<std::mutex> lock(mutex_);
-  task_state_ = TaskState::kRunning;
-  const bool solve = has_pending_ && !stopping_;
-  std::uint64_t skipped = 0;
-  if (solve) {
-    std::swap(pending_, working_);
-    has_pending_ = false;
-    skipped = skipped_;
-    skipped_ = 0;
-  }
-  lock.unlock();
-
+  MutexLock lock(&mutex_);
+  poses_.BeginRun();
+  std::optional<std::uint64_t> skipped;
+  if (!pump_.failing()) skipped = poses_.Take(&solving_);
   bool produced = false;
-  if (solve) {
-    const Clock::time_point solve_start = Clock::now();
-    const StatusOr<int> clamped = PoseFromInput(model_->skeleton(), working_, &pose_);
-    if (clamped.ok()) {
-      DeformTimings timings;
-      model_->Deform(*factorization_, pose_, &scratch_, &timings);
-      const Clock::time_point encode_start = Clock::now();
-      v1::DeformFrame* frame = working_frame_->mutable_frame();
-      EncodeFloat32(scratch_.solution.data(), static_cast<std::size_t>(scratch_.num_vertices) * 3,
-                    frame->mutable_positions()->data());
-      frame->set_sequence(working_.sequence);
-      frame->set_client_timestamp_ns(working_.client_timestamp_ns);
-      frame->set_stiffness_version(version_);
-      frame->set_skipped_poses(skipped);
-      frame->set_clamped_angles(static_cast<std::uint32_t>(*clamped));
-      frame->set_mesh_unloaded(entry_->unloaded.load(std::memory_order_relaxed));
-      v1::FrameTimings* frame_timings = frame->mutable_timings();
-      frame_timings->set_queue_ms(Milliseconds(solve_start - working_.arrival));
-      frame_timings->set_rhs_ms(timings.right_hand_side * 1e3);
-      frame_timings->set_solve_ms(timings.solve * 1e3);
-      frame_timings->set_encode_ms(Milliseconds(Clock::now() - encode_start));
-      produced = true;
-    } else {
-      lock.lock();
-      AddNoticeLocked(
-          v1::Notice::KIND_POSE_REJECTED, working_.sequence, version_,
-          "pose " + std::to_string(working_.sequence) + ": " + clamped.status().message());
-      lock.unlock();
+  if (skipped.has_value()) {
+    // The factorisation cannot change until EndRun(): ApplyNext waits for the end of the run.
+    solve_factorization_ = stiffness_.current();
+    FrameStamp stamp;
+    stamp.stiffness_version = stiffness_.current_version();
+    stamp.skipped_poses = *skipped;
+    stamp.mesh_unloaded = entry_->unloaded.load(std::memory_order_relaxed);
+    v1::DeformFrame* frame = outbox_.working_frame()->mutable_frame();
+    lock.Unlock();  // no lock across the solve
+    const Status solved = solver_->Solve(solving_, *solve_factorization_, stamp, frame);
+    lock.Lock();
+    produced = solved.ok();
+    if (!solved.ok()) {
+      outbox_.AddNotice(v1::Notice::KIND_POSE_REJECTED, solving_.sequence,
+                        stiffness_.current_version(),
+                        "pose " + std::to_string(solving_.sequence) + ": " + solved.message());
     }
   }
-
-  lock.lock();
-  if (produced && !stopping_) {
-    if (has_ready_frame_) {
-      // The unwritten frame is superseded: its pose and the poses it skipped count as skipped.
-      v1::DeformFrame* frame = working_frame_->mutable_frame();
-      frame->set_skipped_poses(frame->skipped_poses() + ready_frame_->frame().skipped_poses() + 1);
-    }
-    std::swap(working_frame_, ready_frame_);
-    has_ready_frame_ = true;
-    notices_before_frame_ = notices_.size();
-  }
-  if (next_factorization_ != nullptr && !stopping_) AdoptFactorizationLocked();
-  bool post = false;
-  bool remove = false;
-  if (has_pending_ && !stopping_) {
-    task_state_ = TaskState::kQueued;  // keeps the queue's hold; back of the queue for fairness
-    post = true;
-  } else {
-    task_state_ = TaskState::kIdle;
-    remove = ReleaseHoldLocked();
-  }
-  PumpLocked();
-  lock.unlock();
-  if (post) core_->pool.PostUrgent(this);
-  if (remove) delete this;
+  if (produced && !pump_.failing()) outbox_.PublishFrame();
+  if (stiffness_.has_next() && !pump_.failing()) ApplyNextFactorizationLocked();
+  const bool post = poses_.EndRun(/*may_continue=*/!pump_.failing());
+  pump_.Pump();
+  lock.Unlock();
+  if (post) core_->pool.PostUrgent(SharedFromThis());
 }
 
-void DeformStreamReactor::AddNoticeLocked(v1::Notice::Kind kind, std::uint64_t sequence,
-                                          std::uint64_t version, const std::string& message,
-                                          double factor_ms) {
-  v1::Notice* notice = notices_.emplace_back().mutable_notice();
-  notice->set_kind(kind);
-  notice->set_sequence(sequence);
-  notice->set_stiffness_version(version);
-  notice->set_message(message);
-  notice->set_factor_ms(factor_ms);
+const v1::DeformResponse* DeformStreamReactor::TakeNextWrite() {
+  mutex_.AssertHeld();
+  return outbox_.TakeNextWrite();
 }
 
-void DeformStreamReactor::RequestFinishLocked(const grpc::Status& status) {
-  if (stopping_) return;  // an error finish is already on its way
-  if (!status.ok()) {
-    stopping_ = true;
-    finish_status_ = status;
-  } else if (finish_requested_) {
-    return;
-  }
-  finish_requested_ = true;
+void DeformStreamReactor::WriteCompleted(bool ok) {
+  mutex_.AssertHeld();
+  if (ok && outbox_.frame_in_flight()) ++frames_written_;
 }
 
-bool DeformStreamReactor::NothingPendingLocked() const {
-  return task_state_ == TaskState::kIdle && !has_pending_ && !has_ready_frame_ &&
-         notices_.empty() && !refactor_running_ && !has_queued_stiffness_;
-}
-
-void DeformStreamReactor::PumpLocked() {
-  if (finish_called_ || write_in_flight_) return;
-  if (stopping_) {
-    finish_called_ = true;
-    Finish(finish_status_);
-    return;
-  }
-  if (has_ready_frame_ && notices_before_frame_ == 0) {
-    std::swap(ready_frame_, writing_frame_);
-    has_ready_frame_ = false;
-    write_in_flight_ = true;
-    frame_in_flight_ = true;
-    StartWrite(writing_frame_);
-    return;
-  }
-  if (!notices_.empty()) {
-    notice_in_flight_.Swap(&notices_.front());
-    notices_.pop_front();
-    if (notices_before_frame_ > 0) --notices_before_frame_;
-    write_in_flight_ = true;
-    frame_in_flight_ = false;
-    StartWrite(&notice_in_flight_);
-    return;
-  }
-  if (finish_requested_ && NothingPendingLocked()) {
-    finish_called_ = true;
-    Finish(grpc::Status::OK);
-  }
+bool DeformStreamReactor::ReadyToFinish() {
+  mutex_.AssertHeld();
+  return poses_.idle() && !poses_.has_pending() && !stiffness_.busy() && outbox_.empty();
 }
 
 void DeformStreamReactor::OnWriteDone(bool ok) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  write_in_flight_ = false;
-  if (ok && frame_in_flight_) ++frames_written_;
-  if (!ok) RequestFinishLocked(grpc::Status(grpc::StatusCode::CANCELLED, "write failed"));
-  PumpLocked();
+  MutexLock lock(&mutex_);
+  pump_.OnWriteDone(ok);
 }
 
 void DeformStreamReactor::OnCancel() {
-  std::lock_guard<std::mutex> lock(mutex_);
-  RequestFinishLocked(grpc::Status(grpc::StatusCode::CANCELLED, "cancelled by the client"));
-  PumpLocked();
+  MutexLock lock(&mutex_);
+  pump_.RequestFinish(grpc::Status(grpc::StatusCode::CANCELLED, "cancelled by the client"));
+  pump_.Pump();
 }
 
 void DeformStreamReactor::Drain() {
-  std::lock_guard<std::mutex> lock(mutex_);
-  RequestFinishLocked(grpc::Status(grpc::StatusCode::UNAVAILABLE, "the server is shutting down"));
-  PumpLocked();
+  MutexLock lock(&mutex_);
+  pump_.RequestFinish(grpc::Status(grpc::StatusCode::UNAVAILABLE, "the server is shutting down"));
+  pump_.Pump();
 }
 
 void DeformStreamReactor::OnDone() {
   if (registered_) core_->streams.Remove(this);
   if (entry_ != nullptr) entry_->open_streams.fetch_sub(1);
-  bool remove;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    MutexLock lock(&mutex_);
+    const grpc::Status& status = pump_.finish_status();
     spdlog::info("{} closed ({}): {} frames written, {} poses rejected", log_context_,
-                 finish_status_.ok() ? std::string("OK") : finish_status_.error_message(),
-                 frames_written_, poses_rejected_);
-    remove = ReleaseHoldLocked();
+                 status.ok() ? std::string("OK") : status.error_message(), frames_written_,
+                 poses_rejected_);
   }
-  if (remove) delete this;
+  ReleaseTransportReference();  // last: may free the reactor
 }
 
 }  // namespace
 
 grpc::ServerBidiReactor<v1::DeformRequest, v1::DeformResponse>* NewDeformStreamReactor(
     ServiceCore* core) {
-  return new DeformStreamReactor(core);
+  return DeformStreamReactor::Create(core);
 }
 
 }  // namespace deform::service

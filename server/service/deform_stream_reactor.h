@@ -1,9 +1,14 @@
-// The Deform RPC: one reactor per stream (deletes itself when the last of gRPC and the workers
-// is done with it).
+// The Deform RPC: one reactor per stream, owned by shared_ptrs (gRPC's until OnDone, and each
+// posted worker task's; shared_reactor.h): freed when the last of them is done with it.
 //
 // Per stream: a shared_ptr to the mesh entry (keeps the model alive after UnloadMesh; frames then
-// carry mesh_unloaded), its own DeformScratch and frame buffers, its current factorisation and
-// stiffness version.
+// carry mesh_unloaded), its own solve buffers and frame messages, its current factorisation and
+// stiffness version. The state is split into parts, each with its own contract and tests:
+//  - PendingPoseSlot (pending_pose_slot.h): the latest pose wins, skipped poses, the solve task;
+//  - StiffnessSwitch (stiffness_switch.h): the factorisation in use and the refactorisations;
+//  - DeformOutbox (deform_outbox.h) over FrameSlots (frame_slots.h): notices and frames, in order;
+//  - StreamWritePump (stream_write_pump.h): one write in flight, the finish;
+//  - FrameSolver (frame_solver.h): the solve into a frame, on the stream's own buffers.
 //
 // Threads and ordering:
 //  - gRPC threads run the reactions. OnReadDone only converts the request: a pose is resolved
@@ -23,6 +28,8 @@
 //    (the older gets KIND_STIFFNESS_REJECTED, "superseded").
 //  - Notices are written in order and never dropped (except KIND_POSE_REJECTED beyond a backlog of
 //    1,024 unwritten notices).
+//  - The parts are guarded by the reactor's mutex (annotated, thread_annotations.h); the solver
+//    and the pose being solved belong to the solve task, the request buffers to the reader.
 //
 // The stream ends with OK after the client half-closes and everything pending is written, with
 // INVALID_ARGUMENT / NOT_FOUND for a bad or unknown `start`, CANCELLED when the client cancels,

@@ -6,7 +6,6 @@
 #include <chrono>
 #include <cstdint>
 #include <deque>
-#include <mutex>
 #include <string>
 #include <utility>
 
@@ -14,9 +13,14 @@
 #include "core/io/mesh_io.h"
 #include "core/io/phantom.h"
 #include "core/io/skeleton_io.h"
+#include "service/annotated_mutex.h"
+#include "service/grpc_stream_sink.h"
 #include "service/mesh_loader.h"
 #include "service/proto_conversion.h"
+#include "service/shared_reactor.h"
 #include "service/status_mapping.h"
+#include "service/stream_write_pump.h"
+#include "service/thread_annotations.h"
 
 namespace deform::service {
 namespace {
@@ -59,33 +63,36 @@ double MillisecondsSince(Clock::time_point start) {
 }
 
 class LoadMeshReactor final
-    : public grpc::ServerBidiReactor<v1::LoadMeshRequest, v1::LoadMeshResponse> {
+    : public grpc::ServerBidiReactor<v1::LoadMeshRequest, v1::LoadMeshResponse>,
+      public SharedReactor<LoadMeshReactor>,
+      private StreamWriteSource<v1::LoadMeshResponse> {
  public:
   explicit LoadMeshReactor(ServiceCore* core)
       : core_(core), log_context_("load=" + std::to_string(core->next_load_id.fetch_add(1))) {
     StartRead(&request_);
   }
 
-  void OnReadDone(bool ok) override;
-  void OnWriteDone(bool ok) override;
-  void OnCancel() override;
+  void OnReadDone(bool ok) DEFORM_EXCLUDES(mutex_) override;
+  void OnWriteDone(bool ok) DEFORM_EXCLUDES(mutex_) override;
+  void OnCancel() DEFORM_EXCLUDES(mutex_) override;
   void OnDone() override;
 
  private:
   Status HandleHeader();
   Status HandleChunk();
-  Status HandleEndOfInput();
+  Status HandleEndOfInput() DEFORM_EXCLUDES(mutex_);
   // On a worker: parse, validate, precompute, register.
-  void Build();
-  StatusOr<std::shared_ptr<const MeshEntry>> ParseAndBuild();
+  void Build() DEFORM_EXCLUDES(mutex_);
+  StatusOr<std::shared_ptr<const MeshEntry>> ParseAndBuild() DEFORM_EXCLUDES(mutex_);
 
-  void Fail(const Status& status);
-  // Require mutex_.
+  void Fail(const Status& status) DEFORM_EXCLUDES(mutex_);
   void AddProgressLocked(v1::LoadMeshResponse::Stage stage, double elapsed_ms,
-                         const MeshEntry* entry = nullptr);
-  void RequestFinishLocked(const grpc::Status& status);
-  void PumpLocked();
-  bool ReleaseHoldLocked() { return --holds_ == 0; }
+                         const MeshEntry* entry = nullptr) DEFORM_REQUIRES(mutex_);
+
+  // StreamWriteSource: the progress messages in order; the pump calls these under mutex_.
+  const v1::LoadMeshResponse* TakeNextWrite() override;
+  void WriteCompleted(bool ok) override;
+  bool ReadyToFinish() override { return true; }  // a finish is only requested when all is queued
 
   ServiceCore* const core_;
   std::string log_context_;
@@ -99,16 +106,13 @@ class LoadMeshReactor final
   std::uint64_t expected_bytes_ = 0;
   MeshRegistry::Reservation reservation_;
 
-  std::mutex mutex_;
-  // Guarded by mutex_.
-  int holds_ = 1;  // gRPC's (released in OnDone) and the build's
-  std::deque<v1::LoadMeshResponse> outbox_;
-  v1::LoadMeshResponse in_flight_;
-  bool write_in_flight_ = false;
-  bool finish_requested_ = false;
-  bool finish_called_ = false;
-  bool cancelled_ = false;
-  grpc::Status finish_status_;
+  GrpcStreamSink<v1::LoadMeshRequest, v1::LoadMeshResponse> sink_{this};
+  Mutex mutex_;
+  std::deque<v1::LoadMeshResponse> outbox_ DEFORM_GUARDED_BY(mutex_);
+  v1::LoadMeshResponse in_flight_ DEFORM_GUARDED_BY(mutex_);
+  bool cancelled_ DEFORM_GUARDED_BY(mutex_) = false;  // by the client, or a write failed
+  StreamWritePump<v1::LoadMeshResponse> pump_ DEFORM_GUARDED_BY(mutex_){
+      this, &sink_, FinishRule::kFirstRequestWins};
 };
 
 void LoadMeshReactor::OnReadDone(bool ok) {
@@ -200,8 +204,8 @@ Status LoadMeshReactor::HandleChunk() {
 
 Status LoadMeshReactor::HandleEndOfInput() {
   {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (finish_requested_) return Status::Ok();  // cancelled or already failed
+    MutexLock lock(&mutex_);
+    if (pump_.finish_requested()) return Status::Ok();  // cancelled or already failed
   }
   if (!has_header_) return Status::InvalidArgument("the stream ended without a header");
   if (header_.has_upload() && mesh_bytes_.size() != expected_bytes_) {
@@ -209,42 +213,36 @@ Status LoadMeshReactor::HandleEndOfInput() {
         "truncated upload: received " + std::to_string(mesh_bytes_.size()) + " of the " +
         std::to_string(expected_bytes_) + " mesh bytes announced in the header");
   }
-  std::lock_guard<std::mutex> lock(mutex_);
+  MutexLock lock(&mutex_);
   AddProgressLocked(v1::LoadMeshResponse::STAGE_RECEIVED, MillisecondsSince(start_));
-  PumpLocked();
-  ++holds_;
-  core_->pool.PostBackground([this] { Build(); });
+  pump_.Pump();
+  core_->pool.PostBackground([self = SharedFromThis()] { self->Build(); });
   return Status::Ok();
 }
 
 void LoadMeshReactor::Build() {
   bool skip;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
-    skip = cancelled_ || finish_requested_;
+    MutexLock lock(&mutex_);
+    skip = cancelled_ || pump_.finish_requested();
   }
   StatusOr<std::shared_ptr<const MeshEntry>> entry =
       skip ? StatusOr<std::shared_ptr<const MeshEntry>>(Status::FailedPrecondition("cancelled"))
            : ParseAndBuild();
-  bool remove;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (entry.ok()) {
-      if (cancelled_) {
-        // Nobody is waiting for it: the mesh would be unreachable.
-        (void)core_->registry.Unload((*entry)->id);
-      } else {
-        AddProgressLocked(v1::LoadMeshResponse::STAGE_READY, MillisecondsSince(start_), entry->get());
-        RequestFinishLocked(grpc::Status::OK);
-      }
-    } else if (!skip) {
-      spdlog::warn("{} failed: {}", log_context_, entry.status().ToString());
-      RequestFinishLocked(ToGrpcStatus(entry.status()));
+  MutexLock lock(&mutex_);
+  if (entry.ok()) {
+    if (cancelled_) {
+      // Nobody is waiting for it: the mesh would be unreachable.
+      (void)core_->registry.Unload((*entry)->id);
+    } else {
+      AddProgressLocked(v1::LoadMeshResponse::STAGE_READY, MillisecondsSince(start_), entry->get());
+      pump_.RequestFinish(grpc::Status::OK);
     }
-    PumpLocked();
-    remove = ReleaseHoldLocked();
+  } else if (!skip) {
+    spdlog::warn("{} failed: {}", log_context_, entry.status().ToString());
+    pump_.RequestFinish(ToGrpcStatus(entry.status()));
   }
-  if (remove) delete this;
+  pump_.Pump();
 }
 
 StatusOr<std::shared_ptr<const MeshEntry>> LoadMeshReactor::ParseAndBuild() {
@@ -277,7 +275,7 @@ StatusOr<std::shared_ptr<const MeshEntry>> LoadMeshReactor::ParseAndBuild() {
   job.options = std::move(*options);
 
   const auto progress = [this](LoadStage stage, double elapsed_ms) {
-    std::lock_guard<std::mutex> lock(mutex_);
+    MutexLock lock(&mutex_);
     switch (stage) {
       case LoadStage::kValidated:
         AddProgressLocked(v1::LoadMeshResponse::STAGE_VALIDATED, elapsed_ms);
@@ -289,16 +287,16 @@ StatusOr<std::shared_ptr<const MeshEntry>> LoadMeshReactor::ParseAndBuild() {
         AddProgressLocked(v1::LoadMeshResponse::STAGE_FACTORISED, elapsed_ms);
         break;
     }
-    PumpLocked();
+    pump_.Pump();
   };
   return BuildAndRegister(&core_->registry, std::move(reservation_), std::move(job), progress);
 }
 
 void LoadMeshReactor::Fail(const Status& status) {
   spdlog::warn("{} refused: {}", log_context_, status.ToString());
-  std::lock_guard<std::mutex> lock(mutex_);
-  RequestFinishLocked(ToGrpcStatus(status));
-  PumpLocked();
+  MutexLock lock(&mutex_);
+  pump_.RequestFinish(ToGrpcStatus(status));
+  pump_.Pump();
 }
 
 void LoadMeshReactor::AddProgressLocked(v1::LoadMeshResponse::Stage stage, double elapsed_ms,
@@ -309,63 +307,40 @@ void LoadMeshReactor::AddProgressLocked(v1::LoadMeshResponse::Stage stage, doubl
   if (entry != nullptr) FillMeshSummary(*entry, progress.mutable_mesh());
 }
 
-void LoadMeshReactor::RequestFinishLocked(const grpc::Status& status) {
-  if (finish_requested_) return;
-  finish_requested_ = true;
-  finish_status_ = status;
+const v1::LoadMeshResponse* LoadMeshReactor::TakeNextWrite() {
+  mutex_.AssertHeld();
+  if (outbox_.empty()) return nullptr;
+  in_flight_.Swap(&outbox_.front());
+  outbox_.pop_front();
+  return &in_flight_;
 }
 
-void LoadMeshReactor::PumpLocked() {
-  if (finish_called_ || write_in_flight_) return;
-  if (finish_requested_ && !finish_status_.ok()) {
-    finish_called_ = true;
-    Finish(finish_status_);
-    return;
-  }
-  if (!outbox_.empty()) {
-    in_flight_.Swap(&outbox_.front());
-    outbox_.pop_front();
-    write_in_flight_ = true;
-    StartWrite(&in_flight_);
-    return;
-  }
-  if (finish_requested_) {
-    finish_called_ = true;
-    Finish(finish_status_);
-  }
+void LoadMeshReactor::WriteCompleted(bool ok) {
+  mutex_.AssertHeld();
+  if (!ok) cancelled_ = true;
 }
 
 void LoadMeshReactor::OnWriteDone(bool ok) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  write_in_flight_ = false;
-  if (!ok) {
-    cancelled_ = true;
-    RequestFinishLocked(grpc::Status(grpc::StatusCode::CANCELLED, "write failed"));
-  }
-  PumpLocked();
+  MutexLock lock(&mutex_);
+  pump_.OnWriteDone(ok);
 }
 
 void LoadMeshReactor::OnCancel() {
-  std::lock_guard<std::mutex> lock(mutex_);
+  MutexLock lock(&mutex_);
   cancelled_ = true;
-  RequestFinishLocked(grpc::Status(grpc::StatusCode::CANCELLED, "cancelled by the client"));
-  PumpLocked();
+  pump_.RequestFinish(grpc::Status(grpc::StatusCode::CANCELLED, "cancelled by the client"));
+  pump_.Pump();
 }
 
 void LoadMeshReactor::OnDone() {
-  bool remove;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    remove = ReleaseHoldLocked();
-  }
-  if (remove) delete this;
+  ReleaseTransportReference();  // last: may free the reactor
 }
 
 }  // namespace
 
 grpc::ServerBidiReactor<v1::LoadMeshRequest, v1::LoadMeshResponse>* NewLoadMeshReactor(
     ServiceCore* core) {
-  return new LoadMeshReactor(core);
+  return LoadMeshReactor::Create(core);
 }
 
 }  // namespace deform::service

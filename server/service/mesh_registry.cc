@@ -45,7 +45,7 @@ void MeshRegistry::Reservation::Release() {
 MeshRegistry::MeshRegistry(const ServiceLimits& limits) : limits_(limits) {}
 
 StatusOr<MeshRegistry::Reservation> MeshRegistry::Reserve() {
-  std::lock_guard<std::mutex> lock(mutex_);
+  MutexLock lock(&mutex_);
   const int in_use = static_cast<int>(meshes_.size()) + reserved_;
   if (in_use >= limits_.max_meshes) {
     return Status::ResourceExhausted("mesh limit reached: " + std::to_string(meshes_.size()) +
@@ -58,12 +58,12 @@ StatusOr<MeshRegistry::Reservation> MeshRegistry::Reserve() {
 }
 
 void MeshRegistry::ReleaseSlot() {
-  std::lock_guard<std::mutex> lock(mutex_);
+  MutexLock lock(&mutex_);
   --reserved_;
 }
 
 Status MeshRegistry::CheckMemoryAvailable(std::size_t bytes) const {
-  std::lock_guard<std::mutex> lock(mutex_);
+  MutexLock lock(&mutex_);
   if (memory_used_ + bytes > limits_.max_memory_bytes) {
     return Status::ResourceExhausted("memory budget exceeded: the mesh needs about " +
                                      MebiBytes(bytes) + ", " + MebiBytes(memory_used_) +
@@ -83,7 +83,7 @@ StatusOr<std::shared_ptr<const MeshEntry>> MeshRegistry::Register(
   entry->memory_bytes = model->EstimatedBytes();
   entry->model = std::move(model);
 
-  std::lock_guard<std::mutex> lock(mutex_);
+  MutexLock lock(&mutex_);
   if (memory_used_ + entry->memory_bytes > limits_.max_memory_bytes) {
     const Status status = Status::ResourceExhausted(
         "memory budget exceeded: the mesh needs about " + MebiBytes(entry->memory_bytes) + ", " +
@@ -105,7 +105,7 @@ StatusOr<std::shared_ptr<const MeshEntry>> MeshRegistry::Register(
 
 StatusOr<std::shared_ptr<const MeshEntry>> MeshRegistry::Find(const std::string& mesh_id) const {
   const std::optional<std::uint64_t> number = NumberOfId(mesh_id);
-  std::lock_guard<std::mutex> lock(mutex_);
+  MutexLock lock(&mutex_);
   if (number) {
     const auto it = meshes_.find(*number);
     if (it != meshes_.end()) return std::shared_ptr<const MeshEntry>(it->second);
@@ -114,7 +114,7 @@ StatusOr<std::shared_ptr<const MeshEntry>> MeshRegistry::Find(const std::string&
 }
 
 std::vector<std::shared_ptr<const MeshEntry>> MeshRegistry::List() const {
-  std::lock_guard<std::mutex> lock(mutex_);
+  MutexLock lock(&mutex_);
   std::vector<std::shared_ptr<const MeshEntry>> list;
   list.reserve(meshes_.size());
   for (const auto& [number, entry] : meshes_) list.push_back(entry);
@@ -123,7 +123,7 @@ std::vector<std::shared_ptr<const MeshEntry>> MeshRegistry::List() const {
 
 Status MeshRegistry::Unload(const std::string& mesh_id) {
   const std::optional<std::uint64_t> number = NumberOfId(mesh_id);
-  std::lock_guard<std::mutex> lock(mutex_);
+  MutexLock lock(&mutex_);
   const auto it = number ? meshes_.find(*number) : meshes_.end();
   if (it == meshes_.end()) return Status::NotFound("no mesh with id '" + mesh_id + "' is loaded");
   it->second->unloaded.store(true);
@@ -133,12 +133,12 @@ Status MeshRegistry::Unload(const std::string& mesh_id) {
 }
 
 std::size_t MeshRegistry::memory_bytes_used() const {
-  std::lock_guard<std::mutex> lock(mutex_);
+  MutexLock lock(&mutex_);
   return memory_used_;
 }
 
 int MeshRegistry::mesh_count() const {
-  std::lock_guard<std::mutex> lock(mutex_);
+  MutexLock lock(&mutex_);
   return static_cast<int>(meshes_.size());
 }
 

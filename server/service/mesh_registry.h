@@ -16,13 +16,14 @@
 #include <cstdint>
 #include <map>
 #include <memory>
-#include <mutex>
 #include <string>
 #include <vector>
 
 #include "core/base/status.h"
 #include "core/model/deformation_model.h"
+#include "service/annotated_mutex.h"
 #include "service/service_options.h"
+#include "service/thread_annotations.h"
 
 namespace deform::service {
 
@@ -88,11 +89,12 @@ class MeshRegistry {
   void ReleaseSlot();
 
   const ServiceLimits limits_;
-  mutable std::mutex mutex_;
-  std::map<std::uint64_t, std::shared_ptr<MeshEntry>> meshes_;  // by sequence number
-  int reserved_ = 0;                                            // slots held by loads in progress
-  std::size_t memory_used_ = 0;  // sum of memory_bytes of loaded meshes
-  std::uint64_t next_number_ = 1;
+  mutable Mutex mutex_;
+  // By sequence number.
+  std::map<std::uint64_t, std::shared_ptr<MeshEntry>> meshes_ DEFORM_GUARDED_BY(mutex_);
+  int reserved_ DEFORM_GUARDED_BY(mutex_) = 0;             // slots held by loads in progress
+  std::size_t memory_used_ DEFORM_GUARDED_BY(mutex_) = 0;  // sum of memory_bytes of loaded meshes
+  std::uint64_t next_number_ DEFORM_GUARDED_BY(mutex_) = 1;
 };
 
 }  // namespace deform::service

@@ -7,11 +7,12 @@
 
 #include <atomic>
 #include <cstdint>
-#include <mutex>
 #include <unordered_set>
 
+#include "service/annotated_mutex.h"
 #include "service/mesh_registry.h"
 #include "service/service_options.h"
+#include "service/thread_annotations.h"
 #include "service/worker_pool.h"
 
 namespace deform::service {
@@ -32,16 +33,16 @@ class Drainable {
 class ActiveStreams {
  public:
   // Registers `stream`; false (not registered) once DrainAll() has been called.
-  bool Add(Drainable* stream);
-  void Remove(Drainable* stream);
+  bool Add(Drainable* stream) DEFORM_EXCLUDES(mutex_);
+  void Remove(Drainable* stream) DEFORM_EXCLUDES(mutex_);
   // Calls Drain() on every registered stream; later Add() calls fail.
-  void DrainAll();
-  int count() const;
+  void DrainAll() DEFORM_EXCLUDES(mutex_);
+  int count() const DEFORM_EXCLUDES(mutex_);
 
  private:
-  mutable std::mutex mutex_;
-  std::unordered_set<Drainable*> streams_;  // guarded by mutex_
-  bool draining_ = false;                   // guarded by mutex_
+  mutable Mutex mutex_;
+  std::unordered_set<Drainable*> streams_ DEFORM_GUARDED_BY(mutex_);
+  bool draining_ DEFORM_GUARDED_BY(mutex_) = false;
 };
 
 struct ServiceCore {

@@ -8,79 +8,93 @@ WorkerPool::WorkerPool(int threads) {
   if (threads <= 0) threads = static_cast<int>(std::thread::hardware_concurrency());
   threads = std::max(threads, 1);
   max_background_ = std::max(1, threads - 1);
+  thread_count_ = threads;
   threads_.reserve(threads);
   for (int i = 0; i < threads; ++i) threads_.emplace_back([this] { WorkerLoop(); });
 }
 
-WorkerPool::~WorkerPool() { Shutdown(); }
-
-void WorkerPool::PostUrgent(UrgentTask* task) {
+WorkerPool::~WorkerPool() {
+  Shutdown();
+  // Tasks posted after Shutdown() never ran; drop them one by one (the urgent chain iteratively,
+  // not by recursive destruction).
+  std::shared_ptr<UrgentTask> head;
+  std::deque<std::function<void()>> background;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
-    task->next_urgent_ = nullptr;
-    if (urgent_tail_ != nullptr) {
-      urgent_tail_->next_urgent_ = task;
-    } else {
-      urgent_head_ = task;
-    }
-    urgent_tail_ = task;
+    MutexLock lock(&mutex_);
+    head = std::move(urgent_head_);
+    urgent_tail_ = nullptr;
+    background.swap(background_);
   }
-  wake_.notify_one();
+  while (head != nullptr) head = std::move(head->next_urgent_);
+}
+
+void WorkerPool::PostUrgent(std::shared_ptr<UrgentTask> task) {
+  {
+    MutexLock lock(&mutex_);
+    UrgentTask* const queued = task.get();
+    if (urgent_tail_ != nullptr) {
+      urgent_tail_->next_urgent_ = std::move(task);
+    } else {
+      urgent_head_ = std::move(task);
+    }
+    urgent_tail_ = queued;
+  }
+  wake_.NotifyOne();
 }
 
 void WorkerPool::PostBackground(std::function<void()> task) {
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    MutexLock lock(&mutex_);
     background_.push_back(std::move(task));
   }
-  wake_.notify_one();
+  wake_.NotifyOne();
 }
 
 void WorkerPool::Shutdown() {
-  std::lock_guard<std::mutex> join_lock(join_mutex_);
+  MutexLock join_lock(&join_mutex_);
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    MutexLock lock(&mutex_);
     stopping_ = true;
   }
-  wake_.notify_all();
+  wake_.NotifyAll();
   for (std::thread& thread : threads_) {
     if (thread.joinable()) thread.join();
   }
 }
 
 void WorkerPool::WorkerLoop() {
-  std::unique_lock<std::mutex> lock(mutex_);
+  MutexLock lock(&mutex_);
   while (true) {
     const bool can_run_background = !background_.empty() && running_background_ < max_background_;
     if (urgent_head_ != nullptr) {
-      UrgentTask* task = urgent_head_;
-      urgent_head_ = task->next_urgent_;
+      std::shared_ptr<UrgentTask> task = std::move(urgent_head_);
+      urgent_head_ = std::move(task->next_urgent_);
       if (urgent_head_ == nullptr) urgent_tail_ = nullptr;
-      task->next_urgent_ = nullptr;
-      lock.unlock();
+      lock.Unlock();
       task->RunUrgent();
-      lock.lock();
+      task = nullptr;  // the queue's reference goes outside the lock
+      lock.Lock();
       continue;
     }
     if (can_run_background) {
       std::function<void()> task = std::move(background_.front());
       background_.pop_front();
       ++running_background_;
-      lock.unlock();
+      lock.Unlock();
       task();
       task = nullptr;  // destroy captures outside the lock
-      lock.lock();
+      lock.Lock();
       --running_background_;
       // A worker waiting only because of the background cap may go now.
-      if (!background_.empty()) wake_.notify_one();
+      if (!background_.empty()) wake_.NotifyOne();
       continue;
     }
     // Stop once nothing is queued and no background task can still post more work.
     if (stopping_ && background_.empty() && running_background_ == 0) {
-      wake_.notify_all();
+      wake_.NotifyAll();
       return;
     }
-    wake_.wait(lock);
+    wake_.Wait(&mutex_);
   }
 }
 

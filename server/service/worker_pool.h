@@ -5,21 +5,27 @@
 // at most max(1, threads - 1) workers at once, so with two or more workers one of them is always
 // free for frames while meshes are being built.
 //
+// Ownership: the pool holds a reference to every task it has been given (the urgent task's
+// shared_ptr, the background task's function and its captures) until the task has run, and drops
+// it outside its lock, so a task's reference can be the last one to its owner (a stream reactor).
+//
 // Thread safety: every method may be called from any thread, including from inside a task.
 #pragma once
 
-#include <condition_variable>
 #include <deque>
 #include <functional>
-#include <mutex>
+#include <memory>
 #include <thread>
 #include <vector>
+
+#include "service/annotated_mutex.h"
+#include "service/thread_annotations.h"
 
 namespace deform::service {
 
 // Work that is posted again and again (one per stream), so queuing it allocates nothing: the
 // pool links tasks through `next_urgent_`. A task must not be posted while it is already queued
-// (its owner tracks that) and must stay alive until RunUrgent() has been called.
+// (its owner tracks that); it may be posted again while it runs.
 class UrgentTask {
  public:
   virtual void RunUrgent() = 0;
@@ -29,41 +35,44 @@ class UrgentTask {
 
  private:
   friend class WorkerPool;
-  UrgentTask* next_urgent_ = nullptr;
+  std::shared_ptr<UrgentTask> next_urgent_;  // the queue's reference to the next task
 };
 
 class WorkerPool {
  public:
   // `threads` <= 0 means std::thread::hardware_concurrency() (at least 1).
   explicit WorkerPool(int threads);
-  // Calls Shutdown().
+  // Calls Shutdown(), then drops the tasks posted after it (they never run).
   ~WorkerPool();
   WorkerPool(const WorkerPool&) = delete;
   WorkerPool& operator=(const WorkerPool&) = delete;
 
-  int size() const { return static_cast<int>(threads_.size()); }
+  int size() const { return thread_count_; }
 
-  // Queues `task` at urgent priority. Allocation-free. Ignored after Shutdown() has finished.
-  void PostUrgent(UrgentTask* task);
-  // Queues `task` at background priority.
-  void PostBackground(std::function<void()> task);
+  // Queues `task` at urgent priority; the pool keeps it alive until RunUrgent() has returned.
+  // Allocation-free. After Shutdown() has finished the task is kept but never runs.
+  void PostUrgent(std::shared_ptr<UrgentTask> task) DEFORM_EXCLUDES(mutex_);
+  // Queues `task` at background priority. After Shutdown() has finished it never runs.
+  void PostBackground(std::function<void()> task) DEFORM_EXCLUDES(mutex_);
 
   // Runs every task already queued (and those they post), then joins the workers. Idempotent.
-  void Shutdown();
+  void Shutdown() DEFORM_EXCLUDES(mutex_, join_mutex_);
 
  private:
-  void WorkerLoop();
+  void WorkerLoop() DEFORM_EXCLUDES(mutex_);
 
-  std::mutex mutex_;
-  std::condition_variable wake_;
-  UrgentTask* urgent_head_ = nullptr;             // guarded by mutex_
-  UrgentTask* urgent_tail_ = nullptr;             // guarded by mutex_
-  std::deque<std::function<void()>> background_;  // guarded by mutex_
-  int running_background_ = 0;                    // guarded by mutex_
-  int max_background_ = 1;
-  bool stopping_ = false;  // guarded by mutex_
-  std::vector<std::thread> threads_;
-  std::mutex join_mutex_;
+  Mutex mutex_;
+  CondVar wake_;
+  std::shared_ptr<UrgentTask> urgent_head_ DEFORM_GUARDED_BY(mutex_);  // owns the queue's chain
+  UrgentTask* urgent_tail_ DEFORM_GUARDED_BY(mutex_) = nullptr;
+  std::deque<std::function<void()>> background_ DEFORM_GUARDED_BY(mutex_);
+  int running_background_ DEFORM_GUARDED_BY(mutex_) = 0;
+  int max_background_ = 1;  // set by the constructor, then read-only
+  bool stopping_ DEFORM_GUARDED_BY(mutex_) = false;
+
+  int thread_count_ = 0;  // set by the constructor, then read-only
+  Mutex join_mutex_;      // serialises Shutdown()
+  std::vector<std::thread> threads_ DEFORM_GUARDED_BY(join_mutex_);
 };
 
 }  // namespace deform::service

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <functional>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -68,8 +69,8 @@ TEST(WorkerPoolTest, UrgentTasksOvertakeQueuedBackgroundTasks) {
   });
   ASSERT_TRUE(blocker_running.Wait());
   pool.PostBackground([&] { log.Add("background"); });
-  FunctionTask urgent([&] { log.Add("urgent"); });
-  pool.PostUrgent(&urgent);
+  auto urgent = std::make_shared<FunctionTask>([&] { log.Add("urgent"); });
+  pool.PostUrgent(urgent);
   release_blocker.Open();
   pool.Shutdown();
   EXPECT_EQ(log.events(), (std::vector<std::string>{"blocker", "urgent", "background"}));
@@ -90,11 +91,11 @@ TEST(WorkerPoolTest, BackgroundWorkLeavesOneWorkerForUrgentTasks) {
     second_started.store(true);
     log.Add("second");
   });
-  FunctionTask urgent([&] {
+  auto urgent = std::make_shared<FunctionTask>([&] {
     log.Add("urgent");
     urgent_ran.Open();
   });
-  pool.PostUrgent(&urgent);
+  pool.PostUrgent(urgent);
   // The second worker is free for the urgent task, but may not take the second background task.
   ASSERT_TRUE(urgent_ran.Wait());
   EXPECT_FALSE(second_started.load());
@@ -105,19 +106,56 @@ TEST(WorkerPoolTest, BackgroundWorkLeavesOneWorkerForUrgentTasks) {
 
 TEST(WorkerPoolTest, ShutdownRunsEverythingQueuedIncludingWorkPostedByTasks) {
   std::atomic<int> runs{0};
-  FunctionTask urgent([&] { runs.fetch_add(1); });
+  auto urgent = std::make_shared<FunctionTask>([&] { runs.fetch_add(1); });
   {
     WorkerPool pool(2);
     for (int i = 0; i < 50; ++i) {
       pool.PostBackground([&] {
         runs.fetch_add(1);
-        if (runs.load() == 10) pool.PostUrgent(&urgent);
+        if (runs.load() == 10) pool.PostUrgent(urgent);
       });
     }
     pool.Shutdown();
     pool.Shutdown();  // idempotent
   }
   EXPECT_EQ(runs.load(), 51);
+}
+
+// The pool's reference keeps a task alive until it has run, and is dropped after it: the task may
+// be its own last owner (as a stream reactor is once gRPC is done with it).
+TEST(WorkerPoolTest, PoolHoldsEachUrgentTaskUntilItHasRun) {
+  WorkerPool pool(1);
+  Gate blocker_running, release_blocker;
+  pool.PostBackground([&] {
+    blocker_running.Open();
+    release_blocker.Wait();
+  });
+  ASSERT_TRUE(blocker_running.Wait());
+  std::atomic<int> runs{0};
+  auto task = std::make_shared<FunctionTask>([&] { runs.fetch_add(1); });
+  const std::weak_ptr<FunctionTask> watch = task;
+  pool.PostUrgent(std::move(task));
+  EXPECT_FALSE(watch.expired());  // queued behind the blocker: only the pool owns it
+  release_blocker.Open();
+  pool.Shutdown();
+  EXPECT_EQ(runs.load(), 1);
+  EXPECT_TRUE(watch.expired());
+}
+
+// A task may post itself again while it runs (a stream with another pose pending does).
+TEST(WorkerPoolTest, UrgentTaskMayRepostItselfWhileRunning) {
+  WorkerPool pool(2);
+  std::atomic<int> runs{0};
+  std::shared_ptr<FunctionTask> task;
+  std::weak_ptr<FunctionTask> self;
+  task = std::make_shared<FunctionTask>([&] {
+    if (runs.fetch_add(1) + 1 < 5) pool.PostUrgent(self.lock());
+  });
+  self = task;
+  pool.PostUrgent(std::move(task));
+  pool.Shutdown();
+  EXPECT_EQ(runs.load(), 5);
+  EXPECT_TRUE(self.expired());
 }
 
 TEST(WorkerPoolTest, ZeroThreadsMeansOnePerCore) {

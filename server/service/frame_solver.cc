@@ -1,0 +1,46 @@
+#include "service/frame_solver.h"
+
+#include <chrono>
+#include <cstddef>
+
+#include "service/proto_conversion.h"
+
+namespace deform::service {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double Milliseconds(Clock::duration duration) {
+  return std::chrono::duration<double, std::milli>(duration).count();
+}
+
+}  // namespace
+
+FrameSolver::FrameSolver(const DeformationModel& model)
+    : model_(model), pose_(Pose::Rest(model.skeleton())), scratch_(model.MakeScratch()) {}
+
+Status FrameSolver::Solve(const PoseInput& input, const MaterialFactorization& factorization,
+                          const FrameStamp& stamp, v1::DeformFrame* frame) {
+  const Clock::time_point solve_start = Clock::now();
+  DEFORM_ASSIGN_OR_RETURN(const int clamped, PoseFromInput(model_.skeleton(), input, &pose_));
+  DeformTimings timings;
+  model_.Deform(factorization, pose_, &scratch_, &timings);
+  const Clock::time_point encode_start = Clock::now();
+  const std::size_t values = static_cast<std::size_t>(scratch_.num_vertices) * 3;
+  frame->mutable_positions()->resize(values * 4);  // no-op when sized by FrameSlots
+  EncodeFloat32(scratch_.solution.data(), values, frame->mutable_positions()->data());
+  frame->set_sequence(input.sequence);
+  frame->set_client_timestamp_ns(input.client_timestamp_ns);
+  frame->set_stiffness_version(stamp.stiffness_version);
+  frame->set_skipped_poses(stamp.skipped_poses);
+  frame->set_clamped_angles(static_cast<std::uint32_t>(clamped));
+  frame->set_mesh_unloaded(stamp.mesh_unloaded);
+  v1::FrameTimings* frame_timings = frame->mutable_timings();
+  frame_timings->set_queue_ms(Milliseconds(solve_start - input.arrival));
+  frame_timings->set_rhs_ms(timings.right_hand_side * 1e3);
+  frame_timings->set_solve_ms(timings.solve * 1e3);
+  frame_timings->set_encode_ms(Milliseconds(Clock::now() - encode_start));
+  return Status::Ok();
+}
+
+}  // namespace deform::service

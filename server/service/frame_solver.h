@@ -1,0 +1,45 @@
+// One Deform stream's solves: a pose in, a frame out, on the stream's own buffers.
+//
+// Owns the per-stream buffers a solve needs (the core Pose, the DeformScratch), sized once for the
+// model, so a solve allocates nothing. Fills a DeformFrame in place: positions as packed
+// little-endian float32, the pose's sequence and timestamp, the stamp (stiffness version, skipped
+// poses, mesh_unloaded), the clamped angles and the timings (queue time from the pose's arrival).
+//
+// Thread safety: one solve at a time (the stream's solve task owns the solver); no lock is taken
+// or needed. The model must outlive the solver.
+#pragma once
+
+#include <cstdint>
+
+#include "core/base/status.h"
+#include "core/geometry/pose.h"
+#include "core/model/deformation_model.h"
+#include "deform/v1/deform.pb.h"
+#include "service/pose_input.h"
+
+namespace deform::service {
+
+// What a frame carries besides the solve's own results.
+struct FrameStamp {
+  std::uint64_t stiffness_version = 0;
+  std::uint64_t skipped_poses = 0;
+  bool mesh_unloaded = false;
+};
+
+class FrameSolver {
+ public:
+  explicit FrameSolver(const DeformationModel& model);
+
+  // Solves `input` with `factorization` (one of the model's) into `frame`; its positions should
+  // already hold 12 bytes per vertex (FrameSlots::Allocate), or they are resized (allocating).
+  // INVALID_ARGUMENT naming the problem when the pose cannot be built; `frame` is then untouched.
+  Status Solve(const PoseInput& input, const MaterialFactorization& factorization,
+               const FrameStamp& stamp, v1::DeformFrame* frame);
+
+ private:
+  const DeformationModel& model_;
+  Pose pose_;
+  DeformScratch scratch_;
+};
+
+}  // namespace deform::service
