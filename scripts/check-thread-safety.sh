@@ -8,7 +8,7 @@
 # -DDEFORM_THREAD_SAFETY_ANALYSIS=ON, which adds -Wthread-safety -Werror to our targets only (the
 # generated protobuf code gets none). Only the object files of the annotated targets are compiled
 # (no linking, no tests, no core libraries), without optimisation: the analysis runs in the front
-# end. Installs clang if missing. About a minute on 2 cores from scratch; ccache makes reruns fast.
+# end. Installs what is missing (scripts/packages/build.txt and checks.txt: clang). About a minute on 2 cores from scratch; ccache makes reruns fast.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 start=$(date +%s)
@@ -16,15 +16,7 @@ BUILD_DIR="${DEFORM_TSA_BUILD_DIR:-build-tsa}"
 # The targets whose sources carry annotations.
 ANNOTATED_TARGETS=(deform_service)
 
-SUDO=""
-if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
-if ! command -v clang++ >/dev/null 2>&1; then
-  echo "check-thread-safety: installing clang"
-  export DEBIAN_FRONTEND=noninteractive
-  $SUDO apt-get update -qq
-  $SUDO apt-get install -y -qq --no-install-recommends clang
-fi
-scripts/install-deps.sh
+scripts/install-deps.sh scripts/packages/build.txt scripts/packages/checks.txt
 
 # The analysis itself must be on: a member touched without its lock has to fail to compile.
 canary_log=$(mktemp)
