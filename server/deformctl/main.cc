@@ -1,7 +1,7 @@
 // deformctl: the deformation core from the command line.
 //
-//   deformctl deform [--mesh FILE --skeleton FILE] --pose SPEC [--method
-//   paper|paper-linear|laplacian|lbs|dqs]
+//   deformctl deform [--mesh FILE --skeleton FILE [--weights FILE] | --mesh RIG.glb]
+//                    --pose SPEC [--method paper|paper-linear|laplacian|lbs|dqs]
 //                    [--out FILE] [--repeat N]
 //   deformctl phantom --out FILE [--skeleton-out FILE] [--vertices N]
 //
@@ -27,6 +27,7 @@ using deform::Status;
 struct DeformArgs {
   std::string mesh_path;
   std::string skeleton_path;
+  std::string weights_path;
   int phantom_vertices = deform::kDefaultPhantomVertices;
   std::string pose = "rest";
   std::string method = "paper";
@@ -50,7 +51,8 @@ int Fail(const Status& status) {
 int RunDeform(const DeformArgs& args) {
   auto method = deform::MethodFromName(args.method);
   if (!method.ok()) return Fail(method.status());
-  auto input = deform::LoadModelInput(args.mesh_path, args.skeleton_path, args.phantom_vertices);
+  auto input = deform::LoadModelInput(args.mesh_path, args.skeleton_path, args.weights_path,
+                                      args.phantom_vertices);
   if (!input.ok()) return Fail(input.status());
   auto terms = deform::ParsePoseSpec(args.pose, input->skeleton);
   if (!terms.ok()) return Fail(terms.status());
@@ -84,6 +86,11 @@ int RunDeform(const DeformArgs& args) {
   out["pose"] = args.pose;
   out["vertices"] = input->mesh.num_vertices();
   out["triangles"] = input->mesh.num_triangles();
+  if (input->weights.has_value()) {
+    // Read and checked against the mesh and skeleton, not yet used: the model binds by geometry.
+    out["skin_weights"] = args.weights_path.empty() ? "glTF" : args.weights_path;
+    out["skin_weights_used"] = false;
+  }
   out["joint_nodes"] = run->joint_nodes;
   out["anchors"] = run->anchors;
   out["clamped_angles"] = *clamped;
@@ -135,9 +142,15 @@ int main(int argc, char** argv) {
   CLI::App* deform_cmd =
       app.add_subcommand("deform", "Pose a mesh and print quality and timings as JSON");
   deform_cmd->add_option("--mesh", deform_args.mesh_path,
-                         "Mesh file (.obj .ply .stl .off); default: the built-in knee phantom");
+                         "Mesh file (.obj .ply .stl .off), or a skinned glTF rig (.gltf .glb) that "
+                         "brings its own skeleton and weights; default: the built-in knee phantom");
   deform_cmd->add_option("--skeleton", deform_args.skeleton_path,
-                         "Skeleton file (.tgf or JSON); required with --mesh");
+                         "Skeleton file (.tgf or JSON); required with --mesh, except a glTF rig");
+  deform_cmd->add_option(
+      "--weights", deform_args.weights_path,
+      "Skinning weights (.dmat or .csv: one row per mesh vertex, one column per "
+      "skeleton bone), checked against the mesh and skeleton; used by the model "
+      "once binding from weights lands (until then the model binds by geometry)");
   deform_cmd
       ->add_option("--phantom-vertices", deform_args.phantom_vertices, "Resolution of the phantom")
       ->capture_default_str();
