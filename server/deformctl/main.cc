@@ -1,8 +1,7 @@
 // deformctl: the deformation core from the command line.
 //
-//   deformctl deform [--mesh FILE --skeleton FILE] --pose SPEC [--method
-//   paper|paper-linear|laplacian|lbs|dqs]
-//                    [--out FILE] [--repeat N]
+//   deformctl deform [--mesh FILE --skeleton FILE [--weights FILE] | --mesh RIG.glb] --pose SPEC
+//                    [--method paper|paper-linear|laplacian|lbs|dqs] [--out FILE] [--repeat N]
 //   deformctl phantom --out FILE [--skeleton-out FILE] [--vertices N]
 //
 // Prints one JSON object on stdout; errors are one line on stderr and a non-zero exit code.
@@ -28,6 +27,7 @@ using deform::StatusOr;
 struct DeformArgs {
   std::string mesh_path;
   std::string skeleton_path;
+  std::string weights_path;
   int phantom_vertices = deform::kDefaultPhantomVertices;
   std::string pose = "rest";
   std::string method = "paper";
@@ -56,9 +56,30 @@ StatusOr<deform::ModelOptions> ModelOptionsFrom(const DeformArgs& args) {
   return options;
 }
 
+// The binding report: where the binding came from, per bone its vertices and rigid pieces, the
+// warnings.
+nlohmann::ordered_json BindingJson(const deform::BindingReport& report) {
+  nlohmann::ordered_json out;
+  out["source"] = report.source;
+  out["seen_through_body"] = report.seen_through_body;
+  out["reached_along_surface"] = report.reached_along_surface;
+  out["straight_line"] = report.straight_line;
+  out["bones"] = nlohmann::ordered_json::array();
+  for (const deform::BoneBinding& bone : report.bones) {
+    out["bones"].push_back({{"bone", bone.name},
+                            {"vertices", bone.vertices},
+                            {"rigid_vertices", bone.rigid_vertices},
+                            {"rigid_pieces", bone.pieces},
+                            {"anchors", bone.anchors}});
+  }
+  out["joints_outside"] = report.joints_outside;
+  out["warnings"] = report.warnings;
+  return out;
+}
+
 nlohmann::ordered_json DeformReport(const DeformArgs& args, const deform::ModelInput& input,
-                                    deform::Method method, const deform::MethodRun& run,
-                                    int clamped) {
+                                    const deform::DeformationModel& model, deform::Method method,
+                                    const deform::MethodRun& run, int clamped) {
   const auto& q = run.quality;
   nlohmann::ordered_json out;
   out["mesh"] = input.description;
@@ -68,6 +89,7 @@ nlohmann::ordered_json DeformReport(const DeformArgs& args, const deform::ModelI
   out["triangles"] = input.mesh.num_triangles();
   out["joint_nodes"] = run.joint_nodes;
   out["anchors"] = run.anchors;
+  out["binding"] = BindingJson(model.binding_report());
   out["clamped_angles"] = clamped;
   out["volume_change"] = q.volume_change;
   out["clearance_min"] = q.clearance.min;
@@ -90,14 +112,17 @@ int RunDeform(const DeformArgs& args) {
   if (!method.ok()) return Fail(method.status());
   auto options = ModelOptionsFrom(args);
   if (!options.ok()) return Fail(options.status());
-  auto input = deform::LoadModelInput(args.mesh_path, args.skeleton_path, args.phantom_vertices);
+  auto input = deform::LoadModelInput(args.mesh_path, args.skeleton_path, args.weights_path,
+                                      args.phantom_vertices);
   if (!input.ok()) return Fail(input.status());
   auto terms = deform::ParsePoseSpec(args.pose, input->skeleton);
   if (!terms.ok()) return Fail(terms.status());
   deform::Pose pose;
   auto clamped = deform::PoseFromTerms(input->skeleton, *terms, &pose);
   if (!clamped.ok()) return Fail(clamped.status());
-  auto model = deform::DeformationModel::Build(input->mesh, input->skeleton, *options);
+  auto model =
+      deform::DeformationModel::Build(input->mesh, input->skeleton, *options,
+                                      input->weights.has_value() ? &*input->weights : nullptr);
   if (!model.ok()) return Fail(model.status());
   auto run = deform::RunMethod(**model, *method, pose, args.repeat);
   if (!run.ok()) return Fail(run.status());
@@ -106,7 +131,10 @@ int RunDeform(const DeformArgs& args) {
         deform::WriteMeshFile({run->posed, input->mesh.triangles}, args.out_path);
     if (!written.ok()) return Fail(written);
   }
-  std::cout << DeformReport(args, *input, *method, *run, *clamped).dump() << std::endl;
+  for (const std::string& warning : (*model)->binding_report().warnings) {
+    std::cerr << "deformctl: warning: " << warning << "\n";
+  }
+  std::cout << DeformReport(args, *input, **model, *method, *run, *clamped).dump() << std::endl;
   return 0;
 }
 
@@ -140,9 +168,14 @@ CLI::App* AddDeformCommand(CLI::App* app, DeformArgs* args) {
   CLI::App* command =
       app->add_subcommand("deform", "Pose a mesh and print quality and timings as JSON");
   command->add_option("--mesh", args->mesh_path,
-                      "Mesh file (.obj .ply .stl .off); default: the built-in knee phantom");
+                      "Mesh file (.obj .ply .stl .off), or a skinned glTF rig (.gltf .glb) that "
+                      "brings its own skeleton and weights; default: the built-in knee phantom");
   command->add_option("--skeleton", args->skeleton_path,
-                      "Skeleton file (.tgf or JSON); required with --mesh");
+                      "Skeleton file (.tgf or JSON); required with --mesh, except a glTF rig");
+  command->add_option("--weights", args->weights_path,
+                      "Skinning weights (.dmat or .csv: one row per mesh vertex, one column per "
+                      "skeleton bone) to bind with instead of binding through the body; the "
+                      "baselines (lbs, dqs) use them too");
   AddWithDefault(command, "--phantom-vertices", &args->phantom_vertices,
                  "Resolution of the phantom");
   AddWithDefault(command, "--pose", &args->pose,

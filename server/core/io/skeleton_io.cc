@@ -1,6 +1,8 @@
 #include "core/io/skeleton_io.h"
 
+#include <cctype>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <initializer_list>
 #include <nlohmann/json.hpp>
@@ -10,8 +12,55 @@
 #include <vector>
 
 #include "core/base/text.h"
+#include "internal/file_bytes.h"
 
 namespace deform {
+namespace {
+
+constexpr char kGltfIsARig[] =
+    "is a glTF rig, not a skeleton file: read it whole (mesh, skeleton and weights) as a glTF";
+
+// `bytes` without a UTF-8 byte order mark and leading white space.
+std::string_view ContentStart(std::string_view bytes) {
+  if (bytes.substr(0, 3) == "\xEF\xBB\xBF") bytes.remove_prefix(3);
+  while (!bytes.empty() && (bytes.front() == ' ' || bytes.front() == '\t' ||
+                            bytes.front() == '\n' || bytes.front() == '\r')) {
+    bytes.remove_prefix(1);
+  }
+  return bytes;
+}
+
+// INVALID_ARGUMENT naming content in a format that is no skeleton file (BVH, a binary glTF).
+Status RefuseForeignContent(std::string_view bytes) {
+  const std::string_view start = ContentStart(bytes);
+  if (start.substr(0, 9) == "HIERARCHY") return Status::InvalidArgument(kBvhNotSupported);
+  if (bytes.substr(0, 4) == "glTF") {
+    return Status::InvalidArgument(std::string("the data (binary glTF) ") + kGltfIsARig);
+  }
+  return Status::Ok();
+}
+
+std::string Shown(std::string_view text) {
+  std::string shown(text.substr(0, 16));
+  for (char& c : shown) {
+    if (c < 0x20 || c > 0x7e) c = '?';
+  }
+  return "'" + shown + (text.size() > 16 ? "...'" : "'");
+}
+
+}  // namespace
+
+StatusOr<SkeletonFormat> SkeletonFormatFromBytes(std::string_view bytes) {
+  DEFORM_RETURN_IF_ERROR(RefuseForeignContent(bytes));
+  const std::string_view start = ContentStart(bytes);
+  if (start.empty()) return Status::InvalidArgument("the skeleton data is empty");
+  if (start.front() == '{') return SkeletonFormat::kJson;
+  const char c = start.front();
+  if ((c >= '0' && c <= '9') || c == '+' || c == '-' || c == '#') return SkeletonFormat::kTgf;
+  return Status::InvalidArgument("unknown skeleton format: the data starts with " + Shown(start) +
+                                 " (expected TGF, the project's JSON, or a skinned glTF read as "
+                                 "a rig)");
+}
 
 namespace {
 
@@ -47,6 +96,7 @@ StatusOr<std::pair<int, int>> TgfBone(std::istringstream* fields, const std::str
 }  // namespace
 
 StatusOr<Skeleton> ParseTgf(std::string_view text) {
+  DEFORM_RETURN_IF_ERROR(RefuseForeignContent(text));
   std::istringstream in{std::string(text)};
   std::string line;
   std::vector<Joint> joints;
@@ -100,6 +150,22 @@ StatusOr<int> JsonJointReference(const nlohmann::json& value, const std::vector<
   return Status::InvalidArgument("bone references unknown joint " + value.dump());
 }
 
+// INVALID_ARGUMENT naming the first key of `object` (described by `what`) outside `known`.
+Status RefuseUnknownKeys(const nlohmann::json& object, const std::string& what,
+                         std::initializer_list<const char*> known) {
+  for (const auto& item : object.items()) {
+    bool found = false;
+    for (const char* key : known) found = found || item.key() == key;
+    if (found) continue;
+    std::string list;
+    for (const char* key : known) list += (list.empty() ? "" : ", ") + std::string(key);
+    return Status::InvalidArgument(what + " has key '" + item.key() +
+                                   "', which is not part of the skeleton JSON format (" + what +
+                                   " keys: " + list + ")");
+  }
+  return Status::Ok();
+}
+
 // Whether `value` is an object with a string "name" and every key of `required`.
 bool IsNamedObject(const nlohmann::json& value, std::initializer_list<const char*> required) {
   if (!value.is_object() || !value.contains("name") || !value["name"].is_string()) return false;
@@ -125,6 +191,7 @@ StatusOr<DegreeOfFreedom> DegreeOfFreedomFromJson(const nlohmann::json& value,
   if (!IsNamedObject(value, {"axis"})) {
     return Status::InvalidArgument(where + ": each dof needs 'name' and 'axis'");
   }
+  DEFORM_RETURN_IF_ERROR(RefuseUnknownKeys(value, where + " dof", {"name", "axis", "min", "max"}));
   DegreeOfFreedom dof;
   dof.name = value["name"].get<std::string>();
   DEFORM_ASSIGN_OR_RETURN(dof.axis, JsonVector(value["axis"], where + " dof axis"));
@@ -139,6 +206,7 @@ StatusOr<Joint> JointFromJson(const nlohmann::json& value, std::size_t index) {
   if (!IsNamedObject(value, {"position"})) {
     return Status::InvalidArgument(where + " needs 'name' (string) and 'position'");
   }
+  DEFORM_RETURN_IF_ERROR(RefuseUnknownKeys(value, where, {"name", "position", "dofs"}));
   Joint joint;
   joint.name = value["name"].get<std::string>();
   DEFORM_ASSIGN_OR_RETURN(joint.rest_position, JsonVector(value["position"], where + " position"));
@@ -152,6 +220,13 @@ StatusOr<Joint> JointFromJson(const nlohmann::json& value, std::size_t index) {
 }
 
 StatusOr<Skeleton> ParseSkeletonJsonValue(const nlohmann::json& doc) {
+  if (doc.is_object() && doc.contains("asset") &&
+      (doc.contains("nodes") || doc.contains("skins") || doc.contains("meshes"))) {
+    return Status::InvalidArgument(std::string("the JSON ") + kGltfIsARig);
+  }
+  if (doc.is_object()) {
+    DEFORM_RETURN_IF_ERROR(RefuseUnknownKeys(doc, "the skeleton", {"joints", "bones"}));
+  }
   if (!doc.is_object() || !doc.contains("joints") || !doc["joints"].is_array() ||
       !doc.contains("bones") || !doc["bones"].is_array()) {
     return Status::InvalidArgument("skeleton JSON needs arrays 'joints' and 'bones'");
@@ -176,6 +251,7 @@ StatusOr<Skeleton> ParseSkeletonJsonValue(const nlohmann::json& doc) {
 }  // namespace
 
 StatusOr<Skeleton> ParseSkeletonJson(std::string_view text) {
+  DEFORM_RETURN_IF_ERROR(RefuseForeignContent(text));
   nlohmann::json doc = nlohmann::json::parse(text.begin(), text.end(), nullptr,
                                              /*allow_exceptions=*/false);
   if (doc.is_discarded()) return Status::InvalidArgument("skeleton JSON does not parse");
@@ -205,15 +281,23 @@ std::string SkeletonToJson(const Skeleton& skeleton) {
   return doc.dump(2);
 }
 
+StatusOr<Skeleton> ParseSkeleton(std::string_view bytes, SkeletonFormat format) {
+  return format == SkeletonFormat::kTgf ? ParseTgf(bytes) : ParseSkeletonJson(bytes);
+}
+
 StatusOr<Skeleton> ReadSkeletonFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Status::NotFound("cannot open skeleton file '" + path + "'");
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  const std::string text = buffer.str();
-  const bool is_tgf = path.size() >= 4 && (path.compare(path.size() - 4, 4, ".tgf") == 0 ||
-                                           path.compare(path.size() - 4, 4, ".TGF") == 0);
-  auto skeleton = is_tgf ? ParseTgf(text) : ParseSkeletonJson(text);
+  DEFORM_ASSIGN_OR_RETURN(const std::string bytes,
+                          io_internal::ReadFileBytes(path, "skeleton file"));
+  std::string extension = std::filesystem::path(path).extension().string();
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  StatusOr<SkeletonFormat> format = SkeletonFormat::kTgf;
+  if (extension == ".json") {
+    format = SkeletonFormat::kJson;
+  } else if (extension != ".tgf") {
+    format = SkeletonFormatFromBytes(bytes);
+  }
+  StatusOr<Skeleton> skeleton =
+      format.ok() ? ParseSkeleton(bytes, *format) : StatusOr<Skeleton>(format.status());
   if (!skeleton.ok()) return skeleton.status().WithContext(path);
   return skeleton;
 }

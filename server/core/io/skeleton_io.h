@@ -1,5 +1,7 @@
 // Reading and writing skeletons: TGF (libigl's) and the project's JSON description.
-// No input crashes a reader: malformed content yields INVALID_ARGUMENT naming the problem.
+// No input crashes a reader: malformed content yields INVALID_ARGUMENT naming the problem. Content
+// in a format that is not a skeleton file is named as such (BVH motion capture, a glTF rig), by
+// every reader, rather than reported as a parse error of the format that was asked for.
 #pragma once
 
 #include <string>
@@ -9,6 +11,19 @@
 #include "core/geometry/skeleton.h"
 
 namespace deform {
+
+enum class SkeletonFormat { kTgf, kJson };
+
+// The message (INVALID_ARGUMENT) for BVH content.
+inline constexpr char kBvhNotSupported[] =
+    "BVH motion capture is not a supported skeleton format (use TGF, the project's JSON, or a "
+    "skinned glTF)";
+
+// The format of skeleton bytes, told by their content: TGF starts with a joint line (a number),
+// JSON with '{'. INVALID_ARGUMENT for BVH ("HIERARCHY", kBvhNotSupported), a glTF (binary, or JSON
+// with "asset"; glTF rigs are read by ReadGltf, core/io/rig_import.h) and anything else, naming
+// what was found.
+StatusOr<SkeletonFormat> SkeletonFormatFromBytes(std::string_view bytes);
 
 // TGF (format in the shared data README): joint lines "index x y z [extra...]", '#', bone lines
 // "a b [flags...]" with 1-based joints, '#'. Joints are named "joint<0-based index>" and have no
@@ -20,11 +35,18 @@ StatusOr<Skeleton> ParseTgf(std::string_view text);
 //                   "dofs": [ { "name": "flexion", "axis": [1, 0, 0],
 //                               "min": -10, "max": 150 }, ... ] }, ... ],
 //     "bones": [ ["hip", "knee"], ["knee", "ankle"] ] }
-// Bones name their head then tail joint (names or 0-based indices).
+// Bones name their head then tail joint (names or 0-based indices). Keys other than these
+// (top-level "joints" and "bones"; a joint's "name", "position", "dofs"; a dof's "name", "axis",
+// "min", "max") are refused by name rather than ignored.
 StatusOr<Skeleton> ParseSkeletonJson(std::string_view text);
 std::string SkeletonToJson(const Skeleton& skeleton);
 
-// Reads a file; ".tgf" is TGF, anything else is parsed as JSON.
+// ParseTgf or ParseSkeletonJson.
+StatusOr<Skeleton> ParseSkeleton(std::string_view bytes, SkeletonFormat format);
+
+// Reads a file: ".tgf" is TGF, ".json" JSON, any other name is told by its content
+// (SkeletonFormatFromBytes); BVH and glTF content is refused whatever the name. NOT_FOUND if the
+// file cannot be opened; errors carry the path.
 StatusOr<Skeleton> ReadSkeletonFile(const std::string& path);
 
 }  // namespace deform

@@ -2,6 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
+#include <string>
+
 #include "core/geometry/skeleton.h"
 #include "tests/shared_data.h"
 
@@ -98,6 +102,74 @@ TEST(SkeletonJson, RefusesMalformedInput) {
       {"name": "b", "position": [0,1,0]}], "bones": [["a", "b"]]})");
   ASSERT_FALSE(bad_range.ok());
   EXPECT_NE(bad_range.status().message().find("range"), std::string::npos);
+}
+
+TEST(SkeletonJson, RefusesKeysOutsideTheFormatByName) {
+  auto expect_refused = [](const char* json, const std::string& needle) {
+    auto result = ParseSkeletonJson(json);
+    ASSERT_FALSE(result.ok()) << json;
+    EXPECT_EQ(result.status().code(), StatusCode::kInvalidArgument);
+    EXPECT_NE(result.status().message().find(needle), std::string::npos)
+        << result.status().message();
+  };
+  constexpr char kTwoJoints[] = R"("joints": [{"name": "a", "position": [0,0,0]},
+      {"name": "b", "position": [0,1,0]}], "bones": [["a", "b"]])";
+  expect_refused((std::string("{") + kTwoJoints + R"(, "weights": []})").c_str(),
+                 "key 'weights', which is not part of the skeleton JSON format");
+  expect_refused((std::string("{") + kTwoJoints + R"(, "root": "a"})").c_str(), "key 'root'");
+  expect_refused(R"({"joints": [{"name": "a", "pos": [0,0,0], "position": [0,0,0]}],
+      "bones": []})",
+                 "joint 0 has key 'pos'");
+  expect_refused(R"({"joints": [{"name": "a", "position": [0,0,0],
+      "dofs": [{"name": "f", "axis": [1,0,0], "limit": 3}]}], "bones": []})",
+                 "dof has key 'limit'");
+  expect_refused(R"({"asset": {"version": "2.0"}, "nodes": []})", "glTF rig");
+}
+
+TEST(SkeletonFormat, IsToldByContentAndNamesForeignFormats) {
+  EXPECT_EQ(*SkeletonFormatFromBytes(kLegTgf), SkeletonFormat::kTgf);
+  EXPECT_EQ(*SkeletonFormatFromBytes("\xEF\xBB\xBF  {\"joints\": []}"), SkeletonFormat::kJson);
+  constexpr char kBvh[] =
+      "HIERARCHY\nROOT Hips\n{\n  OFFSET 0 0 0\n  CHANNELS 3 Xrotation Yrotation Zrotation\n}\n"
+      "MOTION\nFrames: 0\n";
+  for (const auto& status : {SkeletonFormatFromBytes(kBvh).status(),
+                             ParseSkeletonJson(kBvh).status(), ParseTgf(kBvh).status()}) {
+    EXPECT_EQ(status.code(), StatusCode::kInvalidArgument);
+    EXPECT_EQ(status.message(), kBvhNotSupported);
+  }
+  EXPECT_NE(
+      SkeletonFormatFromBytes(std::string("glTF\x02\0\0\0", 8)).status().message().find("glTF rig"),
+      std::string::npos);
+  auto unknown = SkeletonFormatFromBytes("<skeleton/>");
+  ASSERT_FALSE(unknown.ok());
+  EXPECT_NE(unknown.status().message().find("unknown skeleton format"), std::string::npos);
+}
+
+TEST(SkeletonFormat, ReadSkeletonFileNamesBvhWhateverTheExtension) {
+  const auto dir = std::filesystem::temp_directory_path();
+  for (const char* name : {"deform_bvh_test.bvh", "deform_bvh_test.json", "deform_bvh_test.tgf"}) {
+    const std::string path = (dir / name).string();
+    {
+      std::ofstream out(path);
+      out << "HIERARCHY\nROOT Hips\n{\n OFFSET 0 0 0\n}\nMOTION\n";
+    }
+    auto skeleton = ReadSkeletonFile(path);
+    std::filesystem::remove(path);
+    ASSERT_FALSE(skeleton.ok()) << name;
+    EXPECT_EQ(skeleton.status().code(), StatusCode::kInvalidArgument);
+    EXPECT_NE(skeleton.status().message().find(kBvhNotSupported), std::string::npos)
+        << skeleton.status().message();
+  }
+  // A TGF under another name is told by its content.
+  const std::string path = (dir / "deform_tgf_test.txt").string();
+  {
+    std::ofstream out(path);
+    out << kLegTgf;
+  }
+  auto skeleton = ReadSkeletonFile(path);
+  std::filesystem::remove(path);
+  ASSERT_TRUE(skeleton.ok()) << skeleton.status().ToString();
+  EXPECT_EQ(skeleton->num_joints(), 3);
 }
 
 }  // namespace

@@ -1,0 +1,68 @@
+// Importing a skinned rig from glTF 2.0 (.gltf with data URIs, or .glb): the mesh, the skeleton
+// and the skinning weights together, ready for the deformation model.
+//
+// Untrusted input: no bytes crash the reader, and reading never touches anything but the bytes
+// given (a .gltf that refers to an external file, buffer or image, is INVALID_ARGUMENT naming the
+// URI; data URIs and a .glb's BIN chunk are read). Malformed content is INVALID_ARGUMENT naming
+// the problem (accessor, primitive, node); sizes beyond MeshLimits are RESOURCE_EXHAUSTED.
+//
+// What is read, and how it maps onto the core's types:
+//   - The skinned mesh: the one node with both "mesh" and "skin" (none: INVALID_ARGUMENT "no
+//     skin: ..."; several: INVALID_ARGUMENT). Every primitive must be triangles (mode 4, indexed
+//     or not) with POSITION (float VEC3) and JOINTS_n/WEIGHTS_n pairs (n = 0, 1, ...; JOINTS
+//     unsigned byte/short, WEIGHTS float or normalised unsigned byte/short). Primitives are
+//     concatenated in file order. Morph targets, normals, UVs and materials are ignored.
+//   - Positions are kept as the file holds them, in the bind space the inverse bind matrices refer
+//     to: glTF ignores a skinned mesh node's own transform (the joints place the mesh), so it is
+//     not applied here either.
+//   - Joints: the skin's joints, named after their nodes ("node<index>" when unnamed; a repeated
+//     name gets "_2", "_3"...). A joint's bind position is the translation of the inverse of its
+//     inverse bind matrix; without inverseBindMatrices, the translation of its node's world
+//     transform. Its parent is the nearest ancestor node that is also a skin joint.
+//   - Bones: one per (parent joint -> child joint). A joint within 1e-6 of the mesh's bounding-box
+//     diagonal of its parent joint is merged into it (same skeleton joint; its weights go to the
+//     parent's bones). A joint that heads no bone but has weighted vertices gets an end joint
+//     "<name>_end", half the parent bone's length further along the parent->joint direction (a
+//     lone joint without parent: toward its vertices' weighted centroid, twice as far, or along
+//     their principal direction when they centre on the joint).
+//   - Weights: a glTF joint's weight goes to the bone that starts at its skeleton joint; where
+//     several start there, to the one nearest the vertex; normalised (NormalizeSkinWeights).
+//   - Welding: vertices that glTF splits at seams (exactly equal position, weights equal within
+//     1e-6) become one vertex of the mesh; vertices no triangle uses are dropped.
+#pragma once
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/base/status.h"
+#include "core/geometry/mesh.h"
+#include "core/geometry/skeleton.h"
+#include "core/geometry/skin_weights.h"
+
+namespace deform {
+
+struct RigImport {
+  TriangleMesh mesh;    // the welded mesh the solve uses (validated with ValidateMesh)
+  Skeleton skeleton;    // the skin's joints (plus any "<name>_end" joints) and their bones
+  SkinWeights weights;  // on the welded vertices, bone indices in skeleton bone order; normalised
+  // For each vertex in the file's own order (all primitives of the skinned mesh concatenated, as
+  // an engine holds them): its vertex in `mesh`, or -1 if no triangle uses it. Frames computed on
+  // `mesh` return to the file's order through this.
+  std::vector<int> file_vertex_to_mesh;
+  std::string units = "metre";  // glTF's units (the spec says metres)
+  std::string up_axis = "+Y";   // glTF's up axis
+};
+
+// Parses a whole .gltf (JSON, buffers as data URIs) or .glb (told by its "glTF" magic) held in
+// memory. The vertex limit applies to the file's vertices before welding, the triangle limit to
+// its triangles.
+StatusOr<RigImport> ReadGltf(std::string_view bytes, const MeshLimits& limits = {});
+// Reads a file (.gltf or .glb; the content decides). NOT_FOUND if it cannot be opened; errors
+// carry the path.
+StatusOr<RigImport> ReadGltfFile(const std::string& path, const MeshLimits& limits = {});
+
+// True for a path ending in .gltf or .glb (case-insensitive).
+bool IsGltfPath(std::string_view path);
+
+}  // namespace deform
