@@ -56,6 +56,7 @@ deform::v1::MeshFormat MeshFormatFromPath(const std::string& path) {
   if (extension == "ply") return deform::v1::MESH_FORMAT_PLY;
   if (extension == "stl") return deform::v1::MESH_FORMAT_STL;
   if (extension == "off") return deform::v1::MESH_FORMAT_OFF;
+  if (extension == "gltf" || extension == "glb") return deform::v1::MESH_FORMAT_GLTF;
   return deform::v1::MESH_FORMAT_UNSPECIFIED;
 }
 

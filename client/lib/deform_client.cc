@@ -109,23 +109,43 @@ grpc::Status DeformClient::LoadMeshFiles(const std::string& mesh_path,
                                          const std::string& skeleton_path,
                                          const deform::v1::MethodOptions& options,
                                          deform::v1::MeshSummary* summary,
-                                         const ProgressCallback& progress) {
+                                         const ProgressCallback& progress,
+                                         const std::string& weights_path) {
+  deform::v1::LoadMeshHeader header;
+  header.set_name(BaseName(mesh_path));
+  *header.mutable_options() = options;
+  deform::v1::UploadSource* upload = header.mutable_upload();
+  upload->set_format(MeshFormatFromPath(mesh_path));
+  if (upload->format() == deform::v1::MESH_FORMAT_UNSPECIFIED) {
+    return grpc::Status(
+        grpc::StatusCode::INVALID_ARGUMENT,
+        "unknown mesh format for '" + mesh_path + "' (.obj .ply .stl .off, or a .gltf/.glb rig)");
+  }
   std::string mesh_bytes;
-  std::string skeleton_bytes;
   grpc::Status status = ReadWholeFile(mesh_path, &mesh_bytes);
   if (!status.ok()) return status;
-  status = ReadWholeFile(skeleton_path, &skeleton_bytes);
-  if (!status.ok()) return status;
-  const deform::v1::MeshFormat format = MeshFormatFromPath(mesh_path);
-  if (format == deform::v1::MESH_FORMAT_UNSPECIFIED) {
-    return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
-                        "unknown mesh format for '" + mesh_path + "' (.obj .ply .stl .off)");
+  if (!skeleton_path.empty()) {
+    status = ReadWholeFile(skeleton_path, upload->mutable_skeleton());
+    if (!status.ok()) return status;
+    upload->set_skeleton_format(EndsWithTgf(skeleton_path) ? deform::v1::SKELETON_FORMAT_TGF
+                                                           : deform::v1::SKELETON_FORMAT_JSON);
   }
-  const deform::v1::SkeletonFormat skeleton_format = EndsWithTgf(skeleton_path)
-                                                         ? deform::v1::SKELETON_FORMAT_TGF
-                                                         : deform::v1::SKELETON_FORMAT_JSON;
-  return LoadMeshBytes(BaseName(mesh_path), format, mesh_bytes, skeleton_format, skeleton_bytes,
-                       options, summary, progress);
+  if (!weights_path.empty()) {
+    status = ReadWholeFile(weights_path, upload->mutable_weights());
+    if (!status.ok()) return status;
+    const bool csv =
+        weights_path.size() >= 4 && weights_path.compare(weights_path.size() - 4, 4, ".csv") == 0;
+    upload->set_weights_format(csv ? deform::v1::SKIN_WEIGHTS_FORMAT_CSV
+                                   : deform::v1::SKIN_WEIGHTS_FORMAT_DMAT);
+  }
+  return LoadMesh(header, mesh_bytes, summary, progress);
+}
+
+grpc::Status DeformClient::LoadMesh(deform::v1::LoadMeshHeader header,
+                                    const std::string& mesh_bytes, deform::v1::MeshSummary* summary,
+                                    const ProgressCallback& progress) {
+  header.mutable_upload()->set_mesh_size_bytes(mesh_bytes.size());
+  return RunLoadMesh(stub_.get(), options_, header, &mesh_bytes, summary, progress);
 }
 
 grpc::Status DeformClient::LoadMeshBytes(const std::string& name, deform::v1::MeshFormat format,

@@ -47,12 +47,18 @@ class DeformClient {
                            deform::v1::MeshSummary* summary, const ProgressCallback& progress = {},
                            const std::string& name = "phantom");
   // Uploads a mesh file and a skeleton file (formats from the extensions: .obj .ply .stl .off;
-  // .tgf or JSON). Reading a file that does not exist gives NOT_FOUND without contacting the
-  // server.
+  // .tgf or JSON), and optionally the rig's skinning weights (.dmat, or .csv). A .gltf/.glb rig
+  // carries skeleton and weights itself: give neither. Reading a file that does not exist gives
+  // NOT_FOUND without contacting the server.
   grpc::Status LoadMeshFiles(const std::string& mesh_path, const std::string& skeleton_path,
                              const deform::v1::MethodOptions& options,
                              deform::v1::MeshSummary* summary,
-                             const ProgressCallback& progress = {});
+                             const ProgressCallback& progress = {},
+                             const std::string& weights_path = "");
+  // Any upload: `header`'s upload (format, skeleton, weights) and options as the caller sets them;
+  // upload.mesh_size_bytes is set here from `mesh_bytes`.
+  grpc::Status LoadMesh(deform::v1::LoadMeshHeader header, const std::string& mesh_bytes,
+                        deform::v1::MeshSummary* summary, const ProgressCallback& progress = {});
   // Uploads mesh bytes already in memory.
   grpc::Status LoadMeshBytes(const std::string& name, deform::v1::MeshFormat format,
                              const std::string& mesh_bytes,

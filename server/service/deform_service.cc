@@ -24,7 +24,7 @@ grpc::ServerUnaryReactor* DeformServiceImpl::GetMeshInfo(grpc::CallbackServerCon
     return reactor;
   }
   FillMeshSummary(**entry, response->mutable_summary());
-  if (request->include_geometry()) FillMeshGeometry(*(*entry)->model, response);
+  if (request->include_geometry()) FillMeshGeometry(**entry, response);
   reactor->Finish(grpc::Status::OK);
   return reactor;
 }

@@ -163,12 +163,13 @@ void DeformStreamReactor::HandleStart() {
   entry_->open_streams.fetch_add(1);
   model_ = entry_->model.get();
   log_context_ += " mesh=" + entry_->id;
-  solver_.emplace(*model_);  // everything a solve needs, sized once
+  // Everything a solve needs, sized once; frames in the client's vertex order.
+  solver_.emplace(*model_, entry_->presentation.file_vertex_to_mesh);
   spdlog::info("{} opened", log_context_);
 
   MutexLock lock(&mutex_);
   stiffness_.Reset(model_->default_factorization());
-  outbox_.AllocateFrames(model_->mesh().num_vertices());
+  outbox_.AllocateFrames(entry_->client_vertex_count());
   if (!pump_.finish_requested()) StartRead(&request_);
 }
 
@@ -205,7 +206,8 @@ void DeformStreamReactor::HandleStiffness() {
     return;
   }
   const std::uint64_t version = ++last_stiffness_version_;
-  auto stiffness = StiffnessFromProto(request_.stiffness(), *model_);
+  auto stiffness =
+      StiffnessFromProto(request_.stiffness(), *model_, entry_->presentation.file_vertex_to_mesh);
   MutexLock lock(&mutex_);
   if (pump_.finish_requested()) return;
   if (!stiffness.ok()) {

@@ -14,10 +14,17 @@ double Milliseconds(Clock::duration duration) {
   return std::chrono::duration<double, std::milli>(duration).count();
 }
 
+const std::vector<int> kSolvedOrder;
+
 }  // namespace
 
-FrameSolver::FrameSolver(const DeformationModel& model)
-    : model_(model), pose_(Pose::Rest(model.skeleton())), scratch_(model.MakeScratch()) {}
+FrameSolver::FrameSolver(const DeformationModel& model) : FrameSolver(model, kSolvedOrder) {}
+
+FrameSolver::FrameSolver(const DeformationModel& model, const std::vector<int>& client_order)
+    : model_(model),
+      client_order_(client_order),
+      pose_(Pose::Rest(model.skeleton())),
+      scratch_(model.MakeScratch()) {}
 
 Status FrameSolver::Solve(const PoseInput& input, const MaterialFactorization& factorization,
                           const FrameStamp& stamp, v1::DeformFrame* frame) {
@@ -26,9 +33,12 @@ Status FrameSolver::Solve(const PoseInput& input, const MaterialFactorization& f
   DeformTimings timings;
   model_.Deform(factorization, pose_, &scratch_, &timings);
   const Clock::time_point encode_start = Clock::now();
-  const std::size_t values = static_cast<std::size_t>(scratch_.num_vertices) * 3;
-  frame->mutable_positions()->resize(values * 4);  // no-op when sized by FrameSlots
-  EncodeFloat32(scratch_.solution.data(), values, frame->mutable_positions()->data());
+  const std::size_t client_vertices = client_order_.empty()
+                                          ? static_cast<std::size_t>(scratch_.num_vertices)
+                                          : client_order_.size();
+  frame->mutable_positions()->resize(client_vertices * 12);  // no-op when sized by FrameSlots
+  EncodeInClientOrder(scratch_.solution.data(), scratch_.num_vertices, client_order_,
+                      frame->mutable_positions()->data());
   frame->set_sequence(input.sequence);
   frame->set_client_timestamp_ns(input.client_timestamp_ns);
   frame->set_stiffness_version(stamp.stiffness_version);

@@ -28,6 +28,10 @@ struct FrameStamp {
 
 class FrameSolver {
  public:
+  // `client_order`: per client vertex (the file's order) its solved vertex, or empty for the
+  // solved order itself (MeshPresentation); it must outlive the solver.
+  FrameSolver(const DeformationModel& model, const std::vector<int>& client_order);
+  // Frames in the solved order.
   explicit FrameSolver(const DeformationModel& model);
 
   // Solves `input` with `factorization` (one of the model's) into `frame`; its positions should
@@ -38,6 +42,7 @@ class FrameSolver {
 
  private:
   const DeformationModel& model_;
+  const std::vector<int>& client_order_;
   Pose pose_;
   DeformScratch scratch_;
 };

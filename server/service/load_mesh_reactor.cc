@@ -12,7 +12,9 @@
 #include "core/geometry/skeleton.h"
 #include "core/io/mesh_io.h"
 #include "core/io/phantom.h"
+#include "core/io/rig_import.h"
 #include "core/io/skeleton_io.h"
+#include "core/io/skin_weights_io.h"
 #include "service/annotated_mutex.h"
 #include "service/grpc_stream_sink.h"
 #include "service/mesh_loader.h"
@@ -44,6 +46,41 @@ StatusOr<MeshFormat> CoreMeshFormat(v1::MeshFormat format) {
       return Status::InvalidArgument("upload.format is unspecified or unknown (" +
                                      std::to_string(static_cast<int>(format)) + ")");
   }
+}
+
+StatusOr<SkinWeightsFormat> CoreWeightsFormat(v1::SkinWeightsFormat format) {
+  switch (format) {
+    case v1::SKIN_WEIGHTS_FORMAT_DMAT:
+      return SkinWeightsFormat::kDmat;
+    case v1::SKIN_WEIGHTS_FORMAT_CSV:
+      return SkinWeightsFormat::kCsv;
+    default:
+      return Status::InvalidArgument("upload.weights_format is unspecified or unknown (" +
+                                     std::to_string(static_cast<int>(format)) + ")");
+  }
+}
+
+// The header checks of an upload's skeleton and weights: a glTF rig carries both, so neither may
+// be given beside it; other formats need a skeleton, and weights only with their format.
+Status CheckUploadParts(const v1::UploadSource& upload) {
+  if (upload.format() == v1::MESH_FORMAT_GLTF) {
+    if (!upload.skeleton().empty() || !upload.weights().empty()) {
+      return Status::InvalidArgument(
+          "a glTF upload carries its own skeleton and weights: upload.skeleton and "
+          "upload.weights must be empty");
+    }
+    return Status::Ok();
+  }
+  DEFORM_RETURN_IF_ERROR(CoreMeshFormat(upload.format()).status());
+  if (upload.skeleton().empty()) return Status::InvalidArgument("upload.skeleton is empty");
+  if (upload.skeleton_format() != v1::SKELETON_FORMAT_TGF &&
+      upload.skeleton_format() != v1::SKELETON_FORMAT_JSON) {
+    return Status::InvalidArgument("upload.skeleton_format is unspecified or unknown");
+  }
+  if (!upload.weights().empty()) {
+    DEFORM_RETURN_IF_ERROR(CoreWeightsFormat(upload.weights_format()).status());
+  }
+  return Status::Ok();
 }
 
 StatusOr<Skeleton> ParseSkeleton(v1::SkeletonFormat format, const std::string& bytes) {
@@ -84,6 +121,8 @@ class LoadMeshReactor final
   // On a worker: parse, validate, precompute, register.
   void Build() DEFORM_EXCLUDES(mutex_);
   StatusOr<std::shared_ptr<const MeshEntry>> ParseAndBuild() DEFORM_EXCLUDES(mutex_);
+  // The upload's mesh, skeleton and weights (a glTF rig gives all three) into `job`.
+  Status ParseUpload(LoadJob* job) DEFORM_EXCLUDES(mutex_);
 
   void Fail(const Status& status) DEFORM_EXCLUDES(mutex_);
   void AddProgressLocked(v1::LoadMeshResponse::Stage stage, double elapsed_ms,
@@ -161,17 +200,17 @@ Status LoadMeshReactor::HandleHeader() {
     }
     case v1::LoadMeshHeader::kUpload: {
       const v1::UploadSource& upload = header_.upload();
-      DEFORM_RETURN_IF_ERROR(CoreMeshFormat(upload.format()).status());
+      DEFORM_RETURN_IF_ERROR(CheckUploadParts(upload));
       if (upload.mesh_size_bytes() == 0) {
-        return Status::InvalidArgument("upload.mesh_bytes is 0: the mesh file size is required");
+        return Status::InvalidArgument(
+            "upload.mesh_size_bytes is 0: the mesh file size is required");
       }
-      if (upload.skeleton().empty()) return Status::InvalidArgument("upload.skeleton is empty");
-      if (upload.skeleton_format() != v1::SKELETON_FORMAT_TGF &&
-          upload.skeleton_format() != v1::SKELETON_FORMAT_JSON) {
-        return Status::InvalidArgument("upload.skeleton_format is unspecified or unknown");
-      }
-      const std::uint64_t total = upload.mesh_size_bytes() + upload.skeleton().size();
-      if (upload.mesh_size_bytes() > limits.max_upload_bytes || total > limits.max_upload_bytes) {
+      // Compared part by part first, so that the sum cannot overflow.
+      const std::uint64_t total =
+          upload.mesh_size_bytes() + upload.skeleton().size() + upload.weights().size();
+      if (upload.mesh_size_bytes() > limits.max_upload_bytes ||
+          upload.skeleton().size() + upload.weights().size() > limits.max_upload_bytes ||
+          total > limits.max_upload_bytes) {
         return Status::ResourceExhausted("upload of " + std::to_string(total) +
                                          " bytes exceeds the limit of " +
                                          std::to_string(limits.max_upload_bytes) + " bytes");
@@ -257,17 +296,7 @@ StatusOr<std::shared_ptr<const MeshEntry>> LoadMeshReactor::ParseAndBuild() {
     job.skeleton = std::move(phantom.skeleton);
     if (job.name.empty()) job.name = "phantom:" + std::to_string(vertices);
   } else {
-    const v1::UploadSource& upload = header_.upload();
-    DEFORM_ASSIGN_OR_RETURN(const MeshFormat format, CoreMeshFormat(upload.format()));
-    MeshLimits limits;
-    limits.max_vertices = core_->limits.max_vertices;
-    auto mesh = ReadMesh(mesh_bytes_, format, limits);
-    if (!mesh.ok()) return mesh.status().WithContext("mesh");
-    job.mesh = std::move(*mesh);
-    std::string().swap(mesh_bytes_);  // the bytes are no longer needed
-    auto skeleton = ParseSkeleton(upload.skeleton_format(), upload.skeleton());
-    if (!skeleton.ok()) return skeleton.status().WithContext("skeleton");
-    job.skeleton = std::move(*skeleton);
+    DEFORM_RETURN_IF_ERROR(ParseUpload(&job));
     if (job.name.empty()) job.name = "upload";
   }
   auto options = ModelOptionsFromProto(header_.options(), job.skeleton);
@@ -290,6 +319,41 @@ StatusOr<std::shared_ptr<const MeshEntry>> LoadMeshReactor::ParseAndBuild() {
     pump_.Pump();
   };
   return BuildAndRegister(&core_->registry, std::move(reservation_), std::move(job), progress);
+}
+
+Status LoadMeshReactor::ParseUpload(LoadJob* job) {
+  const v1::UploadSource& upload = header_.upload();
+  MeshLimits limits;
+  limits.max_vertices = core_->limits.max_vertices;
+  if (upload.format() == v1::MESH_FORMAT_GLTF) {
+    auto rig = ReadGltf(mesh_bytes_, limits);
+    std::string().swap(mesh_bytes_);
+    if (!rig.ok()) return rig.status().WithContext("glTF");
+    job->mesh = std::move(rig->mesh);
+    job->skeleton = std::move(rig->skeleton);
+    job->weights = std::move(rig->weights);
+    job->presentation.file_vertex_to_mesh = std::move(rig->file_vertex_to_mesh);
+    job->presentation.units = std::move(rig->units);
+    job->presentation.up_axis = std::move(rig->up_axis);
+    return Status::Ok();
+  }
+  DEFORM_ASSIGN_OR_RETURN(const MeshFormat format, CoreMeshFormat(upload.format()));
+  auto mesh = ReadMesh(mesh_bytes_, format, limits);
+  if (!mesh.ok()) return mesh.status().WithContext("mesh");
+  job->mesh = std::move(*mesh);
+  std::string().swap(mesh_bytes_);  // the bytes are no longer needed
+  auto skeleton = ParseSkeleton(upload.skeleton_format(), upload.skeleton());
+  if (!skeleton.ok()) return skeleton.status().WithContext("skeleton");
+  job->skeleton = std::move(*skeleton);
+  if (!upload.weights().empty()) {
+    DEFORM_ASSIGN_OR_RETURN(const SkinWeightsFormat format,
+                            CoreWeightsFormat(upload.weights_format()));
+    auto weights = ReadSkinWeights(upload.weights(), format, limits);
+    if (!weights.ok()) return weights.status().WithContext("weights");
+    WidenSkinWeights(format, job->mesh.num_vertices(), job->skeleton.num_bones(), &*weights);
+    job->weights = std::move(*weights);
+  }
+  return Status::Ok();
 }
 
 void LoadMeshReactor::Fail(const Status& status) {

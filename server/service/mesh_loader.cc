@@ -4,6 +4,8 @@
 
 #include <utility>
 
+#include "service/log_text.h"
+
 namespace deform::service {
 namespace {
 
@@ -33,15 +35,20 @@ StatusOr<std::shared_ptr<const MeshEntry>> BuildAndRegister(MeshRegistry* regist
   };
   DEFORM_ASSIGN_OR_RETURN(
       std::shared_ptr<const DeformationModel> model,
-      DeformationModel::Build(std::move(job.mesh), std::move(job.skeleton), job.options, hooks));
+      DeformationModel::Build(std::move(job.mesh), std::move(job.skeleton), job.options,
+                              job.weights.has_value() ? &*job.weights : nullptr, hooks));
   if (progress) progress(LoadStage::kFactorised, MillisecondsSince(job.start));
   DEFORM_ASSIGN_OR_RETURN(std::shared_ptr<const MeshEntry> entry,
-                          registry->Register(std::move(reservation), job.name, std::move(model)));
+                          registry->Register(std::move(reservation), job.name, std::move(model),
+                                             std::move(job.presentation)));
   spdlog::info(
       "mesh={} name='{}' loaded: {} vertices, precompute {:.1f} ms, factor {:.1f} ms, "
       "about {} KiB",
-      entry->id, entry->name, vertices, entry->precompute_ms, entry->factor_ms,
+      entry->id, EscapeForLog(entry->name), vertices, entry->precompute_ms, entry->factor_ms,
       entry->memory_bytes >> 10);
+  for (const std::string& warning : entry->model->binding_report().warnings) {
+    spdlog::warn("mesh={} binding: {}", entry->id, EscapeForLog(warning));
+  }
   return entry;
 }
 

@@ -8,11 +8,13 @@
 #include <chrono>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "core/base/status.h"
 #include "core/geometry/mesh.h"
 #include "core/geometry/skeleton.h"
+#include "core/geometry/skin_weights.h"
 #include "core/model/deformation_model.h"
 #include "service/mesh_registry.h"
 
@@ -33,6 +35,8 @@ struct LoadJob {
   TriangleMesh mesh;
   Skeleton skeleton;
   ModelOptions options;  // options.limits.max_vertices is set from the registry's limits
+  std::optional<SkinWeights> weights;  // a rig's own weights: binding from them (Build)
+  MeshPresentation presentation;       // from a glTF rig: the file's vertex order, units, up axis
   std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
 };
 

@@ -74,7 +74,8 @@ Status MeshRegistry::CheckMemoryAvailable(std::size_t bytes) const {
 }
 
 StatusOr<std::shared_ptr<const MeshEntry>> MeshRegistry::Register(
-    Reservation reservation, std::string name, std::shared_ptr<const DeformationModel> model) {
+    Reservation reservation, std::string name, std::shared_ptr<const DeformationModel> model,
+    MeshPresentation presentation) {
   auto entry = std::make_shared<MeshEntry>();
   entry->name = std::move(name);
   entry->precompute_ms = model->precompute_seconds() * 1e3;
@@ -82,6 +83,7 @@ StatusOr<std::shared_ptr<const MeshEntry>> MeshRegistry::Register(
   entry->factor_bytes = model->default_factorization()->factor().bytes();
   entry->memory_bytes = model->EstimatedBytes();
   entry->model = std::move(model);
+  entry->presentation = std::move(presentation);
 
   MutexLock lock(&mutex_);
   if (memory_used_ + entry->memory_bytes > limits_.max_memory_bytes) {

@@ -27,6 +27,16 @@
 
 namespace deform::service {
 
+// What a mesh's file says beyond the solve's mesh: the order clients see its vertices in, units,
+// up axis (from a glTF rig; empty for the other formats).
+struct MeshPresentation {
+  // Per vertex in the file's order (the order of frames, rest positions and vertex indices in the
+  // API), its vertex of the solved mesh; empty when they are the same.
+  std::vector<int> file_vertex_to_mesh;
+  std::string units;
+  std::string up_axis;
+};
+
 struct MeshEntry {
   std::string id;    // "mesh-<n>", never reused within a server's life
   std::string name;  // the client's label
@@ -35,6 +45,14 @@ struct MeshEntry {
   double factor_ms = 0;
   std::size_t factor_bytes = 0;
   std::size_t memory_bytes = 0;  // model->EstimatedBytes()
+  MeshPresentation presentation;
+
+  // Vertices of frames and rest positions as clients see them (the file's).
+  int client_vertex_count() const {
+    return presentation.file_vertex_to_mesh.empty()
+               ? model->mesh().num_vertices()
+               : static_cast<int>(presentation.file_vertex_to_mesh.size());
+  }
 
   mutable std::atomic<bool> unloaded{false};
   mutable std::atomic<int> open_streams{0};
@@ -72,8 +90,9 @@ class MeshRegistry {
 
   // Registers a built model under a new id, using `reservation`'s slot. RESOURCE_EXHAUSTED (the
   // slot is released) when the model does not fit in the memory budget.
-  StatusOr<std::shared_ptr<const MeshEntry>> Register(
-      Reservation reservation, std::string name, std::shared_ptr<const DeformationModel> model);
+  StatusOr<std::shared_ptr<const MeshEntry>> Register(Reservation reservation, std::string name,
+                                                      std::shared_ptr<const DeformationModel> model,
+                                                      MeshPresentation presentation = {});
 
   // NOT_FOUND for an unknown (or unloaded) id.
   StatusOr<std::shared_ptr<const MeshEntry>> Find(const std::string& mesh_id) const;

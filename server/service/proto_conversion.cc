@@ -93,7 +93,8 @@ StatusOr<ModelOptions> ModelOptionsFromProto(const v1::MethodOptions& proto,
 }
 
 StatusOr<Stiffness> StiffnessFromProto(const v1::StiffnessUpdate& proto,
-                                       const DeformationModel& model) {
+                                       const DeformationModel& model,
+                                       const std::vector<int>& client_order) {
   Stiffness stiffness;
   for (const v1::JointMaterialUpdate& update : proto.joint_materials()) {
     DEFORM_ASSIGN_OR_RETURN(const int joint,
@@ -115,7 +116,8 @@ StatusOr<Stiffness> StiffnessFromProto(const v1::StiffnessUpdate& proto,
         "vertex_indices has " + std::to_string(proto.vertex_indices_size()) +
         " entries but vertex_weights has " + std::to_string(proto.vertex_weights_size()));
   }
-  const std::uint32_t vertices = static_cast<std::uint32_t>(model.mesh().num_vertices());
+  const std::uint32_t vertices = static_cast<std::uint32_t>(
+      client_order.empty() ? model.mesh().num_vertices() : client_order.size());
   stiffness.vertex_weights.reserve(proto.vertex_indices_size());
   for (int k = 0; k < proto.vertex_indices_size(); ++k) {
     const std::uint32_t vertex = proto.vertex_indices(k);
@@ -126,7 +128,8 @@ StatusOr<Stiffness> StiffnessFromProto(const v1::StiffnessUpdate& proto,
     }
     DEFORM_RETURN_IF_ERROR(
         CheckMaterialWeight(proto.vertex_weights(k), "weight of vertex " + std::to_string(vertex)));
-    stiffness.vertex_weights.emplace_back(static_cast<int>(vertex), proto.vertex_weights(k));
+    const int solved = client_order.empty() ? static_cast<int>(vertex) : client_order[vertex];
+    stiffness.vertex_weights.emplace_back(solved, proto.vertex_weights(k));
   }
   return stiffness;
 }
@@ -136,7 +139,8 @@ void FillMeshSummary(const MeshEntry& entry, v1::MeshSummary* summary) {
   const Skeleton& skeleton = model.skeleton();
   summary->set_mesh_id(entry.id);
   summary->set_name(entry.name);
-  summary->set_vertex_count(static_cast<std::uint32_t>(model.mesh().num_vertices()));
+  summary->set_vertex_count(static_cast<std::uint32_t>(entry.client_vertex_count()));
+  summary->set_solved_vertex_count(static_cast<std::uint32_t>(model.mesh().num_vertices()));
   summary->set_triangle_count(static_cast<std::uint32_t>(model.mesh().num_triangles()));
   summary->set_bone_count(static_cast<std::uint32_t>(skeleton.num_bones()));
   summary->set_factor_bytes(entry.factor_bytes);
@@ -164,20 +168,47 @@ void FillMeshSummary(const MeshEntry& entry, v1::MeshSummary* summary) {
     }
     info->set_has_region(FindJointRegion(model.joint_regions(), j) >= 0);
   }
+  summary->clear_bones();
+  for (const Bone& bone : skeleton.bones()) {
+    v1::BoneInfo* info = summary->add_bones();
+    info->set_head_joint(static_cast<std::uint32_t>(bone.head_joint));
+    info->set_tail_joint(static_cast<std::uint32_t>(bone.tail_joint));
+    info->set_parent_bone(bone.parent_bone);
+  }
+  summary->set_binding(model.weights_given() ? v1::BINDING_WEIGHTS : v1::BINDING_THROUGH_BODY);
+  summary->clear_warnings();
+  for (const std::string& warning : model.binding_report().warnings) summary->add_warnings(warning);
+  summary->set_units(entry.presentation.units);
+  summary->set_up_axis(entry.presentation.up_axis);
 }
 
-void FillMeshGeometry(const DeformationModel& model, v1::GetMeshInfoResponse* info) {
-  const TriangleMesh& mesh = model.mesh();
+void FillMeshGeometry(const MeshEntry& entry, v1::GetMeshInfoResponse* info) {
+  const TriangleMesh& mesh = entry.model->mesh();
+  const std::vector<int>& order = entry.presentation.file_vertex_to_mesh;
   std::string* positions = info->mutable_rest_positions();
-  positions->resize(static_cast<std::size_t>(mesh.num_vertices()) * 3 * 4);
-  EncodeFloat32(mesh.vertices.data(), static_cast<std::size_t>(mesh.num_vertices()) * 3,
-                positions->data());
+  positions->resize(static_cast<std::size_t>(entry.client_vertex_count()) * 3 * 4);
+  EncodeInClientOrder(mesh.vertices.data(), mesh.num_vertices(), order, positions->data());
+  // Triangles name client vertices: each solved vertex by the first file vertex welded into it.
+  std::vector<int> client_of(mesh.num_vertices(), -1);
+  for (int f = static_cast<int>(order.size()) - 1; f >= 0; --f) client_of[order[f]] = f;
   std::string* triangles = info->mutable_triangles();
   const std::size_t indices = static_cast<std::size_t>(mesh.num_triangles()) * 3;
   triangles->resize(indices * 4);
   const int* source = mesh.triangles.data();
   for (std::size_t k = 0; k < indices; ++k) {
-    PutUint32(static_cast<std::uint32_t>(source[k]), triangles->data() + 4 * k);
+    const int vertex = order.empty() ? source[k] : client_of[source[k]];
+    PutUint32(static_cast<std::uint32_t>(vertex), triangles->data() + 4 * k);
+  }
+}
+
+void EncodeInClientOrder(const double* xyz, int solved_vertices, const std::vector<int>& order,
+                         char* out) {
+  if (order.empty()) {
+    EncodeFloat32(xyz, static_cast<std::size_t>(solved_vertices) * 3, out);
+    return;
+  }
+  for (std::size_t f = 0; f < order.size(); ++f) {
+    EncodeFloat32(xyz + 3 * static_cast<std::size_t>(order[f]), 3, out + 12 * f);
   }
 }
 

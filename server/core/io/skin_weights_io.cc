@@ -99,16 +99,20 @@ StatusOr<SkinWeights> ReadSkinWeightsFile(const std::string& path, const MeshLim
   return weights;
 }
 
+void WidenSkinWeights(SkinWeightsFormat format, int num_vertices, int num_bones,
+                      SkinWeights* weights) {
+  if (format != SkinWeightsFormat::kCsv) return;
+  weights->num_bones = std::max(weights->num_bones, num_bones);
+  if (weights->num_vertices() < num_vertices) {
+    weights->offsets.resize(static_cast<std::size_t>(num_vertices) + 1, weights->offsets.back());
+  }
+}
+
 StatusOr<SkinWeights> LoadSkinWeightsFile(const std::string& path, int num_vertices, int num_bones,
                                           const MeshLimits& limits) {
   DEFORM_ASSIGN_OR_RETURN(const SkinWeightsFormat format, SkinWeightsFormatFromPath(path));
   DEFORM_ASSIGN_OR_RETURN(SkinWeights weights, ReadSkinWeightsFile(path, limits));
-  if (format == SkinWeightsFormat::kCsv) {
-    weights.num_bones = std::max(weights.num_bones, num_bones);
-    if (weights.num_vertices() < num_vertices) {
-      weights.offsets.resize(static_cast<std::size_t>(num_vertices) + 1, weights.offsets.back());
-    }
-  }
+  WidenSkinWeights(format, num_vertices, num_bones, &weights);
   StatusOr<SkinWeights> normalized = NormalizeSkinWeights(weights, num_vertices, num_bones);
   if (!normalized.ok()) return normalized.status().WithContext(path);
   return normalized;

@@ -55,6 +55,11 @@ StatusOr<SkinWeights> ReadSkinWeights(std::string_view bytes, SkinWeightsFormat 
 // opened; errors carry the path.
 StatusOr<SkinWeights> ReadSkinWeightsFile(const std::string& path, const MeshLimits& limits = {});
 
+// A CSV names only the vertices and bones it mentions: widens its counts to the mesh's and the
+// skeleton's (never narrows them). A DMAT's counts are left as read (they must match).
+void WidenSkinWeights(SkinWeightsFormat format, int num_vertices, int num_bones,
+                      SkinWeights* weights);
+
 // ReadSkinWeightsFile, then NormalizeSkinWeights against a mesh of `num_vertices` and a skeleton
 // of `num_bones`. A CSV names only the vertices and bones it mentions, so its counts are first
 // widened to the mesh's and skeleton's (never narrowed): a vertex it leaves out is then reported as

@@ -1,0 +1,138 @@
+// Rigs over gRPC: a skinned glTF written by the test, and the same mesh, skeleton and weights
+// uploaded as OBJ + JSON + CSV, deform alike (frames in the glTF file's own vertex order, seams
+// included); the summary says where the binding came from, carries the bones and the warnings.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iterator>
+
+#include "core/io/gltf_writer.h"
+#include "core/io/mesh_io.h"
+#include "core/io/phantom.h"
+#include "core/io/skeleton_io.h"
+#include "core/model/deformation_model.h"
+#include "tests/service/service_fixture.h"
+
+namespace deform {
+namespace {
+
+using ::testing::HasSubstr;
+
+class RigUploadTest : public test_support::ServiceTest {};
+
+std::vector<float> FrameFor(client::DeformClient& client, const std::string& mesh_id,
+                            const std::string& spec) {
+  test_support::StreamRecorder recorder(/*keep_positions=*/true);
+  auto stream = client.OpenStream(mesh_id, recorder.Callbacks());
+  v1::PoseUpdate pose;
+  std::string error;
+  EXPECT_TRUE(client::ParsePoseAngles(spec, &pose, &error)) << error;
+  pose.set_sequence(1);
+  EXPECT_TRUE(stream->SendPose(pose));
+  EXPECT_TRUE(recorder.WaitForFrameWithSequence(1));
+  stream->Close();
+  EXPECT_TRUE(stream->Wait().ok());
+  return client::DecodePositions(recorder.last_frame().positions());
+}
+
+// The phantom's harmonic binding as skinning weights (the CSV text and the core's SkinWeights).
+std::pair<SkinWeights, std::string> PhantomWeights(const KneePhantom& phantom) {
+  auto model = DeformationModel::Build(phantom.mesh, phantom.skeleton, ModelOptions::Paper());
+  EXPECT_TRUE(model.ok());
+  const BoneWeights& h = (*model)->bone_weights();
+  SkinWeights weights;
+  weights.num_bones = phantom.skeleton.num_bones();
+  std::string csv = "vertex,bone,weight\n";
+  for (int i = 0; i < phantom.mesh.num_vertices(); ++i) {
+    std::vector<int> bones;
+    std::vector<double> values;
+    for (int e = h.offsets[i]; e < h.offsets[i + 1]; ++e) {
+      bones.push_back(h.bones[e]);
+      values.push_back(h.weights[e]);
+      char line[96];
+      std::snprintf(line, sizeof line, "%d,%d,%.17g\n", i, h.bones[e], h.weights[e]);
+      csv += line;
+    }
+    weights.AddVertex(bones, values);
+  }
+  return {weights, csv};
+}
+
+TEST_F(RigUploadTest, GltfRigDeformsLikeTheSameRigAsObjJsonAndWeights) {
+  StartServer();
+  auto phantom = MakeKneePhantom(600);
+  ASSERT_TRUE(phantom.ok());
+  const auto [weights, csv] = PhantomWeights(*phantom);
+  auto glb = WriteGltf(phantom->mesh, phantom->skeleton, weights, GltfContainer::kGlb);
+  ASSERT_TRUE(glb.ok()) << glb.status().ToString();
+
+  v1::LoadMeshHeader gltf_header;
+  gltf_header.mutable_upload()->set_format(v1::MESH_FORMAT_GLTF);
+  v1::MeshSummary gltf_summary;
+  grpc::Status loaded = client_->LoadMesh(gltf_header, *glb, &gltf_summary);
+  ASSERT_TRUE(loaded.ok()) << loaded.error_message();
+  EXPECT_EQ(gltf_summary.binding(), v1::BINDING_WEIGHTS);
+  EXPECT_EQ(gltf_summary.units(), "metre");
+  EXPECT_EQ(gltf_summary.bones_size(), phantom->skeleton.num_bones());
+
+  // The same rig as OBJ + the project's JSON skeleton + CSV weights.
+  const std::string obj_path = ::testing::TempDir() + "/rig_upload.obj";
+  ASSERT_TRUE(WriteMeshFile(phantom->mesh, obj_path).ok());
+  std::ifstream obj_file(obj_path);
+  const std::string obj((std::istreambuf_iterator<char>(obj_file)), {});
+  v1::LoadMeshHeader files_header;
+  v1::UploadSource* upload = files_header.mutable_upload();
+  upload->set_format(v1::MESH_FORMAT_OBJ);
+  upload->set_skeleton_format(v1::SKELETON_FORMAT_JSON);
+  upload->set_skeleton(SkeletonToJson(phantom->skeleton));
+  upload->set_weights_format(v1::SKIN_WEIGHTS_FORMAT_CSV);
+  upload->set_weights(csv);
+  v1::MeshSummary files_summary;
+  loaded = client_->LoadMesh(files_header, obj, &files_summary);
+  ASSERT_TRUE(loaded.ok()) << loaded.error_message();
+  EXPECT_EQ(files_summary.binding(), v1::BINDING_WEIGHTS);
+
+  // glTF joints carry no named degrees of freedom: rest-frame axes (flexion is +X).
+  const std::string spec = "knee:x:80,knee:y:10";
+  const std::vector<float> from_gltf = FrameFor(*client_, gltf_summary.mesh_id(), spec);
+  const std::vector<float> from_files = FrameFor(*client_, files_summary.mesh_id(), spec);
+  ASSERT_EQ(from_gltf.size(), 3u * gltf_summary.vertex_count());
+  ASSERT_EQ(from_files.size(), 3u * phantom->mesh.num_vertices());
+  // The written glTF keeps the mesh's vertex order (no seams), so the orders agree.
+  ASSERT_EQ(from_gltf.size(), from_files.size());
+  const double diagonal = BoundingBoxDiagonal(phantom->mesh.vertices);
+  double worst = 0;
+  for (std::size_t c = 0; c < from_gltf.size(); ++c) {
+    worst = std::max(worst, static_cast<double>(std::abs(from_gltf[c] - from_files[c])));
+  }
+  EXPECT_LT(worst, 1e-6 * diagonal);
+  ExpectBackgroundStreamAlive();
+}
+
+TEST_F(RigUploadTest, GltfUploadRefusesASkeletonBesideIt) {
+  StartServer();
+  v1::LoadMeshHeader header;
+  header.mutable_upload()->set_format(v1::MESH_FORMAT_GLTF);
+  header.mutable_upload()->set_skeleton("not wanted");
+  v1::MeshSummary summary;
+  const grpc::Status status = client_->LoadMesh(header, "glTF", &summary);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("carries its own skeleton"));
+}
+
+TEST_F(RigUploadTest, SummaryCarriesBonesAndTheAutomaticBinding) {
+  StartServer();
+  v1::MeshSummary summary;
+  LoadPhantom(500, {}, &summary);
+  EXPECT_EQ(summary.binding(), v1::BINDING_THROUGH_BODY);
+  EXPECT_EQ(summary.bones_size(), 2);
+  EXPECT_EQ(summary.bones(1).parent_bone(), 0);
+  EXPECT_TRUE(summary.warnings().empty());
+  EXPECT_EQ(summary.solved_vertex_count(), summary.vertex_count());
+}
+
+}  // namespace
+}  // namespace deform
