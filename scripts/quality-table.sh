@@ -1,29 +1,41 @@
 #!/usr/bin/env bash
-# Prints a markdown table of the quality measures of all five methods (paper, its linear-blend
-# fast path paper-linear, laplacian, lbs, dqs) at 45, 90 and 120 degrees of flexion, for the built-in phantom and, where ../shared/data
-# is present, the shared leg and arm. Needs a build (scripts/build.sh) and python3.
+# Prints a markdown table of the quality measures of all five methods (paper, its linear-blend fast
+# path paper-linear, laplacian, lbs, dqs) at 45, 90 and 120 degrees, for the built-in phantom and,
+# where ../shared/data is present, the shared legs, the arm (its natural elbow flexion, a negative
+# angle; with the binding through the body and with its authored weights) and the whole body (a
+# multi-joint pose: left knee DEG, left hip flexed DEG/2, right knee DEG/2). Needs a build
+# (scripts/build.sh) and python3.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 DEFORMCTL="${DEFORM_BUILD_DIR:-build}/server/deformctl/deformctl"
 DATA="${DEFORM_SHARED_DATA:-../shared/data}"
 
-# name | mesh | skeleton | joint:axis | sign of the angle
-CASES=("phantom_2k|||knee:flexion|1")
+# name | mesh | skeleton | weights | pose, DEG and HALF standing for the angle and its half
+CASES=("phantom_2k||||knee:flexion:DEG")
 for mesh in leg_1633 leg_25969; do
-  [ -f "$DATA/leg/$mesh.obj" ] && CASES+=("$mesh|$DATA/leg/$mesh.obj|$DATA/leg/leg.tgf|1:x|1")
+  [ -f "$DATA/leg/$mesh.obj" ] && CASES+=("$mesh|$DATA/leg/$mesh.obj|$DATA/leg/leg.tgf||1:x:DEG")
 done
-[ -f "$DATA/arm/arm_132946.obj" ] && CASES+=("arm_132946|$DATA/arm/arm_132946.obj|$DATA/arm/arm.tgf|2:z|-1")
+if [ -f "$DATA/arm/arm_8311.obj" ]; then
+  CASES+=("arm_8311|$DATA/arm/arm_8311.obj|$DATA/arm/arm.tgf||2:z:-DEG")
+  CASES+=("arm_8311 (authored weights)|$DATA/arm/arm_8311.obj|$DATA/arm/arm.tgf|$DATA/arm/arm_8311_weights.dmat|2:z:-DEG")
+fi
+[ -f "$DATA/arm/arm_132946.obj" ] &&
+  CASES+=("arm_132946|$DATA/arm/arm_132946.obj|$DATA/arm/arm.tgf||2:z:-DEG")
+[ -f "$DATA/body/body_13380.obj" ] &&
+  CASES+=("body_13380|$DATA/body/body_13380.obj|$DATA/body/body.tgf||joint5:x:DEG,joint4:x:-HALF,joint10:x:HALF")
 
 echo "| mesh | degrees | method | volume_change | clearance_min | clearance_p01 | sink_fraction | rigid_zone_error |"
 echo "|---|---|---|---|---|---|---|---|"
 for case in "${CASES[@]}"; do
-  IFS='|' read -r name mesh skeleton joint sign <<<"$case"
+  IFS='|' read -r name mesh skeleton weights pose <<<"$case"
   args=()
   [ -n "$mesh" ] && args=(--mesh "$mesh" --skeleton "$skeleton")
+  [ -n "$weights" ] && args+=(--weights "$weights")
   for degrees in 45 90 120; do
-    angle=$((degrees * sign))
+    spec=${pose//DEG/$degrees}
+    spec=${spec//HALF/$((degrees / 2))}
     for method in paper paper-linear laplacian lbs dqs; do
-      "$DEFORMCTL" deform "${args[@]}" --pose "$joint:$angle" --method "$method" |
+      "$DEFORMCTL" deform "${args[@]}" --pose "$spec" --method "$method" 2>/dev/null |
         python3 -c "import json,sys; d=json.load(sys.stdin); print('| $name | $degrees | $method | %+.4f | %.3f | %.3f | %.4f | %.1e |' % (d['volume_change'], d['clearance_min'], d['clearance_p01'], d['sink_fraction'], d['rigid_zone_error']))"
     done
   done

@@ -56,4 +56,13 @@ grpc::Status WaitForServer(client::DeformClient& client, const ConnectionArgs& a
       "cannot reach " + args.target + " within " + std::to_string(args.connect_timeout_ms) + " ms");
 }
 
+grpc::Status ConnectAndAcquire(client::DeformClient& client, const ConnectionArgs& connection,
+                               const MeshSource& source, deform::v1::MeshSummary* summary,
+                               bool* loaded) {
+  *loaded = false;
+  const grpc::Status connected = WaitForServer(client, connection);
+  if (!connected.ok()) return connected;
+  return AcquireMesh(client, source, summary, loaded);
+}
+
 }  // namespace deform::cli

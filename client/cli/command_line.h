@@ -42,4 +42,9 @@ int ReportFailure(const char* program, const grpc::Status& status);
 // Waits up to args.connect_timeout_ms for the server; UNAVAILABLE naming the target otherwise.
 grpc::Status WaitForServer(client::DeformClient& client, const ConnectionArgs& args);
 
+// WaitForServer, then AcquireMesh (mesh_source.h): the start of every command-line client's run.
+grpc::Status ConnectAndAcquire(client::DeformClient& client, const ConnectionArgs& connection,
+                               const MeshSource& source, deform::v1::MeshSummary* summary,
+                               bool* loaded);
+
 }  // namespace deform::cli

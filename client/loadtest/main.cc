@@ -95,11 +95,10 @@ int RunOnMesh(deform::client::DeformClient& client, const LoadtestArgs& args,
 
 int Run(const LoadtestArgs& args) {
   deform::client::DeformClient client(args.connection.target);
-  const grpc::Status connected = deform::cli::WaitForServer(client, args.connection);
-  if (!connected.ok()) return Fail(connected);
   deform::v1::MeshSummary summary;
   bool loaded = false;
-  const grpc::Status acquired = deform::cli::AcquireMesh(client, args.source, &summary, &loaded);
+  const grpc::Status acquired =
+      deform::cli::ConnectAndAcquire(client, args.connection, args.source, &summary, &loaded);
   if (!acquired.ok()) return Fail(acquired);
 
   const int code = RunOnMesh(client, args, summary);

@@ -1,6 +1,10 @@
 #include "core/geometry/mesh_topology.h"
 
 #include <algorithm>
+#include <functional>
+#include <limits>
+#include <queue>
+#include <utility>
 
 namespace deform {
 
@@ -50,6 +54,37 @@ int ConnectedComponents(const VertexAdjacency& adjacency, std::vector<int>* comp
     ++count;
   }
   return count;
+}
+
+std::vector<double> SurfaceDistances(const Positions& vertices, const VertexAdjacency& adjacency,
+                                     const std::vector<int>& sources,
+                                     std::vector<int>* nearest_source) {
+  const int n = static_cast<int>(vertices.rows());
+  std::vector<double> distance(n, std::numeric_limits<double>::infinity());
+  std::vector<int> source_of(n, -1);
+  using Entry = std::pair<double, int>;
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> queue;
+  for (int s : sources) {
+    distance[s] = 0;
+    source_of[s] = s;
+    queue.emplace(0.0, s);
+  }
+  while (!queue.empty()) {
+    const auto [d, i] = queue.top();
+    queue.pop();
+    if (d > distance[i]) continue;
+    for (int p = adjacency.offsets[i]; p < adjacency.offsets[i + 1]; ++p) {
+      const int j = adjacency.neighbors[p];
+      const double through = d + (vertices.row(i) - vertices.row(j)).norm();
+      if (through < distance[j]) {
+        distance[j] = through;
+        source_of[j] = source_of[i];
+        queue.emplace(through, j);
+      }
+    }
+  }
+  if (nearest_source != nullptr) *nearest_source = std::move(source_of);
+  return distance;
 }
 
 bool IsClosed(const Triangles& triangles) {

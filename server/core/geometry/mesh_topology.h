@@ -21,6 +21,13 @@ VertexAdjacency BuildVertexAdjacency(const Triangles& triangles, int num_vertice
 // Component label (0-based, in order of the lowest vertex) of every vertex; returns the count.
 int ConnectedComponents(const VertexAdjacency& adjacency, std::vector<int>* component);
 
+// Shortest distances along the mesh's edges (Euclidean edge lengths) from the `sources` to every
+// vertex: infinity where no source is connected. With `nearest_source`, also the source each vertex
+// is nearest to (-1 where none). Multi-source Dijkstra, O((V + E) log V).
+std::vector<double> SurfaceDistances(const Positions& vertices, const VertexAdjacency& adjacency,
+                                     const std::vector<int>& sources,
+                                     std::vector<int>* nearest_source = nullptr);
+
 // Whether every edge is shared by two triangles (no boundary): the mesh encloses a volume.
 bool IsClosed(const Triangles& triangles);
 

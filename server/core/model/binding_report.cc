@@ -55,33 +55,6 @@ std::vector<std::vector<int>> Pieces(const VertexAdjacency& adjacency,
   return pieces;
 }
 
-// Distance along the surface (over mesh edges) from `main` to every vertex; infinity where the
-// mesh does not connect them.
-std::vector<double> SurfaceDistanceFrom(const Positions& vertices, const VertexAdjacency& adjacency,
-                                        const std::vector<int>& main) {
-  std::vector<double> distance(vertices.rows(), std::numeric_limits<double>::infinity());
-  using Entry = std::pair<double, int>;
-  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> queue;
-  for (int i : main) {
-    distance[i] = 0;
-    queue.emplace(0.0, i);
-  }
-  while (!queue.empty()) {
-    const auto [d, i] = queue.top();
-    queue.pop();
-    if (d > distance[i]) continue;
-    for (int p = adjacency.offsets[i]; p < adjacency.offsets[i + 1]; ++p) {
-      const int j = adjacency.neighbors[p];
-      const double through = d + (vertices.row(i) - vertices.row(j)).norm();
-      if (through < distance[j]) {
-        distance[j] = through;
-        queue.emplace(through, j);
-      }
-    }
-  }
-  return distance;
-}
-
 double Median(std::vector<double> values) {
   if (values.empty()) return 0;
   const auto middle = values.begin() + values.size() / 2;
@@ -107,7 +80,7 @@ void ReportBone(const TriangleMesh& mesh, const Skeleton& skeleton,
   const std::vector<std::vector<int>> pieces = Pieces(adjacency, rigid_bone, k, seen);
   for (const auto& piece : pieces) report->pieces.push_back(static_cast<int>(piece.size()));
   if (pieces.size() > 1) {
-    const std::vector<double> along = SurfaceDistanceFrom(mesh.vertices, adjacency, pieces.front());
+    const std::vector<double> along = SurfaceDistances(mesh.vertices, adjacency, pieces.front());
     for (std::size_t p = 1; p < pieces.size(); ++p) {
       double gap = std::numeric_limits<double>::infinity();
       for (int i : pieces[p]) gap = std::min(gap, along[i]);

@@ -1,9 +1,7 @@
 #include "core/model/body_binding.h"
 
 #include <algorithm>
-#include <functional>
 #include <limits>
-#include <queue>
 #include <utility>
 
 namespace deform {
@@ -49,34 +47,21 @@ NearestBone FirstVisibleBone(const Skeleton& skeleton, const TriangleBvh& bvh,
   return NearestBone{};
 }
 
-// Gives every vertex with bone -1 the bone of the nearest bound vertex along mesh edges (multi-
-// source Dijkstra); returns how many it reached.
+// Gives every vertex with bone -1 the bone of the nearest bound vertex along mesh edges; returns
+// how many it reached.
 int PropagateAlongSurface(const TriangleMesh& mesh, const VertexAdjacency& adjacency,
                           std::vector<int>* bone) {
-  const int n = mesh.num_vertices();
-  std::vector<double> distance(n, std::numeric_limits<double>::infinity());
-  using Entry = std::pair<double, int>;
-  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> queue;
-  for (int i = 0; i < n; ++i) {
-    if ((*bone)[i] >= 0) {
-      distance[i] = 0;
-      queue.emplace(0.0, i);
-    }
+  std::vector<int> bound;
+  for (int i = 0; i < mesh.num_vertices(); ++i) {
+    if ((*bone)[i] >= 0) bound.push_back(i);
   }
+  std::vector<int> nearest;
+  SurfaceDistances(mesh.vertices, adjacency, bound, &nearest);
   int reached = 0;
-  while (!queue.empty()) {
-    const auto [d, i] = queue.top();
-    queue.pop();
-    if (d > distance[i]) continue;
-    for (int p = adjacency.offsets[i]; p < adjacency.offsets[i + 1]; ++p) {
-      const int j = adjacency.neighbors[p];
-      const double through = d + (mesh.vertices.row(i) - mesh.vertices.row(j)).norm();
-      if (through < distance[j]) {
-        if (distance[j] == std::numeric_limits<double>::infinity()) ++reached;
-        distance[j] = through;
-        (*bone)[j] = (*bone)[i];
-        queue.emplace(through, j);
-      }
+  for (int i = 0; i < mesh.num_vertices(); ++i) {
+    if ((*bone)[i] < 0 && nearest[i] >= 0) {
+      (*bone)[i] = (*bone)[nearest[i]];
+      ++reached;
     }
   }
   return reached;
