@@ -159,6 +159,11 @@ StatusOr<AccessorValues> ReadAccessor(const tinygltf::Model& model, int index,
     return Status::InvalidArgument(what + " is sparse; sparse accessors are not supported");
   }
   if (accessor.count == 0) return Status::InvalidArgument(what + " has no elements");
+  if (spec.exact_count != 0 && accessor.count != spec.exact_count) {
+    return Status::InvalidArgument(what + " has " + std::to_string(accessor.count) +
+                                   " elements; expected " + std::to_string(spec.exact_count) +
+                                   " (one per vertex)");
+  }
   if (accessor.bufferView < 0 ||
       static_cast<std::size_t>(accessor.bufferView) >= model.bufferViews.size()) {
     return Status::InvalidArgument(what + " has no valid bufferView (" +

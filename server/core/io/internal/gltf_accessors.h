@@ -24,6 +24,8 @@ struct AccessorSpec {
   // More elements are RESOURCE_EXHAUSTED (checked before anything is allocated).
   std::uint64_t max_count = std::numeric_limits<std::uint64_t>::max();
   const char* limit_noun = "elements";  // for that message: "vertices", "indices"
+  // When non-zero, any other element count is INVALID_ARGUMENT (one element per vertex...).
+  std::uint64_t exact_count = 0;
 };
 
 // An accessor's elements as doubles, `components` values an element, row after row. Normalised
@@ -42,7 +44,8 @@ struct AccessorValues {
 // Reads accessor `index` of `model`. INVALID_ARGUMENT naming spec.what and the accessor when the
 // index, type, component type, normalisation, bufferView, stride, offset or count is not what the
 // spec allows or does not fit the buffer data, for sparse accessors (not supported) and for
-// non-finite floats; RESOURCE_EXHAUSTED beyond spec.max_count.
+// non-finite floats, and for a count other than spec.exact_count; RESOURCE_EXHAUSTED beyond
+// spec.max_count.
 StatusOr<AccessorValues> ReadAccessor(const tinygltf::Model& model, int index,
                                       const AccessorSpec& spec);
 

@@ -130,12 +130,14 @@ StatusOr<RigSkeleton> BuildRigSkeleton(const std::vector<SkinJoint>& joints,
   }
   RigSkeleton rig;
   DEFORM_ASSIGN_OR_RETURN(rig.skeleton, Skeleton::Create(std::move(skeleton_joints), bones));
+  std::vector<std::vector<int>> bones_of_head(static_cast<std::size_t>(rig.skeleton.num_joints()));
+  for (int b = 0; b < rig.skeleton.num_bones(); ++b) {
+    bones_of_head[static_cast<std::size_t>(rig.skeleton.bone(b).head_joint)].push_back(b);
+  }
   rig.bones_of_joint.resize(joints.size());
   for (std::size_t j = 0; j < joints.size(); ++j) {
-    const int s = skeleton_joint[static_cast<std::size_t>(kept_as[j])];
-    for (int b = 0; b < rig.skeleton.num_bones(); ++b) {
-      if (rig.skeleton.bone(b).head_joint == s) rig.bones_of_joint[j].push_back(b);
-    }
+    rig.bones_of_joint[j] = bones_of_head[static_cast<std::size_t>(
+        skeleton_joint[static_cast<std::size_t>(kept_as[j])])];
   }
   return rig;
 }

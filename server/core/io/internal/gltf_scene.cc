@@ -101,6 +101,7 @@ StatusOr<SceneNodes> ReadSceneNodes(const tinygltf::Model& model) {
                        : Eigen::Matrix4d(scene.world[static_cast<std::size_t>(parent)] *
                                          local[static_cast<std::size_t>(*it)]);
       done[static_cast<std::size_t>(*it)] = 1;
+      scene.parents_first.push_back(*it);
     }
   }
   return scene;

@@ -15,6 +15,7 @@ struct SceneNodes {
   // Per node: the product of the local transforms (matrix, or translation * rotation * scale)
   // from the root down to the node; model units (metres for glTF).
   std::vector<Eigen::Matrix4d> world;
+  std::vector<int> parents_first;  // every node, each after its parent
 };
 
 // INVALID_ARGUMENT for a child index out of range, a node with two parents, a cycle, or a local
