@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -49,7 +50,10 @@ StatusOr<std::shared_ptr<const DeformationModel>> VariantFor(const DeformationMo
       options.rotation_blend == paper_model.options().rotation_blend) {
     return std::shared_ptr<const DeformationModel>();
   }
-  return DeformationModel::Build(paper_model.mesh(), paper_model.skeleton(), options);
+  // The same binding: the paper model's given weights, when it was built with some.
+  const std::optional<SkinWeights>& weights = paper_model.given_weights();
+  return DeformationModel::Build(paper_model.mesh(), paper_model.skeleton(), options,
+                                 weights.has_value() ? &*weights : nullptr);
 }
 
 // Paper, paper-linear and laplacian: `repeat` frames of the model's Deform().

@@ -175,7 +175,7 @@ Status DeformationModel::BindToWeights(const SkinWeights& weights,
   rigid_bones_ = binding.rigid_bone;
   bound_bones_ = binding.main_bone;
   bone_weights_ = BoneWeightsFromSkinWeights(normalized);
-  weights_given_ = true;
+  given_weights_ = normalized;
   binding_report_.source = "given weights";
   return Status::Ok();
 }

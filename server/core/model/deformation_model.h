@@ -23,6 +23,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "core/base/status.h"
@@ -178,7 +179,10 @@ class DeformationModel {
   // largest given weight's bone).
   const std::vector<int>& bound_bones() const { return bound_bones_; }
   const BindingReport& binding_report() const { return binding_report_; }
-  bool weights_given() const { return weights_given_; }
+  bool weights_given() const { return given_weights_.has_value(); }
+  // The skinning weights Build was given (normalised), for building a variant with the same
+  // binding; empty when the model bound automatically.
+  const std::optional<SkinWeights>& given_weights() const { return given_weights_; }
   int num_joint_nodes() const { return system_.num_nodes; }
   double bounding_box_diagonal() const { return diagonal_; }
   // Seconds spent in Build() before the first numeric factorisation.
@@ -221,7 +225,7 @@ class DeformationModel {
   JointRegions regions_;
   std::vector<int> rigid_bones_;
   std::vector<int> bound_bones_;
-  bool weights_given_ = false;
+  std::optional<SkinWeights> given_weights_;
   BindingReport binding_report_;
   LaplacianSystem system_;  // L', the rest deltas, the anchors and joint nodes
   std::shared_ptr<const SymbolicCholesky> symbolic_;

@@ -53,10 +53,11 @@ struct ModelOptions {
   // Weigh the joint node as exactly one more neighbour (METHOD.md's 1/(d_i + 1)). Default: false.
   bool joint_node_one_neighbor = false;
   // Weight of the rows that move anchor vertices with their skinning (rigidly with their bone in
-  // a rigid zone). Default: 20: with every rigid-zone vertex anchored, rigid zones then stay
-  // within 3e-4 of the diagonal of linear blend skinning on the shared leg at 120 degrees
-  // (1e-3 at 10), at the same volume and clearance to 0.01.
-  double anchor_weight = 20;
+  // a rigid zone). Default: 40: with every rigid-zone vertex anchored, rigid zones then stay
+  // within 1e-4 of the diagonal of linear blend skinning on the shared leg at 120 degrees (1e-3
+  // at 10, 2.6e-4 at 20; the shared body in a three-joint pose 1.8e-3 at 20), at the same volume
+  // and clearance to 0.003.
+  double anchor_weight = 40;
   // Anchors are vertices in a bone's rigid zone (weight 1) at least this many region radii away
   // from every joint centre. Default: 2.
   double anchor_distance_factor = 2.0;
