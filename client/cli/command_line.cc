@@ -56,13 +56,24 @@ grpc::Status WaitForServer(client::DeformClient& client, const ConnectionArgs& a
       "cannot reach " + args.target + " within " + std::to_string(args.connect_timeout_ms) + " ms");
 }
 
-grpc::Status ConnectAndAcquire(client::DeformClient& client, const ConnectionArgs& connection,
-                               const MeshSource& source, deform::v1::MeshSummary* summary,
-                               bool* loaded) {
-  *loaded = false;
+int RunOnAcquiredMesh(
+    const char* program, const ConnectionArgs& connection, const MeshSource& source,
+    const std::function<int(client::DeformClient&, const deform::v1::MeshSummary&)>& run_on_mesh,
+    const std::function<bool(bool loaded)>& unload) {
+  client::DeformClient client(connection.target);
   const grpc::Status connected = WaitForServer(client, connection);
-  if (!connected.ok()) return connected;
-  return AcquireMesh(client, source, summary, loaded);
+  if (!connected.ok()) return ReportFailure(program, connected);
+  deform::v1::MeshSummary summary;
+  bool loaded = false;
+  const grpc::Status acquired = AcquireMesh(client, source, &summary, &loaded);
+  if (!acquired.ok()) return ReportFailure(program, acquired);
+  const int code = run_on_mesh(client, summary);
+  if (unload(loaded)) {
+    // After a failed run the unload is best effort: the run's error is the one reported.
+    const grpc::Status unloaded = client.UnloadMesh(summary.mesh_id());
+    if (!unloaded.ok() && code == 0) return ReportFailure(program, unloaded);
+  }
+  return code;
 }
 
 }  // namespace deform::cli

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -42,9 +43,13 @@ int ReportFailure(const char* program, const grpc::Status& status);
 // Waits up to args.connect_timeout_ms for the server; UNAVAILABLE naming the target otherwise.
 grpc::Status WaitForServer(client::DeformClient& client, const ConnectionArgs& args);
 
-// WaitForServer, then AcquireMesh (mesh_source.h): the start of every command-line client's run.
-grpc::Status ConnectAndAcquire(client::DeformClient& client, const ConnectionArgs& connection,
-                               const MeshSource& source, deform::v1::MeshSummary* summary,
-                               bool* loaded);
+// A command-line client's run: connects (WaitForServer), acquires the mesh (AcquireMesh), calls
+// `run_on_mesh`, then unloads the mesh when `unload(loaded)` says so (`loaded`: this run loaded
+// it). Failures are reported as "program: ..." lines. Returns run_on_mesh's exit code, or 1 when
+// connecting, acquiring or (after a successful run) unloading failed.
+int RunOnAcquiredMesh(
+    const char* program, const ConnectionArgs& connection, const MeshSource& source,
+    const std::function<int(client::DeformClient&, const deform::v1::MeshSummary&)>& run_on_mesh,
+    const std::function<bool(bool loaded)>& unload);
 
 }  // namespace deform::cli

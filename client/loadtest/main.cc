@@ -94,20 +94,12 @@ int RunOnMesh(deform::client::DeformClient& client, const LoadtestArgs& args,
 }
 
 int Run(const LoadtestArgs& args) {
-  deform::client::DeformClient client(args.connection.target);
-  deform::v1::MeshSummary summary;
-  bool loaded = false;
-  const grpc::Status acquired =
-      deform::cli::ConnectAndAcquire(client, args.connection, args.source, &summary, &loaded);
-  if (!acquired.ok()) return Fail(acquired);
-
-  const int code = RunOnMesh(client, args, summary);
-  if (!args.keep_mesh) {
-    // The run is over: a failed unload is reported but does not change the exit code.
-    const grpc::Status unloaded = client.UnloadMesh(summary.mesh_id());
-    if (!unloaded.ok()) Fail(unloaded);
-  }
-  return code;
+  return deform::cli::RunOnAcquiredMesh(
+      kProgram, args.connection, args.source,
+      [&](deform::client::DeformClient& client, const deform::v1::MeshSummary& summary) {
+        return RunOnMesh(client, args, summary);
+      },
+      [&](bool loaded) { return loaded && !args.keep_mesh; });
 }
 
 void AddFlags(CLI::App& app, LoadtestArgs& args) {

@@ -129,20 +129,12 @@ int RunOnMesh(deform::client::DeformClient& client, const VrArgs& args,
 }
 
 int Run(const VrArgs& args) {
-  deform::client::DeformClient client(args.connection.target);
-  deform::v1::MeshSummary summary;
-  bool loaded = false;
-  const grpc::Status acquired =
-      deform::cli::ConnectAndAcquire(client, args.connection, args.source, &summary, &loaded);
-  if (!acquired.ok()) return Fail(acquired);
-
-  const int code = RunOnMesh(client, args, summary);
-  if (args.unload || (loaded && !args.keep_mesh)) {
-    // After a failed run the unload is best effort: the run's error is the one reported.
-    const grpc::Status unloaded = client.UnloadMesh(summary.mesh_id());
-    if (!unloaded.ok() && code == 0) return Fail(unloaded);
-  }
-  return code;
+  return deform::cli::RunOnAcquiredMesh(
+      kProgram, args.connection, args.source,
+      [&](deform::client::DeformClient& client, const deform::v1::MeshSummary& summary) {
+        return RunOnMesh(client, args, summary);
+      },
+      [&](bool loaded) { return args.unload || (loaded && !args.keep_mesh); });
 }
 
 void AddFlags(CLI::App& app, VrArgs& args) {

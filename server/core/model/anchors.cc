@@ -4,7 +4,6 @@
 #include <cmath>
 
 namespace deform {
-namespace {
 
 // The piece of `start` in the rigid zone of its bone (vertices reached through neighbours with
 // the same rigid bone); marks them in `seen`.
@@ -24,8 +23,6 @@ std::vector<int> RigidPiece(const VertexAdjacency& adjacency, const std::vector<
   }
   return piece;
 }
-
-}  // namespace
 
 std::vector<int> ChooseAnchors(const VertexAdjacency& adjacency, const std::vector<int>& rigid_bone,
                                const JointRegions& regions, double distance_factor,

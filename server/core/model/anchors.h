@@ -9,6 +9,11 @@
 
 namespace deform {
 
+// The connected piece of bone rigid_bone[start]'s rigid zone that holds `start` (vertices reached
+// through neighbours with the same rigid bone), marking them in `seen` (sized to the mesh).
+std::vector<int> RigidPiece(const VertexAdjacency& adjacency, const std::vector<int>& rigid_bone,
+                            int start, std::vector<char>* seen);
+
 // In every connected piece of every bone's rigid zone (`rigid_bone[i]` = the bone vertex i follows
 // alone, -1 for blending vertices): the vertices at least `distance_factor` region radii from every
 // joint centre (JointRegions::relative_distance); where fewer than `min_fraction` of the piece's

@@ -8,6 +8,9 @@
 #include <queue>
 #include <utility>
 
+#include "core/base/median.h"
+#include "core/model/anchors.h"
+
 namespace deform {
 namespace {
 
@@ -28,38 +31,19 @@ double DistanceToBone(const Skeleton& skeleton, int bone, const Eigen::Vector3d&
                               skeleton.joint(b.tail_joint).rest_position);
 }
 
-// Connected pieces of the vertices whose label equals `bone`, each a list of vertices.
+// The connected pieces of bone `bone`'s rigid zone, largest first.
 std::vector<std::vector<int>> Pieces(const VertexAdjacency& adjacency,
                                      const std::vector<int>& rigid_bone, int bone,
                                      std::vector<char>* seen) {
   std::vector<std::vector<int>> pieces;
-  const int n = static_cast<int>(rigid_bone.size());
-  for (int start = 0; start < n; ++start) {
-    if (rigid_bone[start] != bone || (*seen)[start]) continue;
-    std::vector<int> piece{start};
-    (*seen)[start] = 1;
-    for (std::size_t q = 0; q < piece.size(); ++q) {
-      const int i = piece[q];
-      for (int p = adjacency.offsets[i]; p < adjacency.offsets[i + 1]; ++p) {
-        const int j = adjacency.neighbors[p];
-        if (rigid_bone[j] == bone && !(*seen)[j]) {
-          (*seen)[j] = 1;
-          piece.push_back(j);
-        }
-      }
+  for (int start = 0; start < static_cast<int>(rigid_bone.size()); ++start) {
+    if (rigid_bone[start] == bone && !(*seen)[start]) {
+      pieces.push_back(RigidPiece(adjacency, rigid_bone, start, seen));
     }
-    pieces.push_back(std::move(piece));
   }
   std::sort(pieces.begin(), pieces.end(),
             [](const auto& a, const auto& b) { return a.size() > b.size(); });
   return pieces;
-}
-
-double Median(std::vector<double> values) {
-  if (values.empty()) return 0;
-  const auto middle = values.begin() + values.size() / 2;
-  std::nth_element(values.begin(), middle, values.end());
-  return *middle;
 }
 
 void ReportBone(const TriangleMesh& mesh, const Skeleton& skeleton,

@@ -5,6 +5,8 @@
 #include <limits>
 #include <string>
 
+#include "core/base/median.h"
+
 namespace deform {
 namespace {
 
@@ -22,13 +24,6 @@ double ShortestAdjacentBone(const Skeleton& skeleton, int joint) {
                                       .norm());
   }
   return shortest;
-}
-
-double Median(std::vector<double> values) {
-  if (values.empty()) return 0;
-  const auto middle = values.begin() + values.size() / 2;
-  std::nth_element(values.begin(), middle, values.end());
-  return *middle;
 }
 
 // Median distance from the joint centre to the vertices whose closest skeleton point is within a
