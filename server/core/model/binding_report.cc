@@ -59,7 +59,7 @@ void ReportBone(const TriangleMesh& mesh, const Skeleton& skeleton,
     distances.push_back(DistanceToBone(skeleton, k, mesh.vertices.row(i).transpose()));
   }
   report->thickness = 2 * Median(distances);
-  for (double d : distances) report->beyond_thickness += d > report->thickness;
+  for (double d : distances) report->beyond_thickness += d > 2 * report->thickness;
 
   const std::vector<std::vector<int>> pieces = Pieces(adjacency, rigid_bone, k, seen);
   for (const auto& piece : pieces) report->pieces.push_back(static_cast<int>(piece.size()));
@@ -71,7 +71,9 @@ void ReportBone(const TriangleMesh& mesh, const Skeleton& skeleton,
       report->farthest_piece = std::max(report->farthest_piece, gap);
     }
   }
-  const double far_apart = std::max(2 * report->thickness, 0.05 * diagonal);
+  // Toes or fingers split by a joint region lie a few limb widths apart along the surface; a part
+  // bound to the wrong bone (an ear to a hand) lies across the body.
+  const double far_apart = std::max(2 * report->thickness, 0.2 * diagonal);
   if (pieces.size() > 1 && report->farthest_piece > far_apart) {
     const std::string how_far =
         std::isfinite(report->farthest_piece)
@@ -83,11 +85,11 @@ void ReportBone(const TriangleMesh& mesh, const Skeleton& skeleton,
   }
   if (report->vertices == 0) {
     warnings->push_back("bone " + report->name + ": no vertex follows it");
-  } else if (report->rigid_vertices > 0 && report->beyond_thickness > report->vertices / 20) {
+  } else if (report->rigid_vertices > 0 && report->beyond_thickness > 0) {
     warnings->push_back("bone " + report->name + ": " + std::to_string(report->beyond_thickness) +
                         " of its " + std::to_string(report->vertices) +
-                        " vertices lie farther from it than the limb is thick (" +
-                        Format("%.3g", report->thickness) + ")");
+                        " vertices lie farther from it than twice the limb's thickness (" +
+                        Format("%.3g", 2 * report->thickness) + ")");
   }
 }
 

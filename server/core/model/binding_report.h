@@ -26,7 +26,7 @@ struct BoneBinding {
   double farthest_piece = 0;  // distance from the largest piece to the farthest other piece
   int anchors = 0;
   double thickness = 0;      // twice the median distance of its vertices from the bone
-  int beyond_thickness = 0;  // vertices bound farther from the bone than `thickness`
+  int beyond_thickness = 0;  // vertices bound farther from the bone than 2 * thickness
 };
 
 struct BindingReport {
