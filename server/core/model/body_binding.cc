@@ -85,15 +85,20 @@ BodyBinding BindThroughBody(const TriangleMesh& mesh, const Skeleton& skeleton,
     if (visible.bone >= 0) ++result.seen_through_body;
   }
   result.reached_along_surface = PropagateAlongSurface(mesh, adjacency, &bone);
-  const std::vector<NearestBone> straight = NearestBones(mesh.vertices, skeleton);
   result.bones.resize(n);
   for (int i = 0; i < n; ++i) {
-    if (bone[i] < 0) {
-      result.bones[i] = straight[i];
-      ++result.straight_line;
-    } else {
-      result.bones[i] = MeasureToBone(skeleton, bone[i], mesh.vertices.row(i).transpose());
+    const Eigen::Vector3d p = mesh.vertices.row(i).transpose();
+    if (bone[i] >= 0) {
+      result.bones[i] = MeasureToBone(skeleton, bone[i], p);
+      continue;
     }
+    // A piece in which no vertex saw a bone: the straight-line nearest (ties to the lower index).
+    result.bones[i] = MeasureToBone(skeleton, 0, p);
+    for (int k = 1; k < skeleton.num_bones(); ++k) {
+      const NearestBone candidate = MeasureToBone(skeleton, k, p);
+      if (candidate.distance < result.bones[i].distance) result.bones[i] = candidate;
+    }
+    ++result.straight_line;
   }
   return result;
 }
