@@ -4,7 +4,7 @@
 # where ../shared/data is present, the shared legs, the arm (its natural elbow flexion, a negative
 # angle; with the binding through the body and with its authored weights) and the whole body (a
 # multi-joint pose: left knee DEG, left hip flexed DEG/2, right knee DEG/2). Needs a build
-# (scripts/build.sh) and python3.
+# (scripts/build.sh) and python3. DEFORM_QUALITY_METHODS="paper-linear lbs" limits the methods.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 DEFORMCTL="${DEFORM_BUILD_DIR:-build}/server/deformctl/deformctl"
@@ -34,7 +34,7 @@ for case in "${CASES[@]}"; do
   for degrees in 45 90 120; do
     spec=${pose//DEG/$degrees}
     spec=${spec//HALF/$((degrees / 2))}
-    for method in paper paper-linear laplacian lbs dqs; do
+    for method in ${DEFORM_QUALITY_METHODS:-paper paper-linear laplacian lbs dqs}; do
       "$DEFORMCTL" deform "${args[@]}" --pose "$spec" --method "$method" 2>/dev/null |
         python3 -c "import json,sys; d=json.load(sys.stdin); print('| $name | $degrees | $method | %+.4f | %.3f | %.3f | %.4f | %.1e |' % (d['volume_change'], d['clearance_min'], d['clearance_p01'], d['sink_fraction'], d['rigid_zone_error']))"
     done

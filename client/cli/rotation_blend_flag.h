@@ -29,8 +29,8 @@ inline CLI::Option* AddRotationBlendFlag(CLI::App& app, deform::v1::RotationBlen
   return app
       .add_option("--rotation-blend", *blend,
                   "How the mesh loaded blends bone rotations near a joint: quaternion (the "
-                  "method's default) or linear (four linear segments along each bone pair's "
-                  "quaternion blend: a precomputed response, no solve per frame, a few tenths "
+                  "method's default) or linear (linear between samples of the bones' "
+                  "quaternion blend, four segments per weight: a precomputed response, no solve per frame, a few tenths "
                   "of a percent more volume loss at a bent joint)")
       ->transform(CLI::CheckedTransformer(RotationBlendNames(), CLI::ignore_case))
       ->default_str("quaternion");

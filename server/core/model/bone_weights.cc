@@ -44,6 +44,41 @@ Status SolveFreeVertices(const VertexAdjacency& adjacency, const std::vector<int
   return Status::Ok();
 }
 
+// Bone `bone`'s field on the free vertices allowed to use it (local index `local`, numbered
+// 0..count - 1): harmonic there, 1 on the bone's fixed vertices, 0 on every other vertex.
+Status SolveOneBone(const VertexAdjacency& adjacency, const std::vector<int>& fixed_bone,
+                    const std::vector<int>& local, int count, int bone, Eigen::MatrixXd* dense) {
+  const int n = static_cast<int>(fixed_bone.size());
+  std::vector<Eigen::Triplet<double>> triplets;
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(count);
+  for (int i = 0; i < n; ++i) {
+    const int li = local[i];
+    if (li < 0) continue;
+    triplets.emplace_back(li, li, adjacency.degree(i));
+    for (int p = adjacency.offsets[i]; p < adjacency.offsets[i + 1]; ++p) {
+      const int u = adjacency.neighbors[p];
+      if (local[u] >= 0) {
+        triplets.emplace_back(li, local[u], -1.0);
+      } else if (fixed_bone[u] == bone) {
+        rhs[li] += 1.0;
+      }
+    }
+  }
+  Eigen::SparseMatrix<double> laplacian(count, count);
+  laplacian.setFromTriplets(triplets.begin(), triplets.end());
+  Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> llt(
+      laplacian);
+  if (llt.info() != Eigen::Success) {
+    return Status::Internal("harmonic weight system of bone " + std::to_string(bone) +
+                            " could not be factorised");
+  }
+  const Eigen::VectorXd solution = llt.solve(rhs);
+  for (int i = 0; i < n; ++i) {
+    if (local[i] >= 0) (*dense)(i, bone) = std::clamp(solution[local[i]], 0.0, 1.0);
+  }
+  return Status::Ok();
+}
+
 // The compressed per-vertex lists of `weights` from its dense field: weights below kDropBelow
 // dropped, the rest renormalised, largest first.
 void CompressWeights(BoneWeights* weights) {
@@ -115,6 +150,44 @@ StatusOr<BoneWeights> HarmonicBoneWeights(const VertexAdjacency& adjacency,
   if (num_free > 0) {
     DEFORM_RETURN_IF_ERROR(
         SolveFreeVertices(adjacency, fixed_bone, free_index, num_free, &result.dense));
+  }
+  CompressWeights(&result);
+  return result;
+}
+
+StatusOr<BoneWeights> HarmonicBoneWeights(const VertexAdjacency& adjacency,
+                                          const std::vector<int>& fixed_bone, int num_bones,
+                                          const std::vector<std::vector<int>>& allowed_bones) {
+  const int n = static_cast<int>(fixed_bone.size());
+  DEFORM_RETURN_IF_ERROR(CheckEveryComponentAnchored(adjacency, fixed_bone));
+  BoneWeights result;
+  result.num_bones = num_bones;
+  result.dense = Eigen::MatrixXd::Zero(n, num_bones);
+  std::vector<std::vector<int>> free_vertices_of_bone(num_bones);
+  for (int i = 0; i < n; ++i) {
+    if (fixed_bone[i] >= 0) {
+      result.dense(i, fixed_bone[i]) = 1.0;
+      continue;
+    }
+    for (int k : allowed_bones[i]) free_vertices_of_bone[k].push_back(i);
+  }
+  std::vector<int> local(n, -1);
+  for (int k = 0; k < num_bones; ++k) {
+    const auto& vertices = free_vertices_of_bone[k];
+    if (vertices.empty()) continue;
+    for (int v = 0; v < static_cast<int>(vertices.size()); ++v) local[vertices[v]] = v;
+    DEFORM_RETURN_IF_ERROR(SolveOneBone(adjacency, fixed_bone, local,
+                                        static_cast<int>(vertices.size()), k, &result.dense));
+    for (int i : vertices) local[i] = -1;
+  }
+  for (int i = 0; i < n; ++i) {
+    if (fixed_bone[i] >= 0) continue;
+    const double sum = result.dense.row(i).sum();
+    if (sum > 1e-12) {
+      result.dense.row(i) /= sum;
+    } else {
+      result.dense(i, allowed_bones[i].front()) = 1.0;
+    }
   }
   CompressWeights(&result);
   return result;

@@ -31,6 +31,16 @@ struct BoneWeights {
 StatusOr<BoneWeights> HarmonicBoneWeights(const VertexAdjacency& adjacency,
                                           const std::vector<int>& fixed_bone, int num_bones);
 
+// The same with each bone's field kept to the free vertices that may use it: h_k is harmonic on
+// the free vertices whose `allowed_bones[i]` lists k, 1 on k's fixed vertices and 0 everywhere
+// else, so it falls to 0 where k's joints' regions end instead of spreading across the body; each
+// free vertex's weights are then renormalised to sum to 1 (a vertex that no allowed field reaches
+// takes its first allowed bone wholly). `allowed_bones` has one list per vertex (the fixed
+// vertices' are ignored); bones in [0, num_bones).
+StatusOr<BoneWeights> HarmonicBoneWeights(const VertexAdjacency& adjacency,
+                                          const std::vector<int>& fixed_bone, int num_bones,
+                                          const std::vector<std::vector<int>>& allowed_bones);
+
 // INVALID_ARGUMENT naming a connected component of the mesh with no vertex in a rigid zone
 // (`fixed_bone[i]` >= 0): nothing could anchor it to the skeleton.
 Status CheckEveryComponentAnchored(const VertexAdjacency& adjacency,

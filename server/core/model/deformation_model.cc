@@ -13,7 +13,7 @@
 #include "core/geometry/skeleton_geometry.h"
 #include "core/geometry/triangle_bvh.h"
 #include "core/model/body_binding.h"
-#include "core/model/rotation_blend.h"
+#include "core/model/rigid_cores.h"
 #include "core/model/weight_binding.h"
 
 namespace deform {
@@ -30,6 +30,9 @@ std::uint64_t NextModelId() {
   static std::atomic<std::uint64_t> next{1};
   return next.fetch_add(1, std::memory_order_relaxed);
 }
+
+// The least fraction of each bone's vertices kept outside every joint region (rigid_cores.h).
+constexpr double kMinRigidFraction = 0.2;
 
 // Rigid zones: outside every joint region, a vertex belongs wholly to the bone it is bound to (the
 // bone per vertex, -1 inside a region).
@@ -59,31 +62,6 @@ Eigen::Quaterniond QuaternionBlend(const BoneWeights& bw, int vertex,
   }
   q.normalize();
   return q;
-}
-
-// The linear blend T_i of vertex i (piecewise along pairs, `segments` per pair; rotation_blend.h).
-Eigen::Matrix3d LinearBlend(const BoneWeights& bw, int segments, int vertex,
-                            const std::vector<RigidTransform>& bones,
-                            const std::vector<Eigen::Matrix3d>& bone_rotations) {
-  const int begin = bw.offsets[vertex], end = bw.offsets[vertex + 1];
-  if (end - begin == 2 && segments > 1) {
-    // The pair's knots (ordered by bone index, as the response numbers them) around h_b.
-    const BonePair pair =
-        OrderedPair(bw.bones[begin], bw.weights[begin], bw.bones[begin + 1], bw.weights[begin + 1]);
-    const PairSegment segment = SegmentOf(pair.h, segments);
-    const auto knot = [&](int j) -> Eigen::Matrix3d {
-      if (j == 0) return bone_rotations[pair.a];
-      if (j == segments) return bone_rotations[pair.b];
-      return PairKnot(bones[pair.a].rotation, bones[pair.b].rotation,
-                      static_cast<double>(j) / segments)
-          .toRotationMatrix();
-    };
-    return (1 - segment.upper_weight) * knot(segment.lower) +
-           segment.upper_weight * knot(segment.lower + 1);
-  }
-  Eigen::Matrix3d blend = bw.weights[begin] * bone_rotations[bw.bones[begin]];
-  for (int p = begin + 1; p < end; ++p) blend += bw.weights[p] * bone_rotations[bw.bones[p]];
-  return blend;
 }
 
 }  // namespace
@@ -126,6 +104,10 @@ Status DeformationModel::Precompute(const SkinWeights* weights) {
     DEFORM_RETURN_IF_ERROR(BindAutomatically(adjacency, bvh));
   }
   system_ = BuildLaplacianSystem(mesh_, adjacency, regions_, rigid_bones_, bone_weights_, options_);
+  if (options_.rotation_blend == RotationBlend::kLinear) {
+    linear_blend_plan_ = std::make_shared<const LinearBlendPlan>(LinearBlendPlan::Build(
+        bone_weights_, skeleton_.num_bones(), options_.linear_blend_segments));
+  }
   BindingReport report = ReportBinding(mesh_, skeleton_, adjacency, bvh, bound_bones_, rigid_bones_,
                                        system_.anchors, IsClosed(mesh_.triangles));
   report.source = binding_report_.source;
@@ -154,10 +136,13 @@ Status DeformationModel::BindAutomatically(const VertexAdjacency& adjacency,
     binding_report_.straight_line = mesh_.num_vertices();
   }
   DEFORM_ASSIGN_OR_RETURN(
-      regions_, ComputeJointRegions(mesh_, skeleton_, adjacency, bound, options_.regions));
+      JointRegions regions,
+      ComputeJointRegions(mesh_, skeleton_, adjacency, bound, options_.regions));
+  regions_ = KeepRigidCores(mesh_, adjacency, bound, std::move(regions), kMinRigidFraction);
   rigid_bones_ = RigidZones(regions_, bound);
   DEFORM_ASSIGN_OR_RETURN(bone_weights_,
-                          HarmonicBoneWeights(adjacency, rigid_bones_, skeleton_.num_bones()));
+                          HarmonicBoneWeights(adjacency, rigid_bones_, skeleton_.num_bones(),
+                                              RegionBonesPerVertex(regions_, skeleton_, bound)));
   bound_bones_.resize(bound.size());
   for (std::size_t i = 0; i < bound.size(); ++i) bound_bones_[i] = bound[i].bone;
   return Status::Ok();
@@ -191,9 +176,8 @@ StatusOr<std::shared_ptr<const MaterialFactorization>> DeformationModel::Factori
       result->factor_, CholeskyFactor::Factorize(
                            symbolic_, deform::NormalMatrix(system_, result->row_weights_squared_)));
   if (options_.rotation_blend == RotationBlend::kLinear) {
-    result->linear_response_ =
-        BuildLinearPoseResponse(system_, skeleton_, bone_weights_, options_.linear_blend_segments,
-                                result->row_weights_squared_, result->factor_);
+    result->linear_response_ = BuildLinearPoseResponse(
+        system_, skeleton_, linear_blend_plan_, result->row_weights_squared_, result->factor_);
   }
   result->factor_seconds_ = SecondsSince(start);
   return std::shared_ptr<const MaterialFactorization>(std::move(result));
@@ -234,7 +218,8 @@ DeformScratch DeformationModel::MakeScratch() const {
   scratch.model_id_ = id_;
   scratch.num_vertices = mesh_.num_vertices();
   scratch.bone_transforms.resize(skeleton_.num_bones());
-  scratch.bone_rotations.resize(skeleton_.num_bones());
+  scratch.slot_rotations.resize(linear_blend_plan_ ? linear_blend_plan_->num_slots()
+                                                  : skeleton_.num_bones());
   scratch.solution.resize(mesh_.num_vertices() + system_.num_nodes, 3);
   scratch.rotated_deltas.resize(mesh_.num_vertices(), 3);
   scratch.solve_work.resize(default_factorization_->factor().WorkSize());
@@ -299,18 +284,19 @@ void DeformationModel::RotateDeltas(const MaterialFactorization& factorization,
   const auto& bw = bone_weights_;
   const auto& w2 = factorization.row_weights_squared_;
   auto& r = scratch->rotated_deltas;
-  for (size_t k = 0; k < bones.size(); ++k) {
-    scratch->bone_rotations[k] = bones[k].rotation.toRotationMatrix();
+  auto& rotations = scratch->slot_rotations;
+  if (linear_blend_plan_) {
+    linear_blend_plan_->SlotRotations(bones, rotations.data());
+  } else {
+    for (size_t k = 0; k < bones.size(); ++k) rotations[k] = bones[k].rotation.toRotationMatrix();
   }
   for (int i = 0; i < mesh_.num_vertices(); ++i) {
     const int begin = bw.offsets[i], end = bw.offsets[i + 1];
     const Eigen::Vector3d delta = system_.rest_deltas.row(i).transpose();
     if (end - begin == 1) {  // most vertices: wholly one bone's
-      r.row(i) = w2[i] * (scratch->bone_rotations[bw.bones[begin]] * delta).transpose();
-    } else if (options_.rotation_blend == RotationBlend::kLinear) {
-      const Eigen::Matrix3d blend =
-          LinearBlend(bw, options_.linear_blend_segments, i, bones, scratch->bone_rotations);
-      r.row(i) = w2[i] * (blend * delta).transpose();
+      r.row(i) = w2[i] * (rotations[bw.bones[begin]] * delta).transpose();
+    } else if (linear_blend_plan_) {
+      r.row(i) = w2[i] * (linear_blend_plan_->Blend(i, rotations.data()) * delta).transpose();
     } else {
       r.row(i) = w2[i] * (QuaternionBlend(bw, i, bones) * delta).transpose();
     }

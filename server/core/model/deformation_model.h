@@ -35,6 +35,7 @@
 #include "core/model/bone_weights.h"
 #include "core/model/joint_regions.h"
 #include "core/model/laplacian_system.h"
+#include "core/model/linear_blend_plan.h"
 #include "core/model/linear_pose_response.h"
 #include "core/model/model_options.h"
 #include "core/model/stiffness.h"
@@ -68,7 +69,8 @@ class MaterialFactorization {
 // It belongs to the model that made it: another model's Deform() refuses it.
 struct DeformScratch {
   std::vector<RigidTransform> bone_transforms;  // K
-  std::vector<Eigen::Matrix3d> bone_rotations;  // K, the same rotations as matrices
+  // K, the same rotations as matrices, then (linear blend) the knots' (linear_blend_plan.h)
+  std::vector<Eigen::Matrix3d> slot_rotations;
   Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> solution;        // (n + m) by 3
   Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> rotated_deltas;  // n by 3
   std::vector<double> solve_work;  // CholeskyFactor::WorkSize()
@@ -171,6 +173,8 @@ class DeformationModel {
   const Skeleton& skeleton() const { return skeleton_; }
   const ModelOptions& options() const { return options_; }
   const BoneWeights& bone_weights() const { return bone_weights_; }
+  // With the linear rotation blend, its knots and per-vertex terms; null otherwise.
+  const LinearBlendPlan* linear_blend_plan() const { return linear_blend_plan_.get(); }
   const JointRegions& joint_regions() const { return regions_; }
   const std::vector<int>& anchor_vertices() const { return system_.anchors; }
   // Per vertex: the bone whose rigid zone it is in (it follows that bone alone), or -1.
@@ -222,6 +226,8 @@ class DeformationModel {
   ModelOptions options_;
   double diagonal_ = 0;
   BoneWeights bone_weights_;
+  // With the linear rotation blend: its knots and per-vertex terms (shared with the responses).
+  std::shared_ptr<const LinearBlendPlan> linear_blend_plan_;
   JointRegions regions_;
   std::vector<int> rigid_bones_;
   std::vector<int> bound_bones_;

@@ -2,11 +2,9 @@
 
 #include <algorithm>
 #include <cassert>
-#include <map>
 #include <memory>
 #include <utility>
 
-#include "core/model/rotation_blend.h"
 
 namespace deform {
 namespace {
@@ -33,8 +31,6 @@ DEFORM_ALWAYS_INLINE void AddScaledColumn(const double* __restrict column, int c
   }
 }
 
-using Knot = LinearPoseResponse::Knot;
-
 // x, y, z[0, count) += r * (the three response vectors at u, one column of r each).
 DEFORM_ALWAYS_INLINE void AddRotated(const Eigen::Matrix3d& r, const double* u, std::size_t n,
                                      int count, double* x, double* y, double* z) {
@@ -46,7 +42,7 @@ DEFORM_ALWAYS_INLINE void AddRotated(const Eigen::Matrix3d& r, const double* u, 
 // The whole evaluation, written once and compiled for AVX2 + FMA and for any x86-64 (or other)
 // CPU; Evaluate() picks one at run time.
 DEFORM_ALWAYS_INLINE void EvaluateBlocks(int n, const std::vector<int>& bones,
-                                         const std::vector<Knot>& knots, const double* columns,
+                                         const LinearBlendPlan& plan, const double* columns,
                                          const std::vector<RigidTransform>& transforms,
                                          double* positions) {
   const std::size_t stride = static_cast<std::size_t>(n);
@@ -66,12 +62,10 @@ DEFORM_ALWAYS_INLINE void EvaluateBlocks(int n, const std::vector<int>& bones,
       const Eigen::Vector3d& t = transform.translation;
       AddScaledColumn(u + 3 * stride, count, t.x(), t.y(), t.z(), x, y, z);
     }
-    for (std::size_t k = 0; k < knots.size(); ++k) {
-      const Knot& knot = knots[k];
-      const Eigen::Quaterniond q =
-          PairKnot(transforms[knot.bone_a].rotation, transforms[knot.bone_b].rotation, knot.s);
-      AddRotated(q.toRotationMatrix(), knot_columns + 3 * k * stride + begin, stride, count, x, y,
-                 z);
+    for (int k = 0; k < plan.num_knots(); ++k) {
+      AddRotated(plan.KnotRotation(k, transforms).toRotationMatrix(),
+                 knot_columns + 3 * static_cast<std::size_t>(k) * stride + begin, stride, count, x,
+                 y, z);
     }
     double* out = positions + 3 * static_cast<std::size_t>(begin);
     for (int i = 0; i < count; ++i) {
@@ -84,11 +78,11 @@ DEFORM_ALWAYS_INLINE void EvaluateBlocks(int n, const std::vector<int>& bones,
 
 #if defined(__x86_64__) && defined(__GNUC__)
 __attribute__((target("avx2,fma"))) void EvaluateAvx2(int n, const std::vector<int>& bones,
-                                                      const std::vector<Knot>& knots,
+                                                      const LinearBlendPlan& plan,
                                                       const double* columns,
                                                       const std::vector<RigidTransform>& transforms,
                                                       double* positions) {
-  EvaluateBlocks(n, bones, knots, columns, transforms, positions);
+  EvaluateBlocks(n, bones, plan, columns, transforms, positions);
 }
 
 bool HasAvx2Fma() {
@@ -100,24 +94,25 @@ bool HasAvx2Fma() {
 }  // namespace
 
 LinearPoseResponse::LinearPoseResponse(int num_vertices, std::vector<int> bones,
-                                       std::vector<Knot> knots, std::vector<double> columns)
+                                       std::shared_ptr<const LinearBlendPlan> plan,
+                                       std::vector<double> columns)
     : num_vertices_(num_vertices),
       bones_(std::move(bones)),
-      knots_(std::move(knots)),
+      plan_(std::move(plan)),
       columns_(std::move(columns)) {
-  assert(columns_.size() ==
-         (4 * bones_.size() + 3 * knots_.size()) * static_cast<std::size_t>(num_vertices_));
+  assert(columns_.size() == (4 * bones_.size() + 3 * static_cast<std::size_t>(num_knots())) *
+                                static_cast<std::size_t>(num_vertices_));
 }
 
 void LinearPoseResponse::Evaluate(const std::vector<RigidTransform>& bone_transforms,
                                   double* positions) const {
 #if defined(__x86_64__) && defined(__GNUC__)
   if (HasAvx2Fma()) {
-    EvaluateAvx2(num_vertices_, bones_, knots_, columns_.data(), bone_transforms, positions);
+    EvaluateAvx2(num_vertices_, bones_, *plan_, columns_.data(), bone_transforms, positions);
     return;
   }
 #endif
-  EvaluateBlocks(num_vertices_, bones_, knots_, columns_.data(), bone_transforms, positions);
+  EvaluateBlocks(num_vertices_, bones_, *plan_, columns_.data(), bone_transforms, positions);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -126,19 +121,20 @@ void LinearPoseResponse::Evaluate(const std::vector<RigidTransform>& bone_transf
 namespace {
 
 // The rotations the response is linear in ("slots"): first each bone that reaches the right-hand
-// side (with its translation), then the knots of the pair blends.
+// side (with its translation), then the blend plan's knots.
 struct ResponseSlots {
   std::vector<int> bones;      // the bone of each bone slot, ascending
   std::vector<int> bone_slot;  // per bone, its slot or -1
-  std::vector<Knot> knots;     // knot k is slot bones.size() + k
+  int num_knots = 0;           // knot k is slot bones.size() + k
   // Per vertex, T_i = sum of coefficient * (the slot's rotation).
   std::vector<std::vector<std::pair<int, double>>> vertex_terms;
 
   int num_bone_slots() const { return static_cast<int>(bones.size()); }
-  int num_slots() const { return num_bone_slots() + static_cast<int>(knots.size()); }
+  int num_slots() const { return num_bone_slots() + num_knots; }
   // Doubles of the response: four vectors per bone, three per knot, n each.
   std::size_t response_doubles(int n) const {
-    return (4 * bones.size() + 3 * knots.size()) * static_cast<std::size_t>(n);
+    return (4 * bones.size() + 3 * static_cast<std::size_t>(num_knots)) *
+           static_cast<std::size_t>(n);
   }
   // Where slot `slot`'s vectors start among them (linear_pose_response.h's order).
   std::size_t offset(int slot, int n) const {
@@ -150,10 +146,13 @@ struct ResponseSlots {
 
 // The bone slots: bones that appear in the right-hand side at all, through blend weights, anchors
 // and joint nodes. False when a joint node moves with the root transform (inner joints never do).
-bool FindBoneSlots(const LaplacianSystem& system, const BoneWeights& bone_weights,
+bool FindBoneSlots(const LaplacianSystem& system, const LinearBlendPlan& plan,
                    const std::vector<int>& node_bones, int num_bones, ResponseSlots* slots) {
   std::vector<char> appears(num_bones, 0);
-  for (int k : bone_weights.bones) appears[k] = 1;
+  for (int t = 0; t < plan.term_begin(plan.num_vertices()); ++t) {
+    if (plan.term_slot(t) < num_bones) appears[plan.term_slot(t)] = 1;
+  }
+
   for (int k : system.anchor_bones) appears[k] = 1;
   for (int k : node_bones) {
     if (k < 0) return false;
@@ -168,38 +167,20 @@ bool FindBoneSlots(const LaplacianSystem& system, const BoneWeights& bone_weight
   return true;
 }
 
-// The knots of every bone pair some vertex blends (`segments` per pair, rotation_blend.h), and each
-// vertex's terms.
-void AddBlendTerms(const BoneWeights& bw, int segments, ResponseSlots* slots) {
-  const int n = bw.num_vertices();
-  std::map<std::pair<int, int>, int> first_knot;
+// Each vertex's terms in response slots (the plan's bone slot k -> bone_slot[k], knot j -> the
+// j-th knot slot).
+void AddBlendTerms(const LinearBlendPlan& plan, ResponseSlots* slots) {
+  const int n = plan.num_vertices();
+  slots->num_knots = plan.num_knots();
   slots->vertex_terms.assign(n, {});
   for (int i = 0; i < n; ++i) {
-    const int begin = bw.offsets[i], end = bw.offsets[i + 1];
-    auto& terms = slots->vertex_terms[i];
-    if (end - begin != 2 || segments <= 1) {
-      for (int p = begin; p < end; ++p)
-        terms.emplace_back(slots->bone_slot[bw.bones[p]], bw.weights[p]);
-      continue;
+    for (int t = plan.term_begin(i); t < plan.term_end(i); ++t) {
+      const int slot = plan.term_slot(t);
+      const int response_slot = slot < plan.num_bones()
+                                    ? slots->bone_slot[slot]
+                                    : slots->num_bone_slots() + slot - plan.num_bones();
+      slots->vertex_terms[i].emplace_back(response_slot, plan.term_coefficient(t));
     }
-    const BonePair pair =
-        OrderedPair(bw.bones[begin], bw.weights[begin], bw.bones[begin + 1], bw.weights[begin + 1]);
-    const auto inserted =
-        first_knot.emplace(std::make_pair(pair.a, pair.b), static_cast<int>(slots->knots.size()));
-    if (inserted.second) {
-      for (int j = 1; j < segments; ++j) {
-        slots->knots.push_back({pair.a, pair.b, static_cast<double>(j) / segments});
-      }
-    }
-    const int pair_first_knot = inserted.first->second;
-    const auto slot_of_knot = [&](int j) {
-      if (j == 0) return slots->bone_slot[pair.a];
-      if (j == segments) return slots->bone_slot[pair.b];
-      return slots->num_bone_slots() + pair_first_knot + j - 1;
-    };
-    const PairSegment segment = SegmentOf(pair.h, segments);
-    terms = {{slot_of_knot(segment.lower), 1 - segment.upper_weight},
-             {slot_of_knot(segment.lower + 1), segment.upper_weight}};
   }
 }
 
@@ -290,18 +271,17 @@ class ResponseSolver {
 }  // namespace
 
 std::unique_ptr<const LinearPoseResponse> BuildLinearPoseResponse(
-    const LaplacianSystem& system, const Skeleton& skeleton, const BoneWeights& bone_weights,
-    int segments, const Eigen::VectorXd& row_weights_squared, const CholeskyFactor& factor) {
+    const LaplacianSystem& system, const Skeleton& skeleton,
+    const std::shared_ptr<const LinearBlendPlan>& plan, const Eigen::VectorXd& row_weights_squared,
+    const CholeskyFactor& factor) {
   const int n = system.num_vertices;
   std::vector<int> node_bones(system.num_nodes);
   for (int c = 0; c < system.num_nodes; ++c) {
     node_bones[c] = skeleton.IncomingBone(system.node_joints[c]);
   }
   ResponseSlots slots;
-  if (!FindBoneSlots(system, bone_weights, node_bones, skeleton.num_bones(), &slots)) {
-    return nullptr;
-  }
-  AddBlendTerms(bone_weights, segments, &slots);
+  if (!FindBoneSlots(system, *plan, node_bones, skeleton.num_bones(), &slots)) return nullptr;
+  AddBlendTerms(*plan, &slots);
   // A frame reads the response once, a solve reads the factor twice: build it when it reads less.
   const std::size_t response_doubles = slots.response_doubles(n);
   if (response_doubles >= 2 * static_cast<std::size_t>(factor.nonzeros())) return nullptr;
@@ -317,8 +297,7 @@ std::unique_ptr<const LinearPoseResponse> BuildLinearPoseResponse(
       return nullptr;
     }
   }
-  return std::make_unique<LinearPoseResponse>(n, std::move(slots.bones), std::move(slots.knots),
-                                              std::move(columns));
+  return std::make_unique<LinearPoseResponse>(n, std::move(slots.bones), plan, std::move(columns));
 }
 
 }  // namespace deform

@@ -12,9 +12,9 @@
 // with the solve) and differs from the quaternion blend in the blend regions (measured in
 // METHOD-comparison tests and the quality table).
 //
-// Piecewise-linear pair blends (rotation_blend.h) add knots: a knot is the quaternion blend of two
-// bones at a fixed s, computed per frame, and enters like one more rotation with three response
-// vectors (the translations only reach the right-hand side through the bones themselves).
+// The blend's knots (linear_blend_plan.h: quaternion blends of a few bones at fixed shares,
+// computed per frame) enter like more rotations, three response vectors each (the translations
+// only reach the right-hand side through the bones themselves).
 //
 // BuildLinearPoseResponse (at the end) computes it from the model's least-squares system.
 // Immutable after construction; Evaluate() is const, allocation-free and may run on any number of
@@ -28,7 +28,7 @@
 
 #include "core/geometry/pose.h"
 #include "core/geometry/skeleton.h"
-#include "core/model/bone_weights.h"
+#include "core/model/linear_blend_plan.h"
 #include "core/model/laplacian_system.h"
 #include "core/solver/cholesky_factor.h"
 
@@ -36,19 +36,12 @@ namespace deform {
 
 class LinearPoseResponse {
  public:
-  // An interior knot of a bone pair's blend: QLERP(q_bone_a, q_bone_b; s).
-  struct Knot {
-    int bone_a = 0;
-    int bone_b = 0;
-    double s = 0;
-  };
-
   // `bones`: the bones with a non-zero response, ascending. `columns`: for each of them, in that
   // order, the four response vectors U_k0, U_k1, U_k2, V_k of `num_vertices` doubles each; then
-  // for each knot its three vectors U_0, U_1, U_2.
-  // Precondition: columns.size() == (4 * bones.size() + 3 * knots.size()) * num_vertices.
-  LinearPoseResponse(int num_vertices, std::vector<int> bones, std::vector<Knot> knots,
-                     std::vector<double> columns);
+  // for each of `plan`'s knots its three vectors U_0, U_1, U_2.
+  // Precondition: columns.size() == (4 * bones.size() + 3 * plan->num_knots()) * num_vertices.
+  LinearPoseResponse(int num_vertices, std::vector<int> bones,
+                     std::shared_ptr<const LinearBlendPlan> plan, std::vector<double> columns);
 
   // positions (n by 3, row-major) = the solution for these bone transforms (one per skeleton bone,
   // as ForwardKinematics gives them). No allocation.
@@ -56,25 +49,26 @@ class LinearPoseResponse {
 
   int num_vertices() const { return num_vertices_; }
   const std::vector<int>& bones() const { return bones_; }
-  const std::vector<Knot>& knots() const { return knots_; }
+  int num_knots() const { return plan_->num_knots(); }
   // Bytes of the stored response vectors: what each frame reads.
   std::size_t bytes() const { return columns_.size() * sizeof(double); }
 
  private:
   int num_vertices_ = 0;
   std::vector<int> bones_;
-  std::vector<Knot> knots_;
+  std::shared_ptr<const LinearBlendPlan> plan_;
   std::vector<double> columns_;
 };
 
-// METHOD.md's precomputed response of `system` for the linear blend (`segments` per bone pair,
-// rotation_blend.h) of `bone_weights`, with the vertex rows' squared weights
-// `row_weights_squared` (n) and `factor`, the Cholesky factor of that NormalMatrix. Costs 2 K + 3
-// (knots) three-column solves. Null when a frame would read more from it than a solve reads from
-// the factor (its doubles against twice the factor's non-zeros), or when a joint node moves with
-// the root transform (its joint has no incoming bone; inner joints always have one).
+// METHOD.md's precomputed response of `system` for the linear blend `plan` (of the model's bone
+// weights), with the vertex rows' squared weights `row_weights_squared` (n) and `factor`, the
+// Cholesky factor of that NormalMatrix. Costs 2 K + 3 (knots) three-column solves. Null when a
+// frame would read more from it than a solve reads from the factor (its doubles against twice the
+// factor's non-zeros), or when a joint node moves with the root transform (its joint has no
+// incoming bone; inner joints always have one).
 std::unique_ptr<const LinearPoseResponse> BuildLinearPoseResponse(
-    const LaplacianSystem& system, const Skeleton& skeleton, const BoneWeights& bone_weights,
-    int segments, const Eigen::VectorXd& row_weights_squared, const CholeskyFactor& factor);
+    const LaplacianSystem& system, const Skeleton& skeleton,
+    const std::shared_ptr<const LinearBlendPlan>& plan, const Eigen::VectorXd& row_weights_squared,
+    const CholeskyFactor& factor);
 
 }  // namespace deform

@@ -78,11 +78,10 @@ struct ModelOptions {
   Ordering ordering = Ordering::kAuto;
   // Default: kQuaternion.
   RotationBlend rotation_blend = RotationBlend::kQuaternion;
-  // With kLinear: a vertex blending two bones interpolates linearly between this many + 1 samples
-  // of the pair's quaternion blend (rotation_blend.h); 1 is METHOD.md's plain linear blend, more
-  // segments approach the quaternion blend at 3 more response vectors per pair and segment.
-  // Vertices blending three or more bones take the plain linear blend. Default: 4; at most
-  // kMaxLinearBlendSegments.
+  // With kLinear: a vertex's blend interpolates linearly between knots, samples of its bones'
+  // quaternion blend on a grid of this resolution over their weights (linear_blend_plan.h); 1 is
+  // METHOD.md's plain linear blend, more segments approach the quaternion blend at 3 more response
+  // vectors per knot. Default: 4; at most kMaxLinearBlendSegments.
   int linear_blend_segments = 4;
   static constexpr int kMaxLinearBlendSegments = 64;
   MeshLimits limits;

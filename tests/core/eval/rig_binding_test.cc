@@ -3,7 +3,12 @@
 // the diagonal, and bending one joint moves only what hangs from that joint.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "core/eval/skinning.h"
 #include "core/geometry/skin_weights.h"
@@ -134,6 +139,128 @@ TEST(RigBinding, TheArmsAuthoredWeightsKeepRigidZonesOnTheirBones) {
   ASSERT_TRUE(given.ok()) << given.status().ToString();
   const Frame frame = Deform(**given, PoseFromSpec((*given)->skeleton(), "2:z:-90"));
   EXPECT_LT(RigidZoneError(**given, frame), 1e-3);
+}
+
+// The shared body posed by the method itself and saved as a new rest shape: both shoulders turned
+// down by `degrees` about z (the rest pose holds the arms out at about 45 degrees), so that the
+// hands hang by the thighs; the skeleton's joints move with them.
+struct BodyRig {
+  TriangleMesh mesh;
+  Skeleton skeleton;
+  // The forearm and hand vertices: bound to a bone below an elbow in the body's own rest shape,
+  // where the arms are far from everything else.
+  std::vector<char> hand_vertex;
+};
+
+// The bones that turning either elbow moves (forearms, hands, fingers).
+std::vector<char> BonesBelowTheElbows(const Skeleton& skeleton) {
+  const int left = *skeleton.FindJoint("joint21"), right = *skeleton.FindJoint("joint24");
+  std::vector<char> below(skeleton.num_bones(), 0);
+  for (int k : skeleton.BonesParentsFirst()) {
+    const Bone& bone = skeleton.bone(k);
+    below[k] = bone.head_joint == left || bone.head_joint == right ||
+               (bone.parent_bone >= 0 && below[bone.parent_bone]);
+  }
+  return below;
+}
+
+std::optional<BodyRig> BodyWithArmsLowered(const std::string& mesh_path,
+                                           const std::string& skeleton_path, double degrees) {
+  auto mesh = ReadMeshFile(mesh_path);
+  auto skeleton = ReadSkeletonFile(skeleton_path);
+  if (!mesh.ok() || !skeleton.ok()) return std::nullopt;
+  auto model = DeformationModel::Build(*mesh, *skeleton, ModelOptions::Paper());
+  if (!model.ok()) return std::nullopt;
+  const std::string spec =
+      "joint18:z:" + std::to_string(-degrees) + ",joint20:z:" + std::to_string(degrees);
+  const Pose pose = PoseFromSpec((*model)->skeleton(), spec);
+  const Frame frame = Deform(**model, pose);
+  BodyRig rig{*mesh, *skeleton, std::vector<char>(mesh->num_vertices(), 0)};
+  rig.mesh.vertices = frame.posed;
+  const std::vector<char> below = BonesBelowTheElbows(*skeleton);
+  for (int i = 0; i < mesh->num_vertices(); ++i) {
+    rig.hand_vertex[i] = below[(*model)->bound_bones()[i]];
+  }
+  std::vector<Joint> joints = skeleton->joints();
+  for (int j = 0; j < skeleton->num_joints(); ++j) {
+    joints[j].rest_position = PosedJointPosition(*skeleton, pose, frame.bones, j);
+  }
+  std::vector<std::pair<int, int>> bones;
+  for (const Bone& bone : skeleton->bones()) bones.emplace_back(bone.head_joint, bone.tail_joint);
+  auto lowered = Skeleton::Create(std::move(joints), std::move(bones));
+  if (!lowered.ok()) return std::nullopt;
+  rig.skeleton = *std::move(lowered);
+  return rig;
+}
+
+// The largest displacement of the forearm and hand vertices, relative to the diagonal.
+double HandMovement(const BodyRig& rig, const Positions& posed) {
+  double worst = 0;
+  for (int i = 0; i < rig.mesh.num_vertices(); ++i) {
+    if (!rig.hand_vertex[i]) continue;
+    worst = std::max(worst, (posed.row(i) - rig.mesh.vertices.row(i)).norm());
+  }
+  return worst / BoundingBoxDiagonal(rig.mesh.vertices);
+}
+
+// As far as the shoulders turn before the forearms enter the waist: the hands then hang 1.6 units
+// (0.7 from its skin) from the thigh's bone.
+constexpr double kArmsLoweredDegrees = 42;
+
+TEST(RigBinding, BodyWithHandsByTheThighsBendsAHipAndTheHandsStay) {
+  DEFORM_REQUIRE_SHARED_FILE(mesh_path, "body/body_13380.obj");
+  DEFORM_REQUIRE_SHARED_FILE(skeleton_path, "body/body.tgf");
+  const std::optional<BodyRig> rig =
+      BodyWithArmsLowered(mesh_path, skeleton_path, kArmsLoweredDegrees);
+  ASSERT_TRUE(rig.has_value());
+  auto model = DeformationModel::Build(rig->mesh, rig->skeleton, ModelOptions::Paper());
+  ASSERT_TRUE(model.ok()) << model.status().ToString();
+  for (const char* spec : {"joint4:x:-60", "joint9:x:-60", "joint4:z:30"}) {
+    const Frame frame = Deform(**model, PoseFromSpec((*model)->skeleton(), spec));
+    EXPECT_LT(RigidZoneError(**model, frame), 1e-3) << spec;
+    EXPECT_LT(HandMovement(*rig, frame.posed), 1e-3) << spec;
+  }
+  // The hands by the thighs are still bound to the hands' bones, vertex for vertex.
+  const std::vector<char> below = BonesBelowTheElbows((*model)->skeleton());
+  int rebound = 0;
+  for (int i = 0; i < rig->mesh.num_vertices(); ++i) {
+    rebound += rig->hand_vertex[i] && !below[(*model)->bound_bones()[i]];
+  }
+  EXPECT_EQ(rebound, 0);
+}
+
+// Short bones against a thick body (the spine, the pelvis): every bone keeps a rigid core and each
+// bone's weights stay in its joints' regions, so bending a hip leaves the chest, the arms and the
+// head where they are (the chest moved by 1.2% of the diagonal when the thigh's weight spread over
+// the whole torso).
+TEST(RigBinding, BendingTheBodysHipLeavesTheUpperBodyStill) {
+  DEFORM_REQUIRE_SHARED_FILE(mesh_path, "body/body_13380.obj");
+  DEFORM_REQUIRE_SHARED_FILE(skeleton_path, "body/body.tgf");
+  auto mesh = ReadMeshFile(mesh_path);
+  auto skeleton = ReadSkeletonFile(skeleton_path);
+  ASSERT_TRUE(mesh.ok() && skeleton.ok());
+  auto model = DeformationModel::Build(*mesh, *skeleton, ModelOptions::Paper());
+  ASSERT_TRUE(model.ok()) << model.status().ToString();
+  // Every bone that vertices follow keeps a fifth of them rigid (the head's bone had none).
+  std::vector<int> bound(skeleton->num_bones(), 0), rigid(skeleton->num_bones(), 0);
+  for (int i = 0; i < mesh->num_vertices(); ++i) {
+    ++bound[(*model)->bound_bones()[i]];
+    rigid[(*model)->bound_bones()[i]] += (*model)->rigid_bones()[i] >= 0;
+  }
+  for (int k = 0; k < skeleton->num_bones(); ++k) EXPECT_GE(5 * rigid[k], bound[k]) << "bone " << k;
+  // The chest and above: higher than the middle spine joint by a fifth of the torso.
+  const double chest = (*model)->skeleton().joint(*(*model)->skeleton().FindJoint("joint15"))
+                           .rest_position.y() + 0.5;
+  for (const char* spec : {"joint4:x:-60", "joint9:x:-60", "joint5:x:90"}) {
+    const Frame frame = Deform(**model, PoseFromSpec((*model)->skeleton(), spec));
+    double worst = 0;
+    for (int i = 0; i < mesh->num_vertices(); ++i) {
+      if (mesh->vertices(i, 1) < chest) continue;
+      worst = std::max(worst, (frame.posed.row(i) - mesh->vertices.row(i)).norm());
+    }
+    EXPECT_LT(worst / (*model)->bounding_box_diagonal(), 1e-3) << spec;
+    EXPECT_LT(RigidZoneError(**model, frame), 1e-3) << spec;
+  }
 }
 
 }  // namespace

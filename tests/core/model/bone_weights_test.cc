@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <vector>
+
 #include "core/io/mesh_io.h"
 #include "core/io/phantom.h"
 #include "core/model/deformation_model.h"
@@ -58,6 +60,45 @@ TEST(HarmonicBoneWeights, RefuseAComponentWithoutAFixedVertex) {
   ASSERT_FALSE(w.ok());
   EXPECT_EQ(w.status().code(), StatusCode::kInvalidArgument);
   EXPECT_NE(w.status().message().find("vertex 2"), std::string::npos);
+}
+
+// A path 0-1-...-8 fixed to bone 0 at 0, bone 1 at 4 and bone 2 at 8, every free vertex allowed
+// bones 0 and 1 except 5..7, which may use 1 and 2: bone 2's field stays off the left half, and
+// bone 0's off the right half, however the unrestricted field would spread.
+TEST(HarmonicBoneWeights, StayOnTheVerticesAllowedToUseThem) {
+  VertexAdjacency path;
+  path.offsets = {0};
+  for (int i = 0; i < 9; ++i) {
+    if (i > 0) path.neighbors.push_back(i - 1);
+    if (i < 8) path.neighbors.push_back(i + 1);
+    path.offsets.push_back(static_cast<int>(path.neighbors.size()));
+  }
+  const std::vector<int> fixed = {0, -1, -1, -1, 1, -1, -1, -1, 2};
+  std::vector<std::vector<int>> allowed(9, std::vector<int>{0, 1});
+  for (int i = 5; i <= 7; ++i) allowed[i] = {1, 2};
+  auto w = HarmonicBoneWeights(path, fixed, 3, allowed);
+  ASSERT_TRUE(w.ok()) << w.status().ToString();
+  for (int i = 0; i < 9; ++i) EXPECT_NEAR(w->dense.row(i).sum(), 1.0, 1e-12) << i;
+  for (int i = 1; i <= 3; ++i) {
+    EXPECT_EQ(w->dense(i, 2), 0.0);
+    EXPECT_NEAR(w->dense(i, 1), i / 4.0, 1e-12);  // linear between the fixed ends, as before
+  }
+  for (int i = 5; i <= 7; ++i) {
+    EXPECT_EQ(w->dense(i, 0), 0.0);
+    EXPECT_NEAR(w->dense(i, 2), (i - 4) / 4.0, 1e-12);
+  }
+}
+
+// Vertices allowed a bone that no fixed vertex holds (its field is 0 there) keep their other bones;
+// one that no field reaches at all takes its first allowed bone.
+TEST(HarmonicBoneWeights, AVertexNoFieldReachesTakesItsFirstAllowedBone) {
+  VertexAdjacency path;  // 0-1-2, vertex 0 fixed to bone 0, 1 and 2 allowed only bone 1
+  path.offsets = {0, 1, 3, 4};
+  path.neighbors = {1, 0, 2, 1};
+  auto w = HarmonicBoneWeights(path, {0, -1, -1}, 2, {{0}, {1}, {1}});
+  ASSERT_TRUE(w.ok()) << w.status().ToString();
+  EXPECT_EQ(w->dense(1, 1), 1.0);
+  EXPECT_EQ(w->dense(2, 1), 1.0);
 }
 
 }  // namespace

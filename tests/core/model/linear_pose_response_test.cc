@@ -3,6 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <set>
+#include <utility>
+#include <vector>
+
 #include "core/io/phantom.h"
 #include "core/model/deformation_model.h"
 #include "tests/allocation_counter.h"
@@ -61,8 +65,12 @@ TEST(LinearPoseResponse, OnlyTheLinearBlendHasOne) {
   ASSERT_NE(response, nullptr);
   EXPECT_EQ(response->num_vertices(), model->mesh().num_vertices());
   EXPECT_EQ(response->bones().size(), 2u);  // thigh and shank
-  ASSERT_EQ(response->knots().size(), 3u);  // the knee's pair blend in 4 segments
-  EXPECT_DOUBLE_EQ(response->knots()[1].s, 0.5);
+  // The knee's pair blend in 4 segments: 3 interior knots, shares (3, 1), (2, 2), (1, 3).
+  ASSERT_EQ(response->num_knots(), 3);
+  std::set<std::vector<std::pair<int, int>>> knots;
+  for (int j = 0; j < 3; ++j) knots.insert(model->linear_blend_plan()->KnotShares(j));
+  EXPECT_EQ(knots, (std::set<std::vector<std::pair<int, int>>>{
+                       {{0, 3}, {1, 1}}, {{0, 2}, {1, 2}}, {{0, 1}, {1, 3}}}));
   // 4 vectors per bone, 3 per knot.
   EXPECT_EQ(response->bytes(), (4 * 2 + 3 * 3) * sizeof(double) * model->mesh().num_vertices());
 }
@@ -118,7 +126,7 @@ TEST(LinearPoseResponse, PlainLinearBlendDiffersFromTheQuaternionBlendOnlyNearTh
   ModelOptions plain = LinearBlend();
   plain.linear_blend_segments = 1;
   auto linear = BuildPhantomModel(plain);
-  ASSERT_TRUE(linear->default_factorization()->linear_response()->knots().empty());
+  ASSERT_TRUE(linear->default_factorization()->linear_response()->num_knots() == 0);
   auto quaternion = BuildPhantomModel(ModelOptions::Paper());
   const Pose pose = PoseFromSpec(linear->skeleton(), "knee:flexion:90");
   const Positions a = Frame(*linear, *linear->default_factorization(), pose);
