@@ -39,12 +39,13 @@
 #include <grpcpp/support/server_callback.h>
 
 #include "deform/v1/deform.pb.h"
+#include "service/identity.h"
 #include "service/service_core.h"
 
 namespace deform::service {
 
 // A new reactor for one Deform call. `core` must outlive it.
 grpc::ServerBidiReactor<v1::DeformRequest, v1::DeformResponse>* NewDeformStreamReactor(
-    ServiceCore* core);
+    ServiceCore* core, Identity caller);
 
 }  // namespace deform::service

@@ -18,12 +18,13 @@
 #include <grpcpp/support/server_callback.h>
 
 #include "deform/v1/deform.pb.h"
+#include "service/identity.h"
 #include "service/service_core.h"
 
 namespace deform::service {
 
 // A new reactor for one LoadMesh call. `core` must outlive it.
 grpc::ServerBidiReactor<v1::LoadMeshRequest, v1::LoadMeshResponse>* NewLoadMeshReactor(
-    ServiceCore* core);
+    ServiceCore* core, Identity caller);
 
 }  // namespace deform::service
