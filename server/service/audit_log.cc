@@ -17,6 +17,8 @@ spdlog::logger& AuditLogger() {
     std::shared_ptr<spdlog::logger> created = spdlog::stdout_color_mt("audit");
     // deformd's pattern with the logger's name, so that audit lines can be told apart.
     created->set_pattern("[%Y-%m-%d %H:%M:%S.%e] [%^%l%$] [%n] %v");
+    // An audit trail, not diagnostics: written whatever --log-level says.
+    created->set_level(spdlog::level::info);
     return created;
   }();
   return *logger;

@@ -5,6 +5,8 @@
 //     [time] [info] [audit] tenant=ward-3 action=unload mesh=mesh-4f... result=OK
 //
 // Every field is escaped (EscapeForLog): client strings (mesh ids, names) cannot forge a line.
+// The logger logs at info whatever the server's log level (it is created at the first line,
+// after deformd set the level).
 // `tenant` is "-" for a caller that did not authenticate. Thread-safe.
 #pragma once
 
