@@ -31,6 +31,9 @@
 //  - The parts are guarded by the reactor's mutex (annotated, thread_annotations.h); the solver
 //    and the pose being solved belong to the solve task, the request buffers to the reader.
 //
+// `start` finds the mesh as the caller may see it (another tenant's mesh is NOT_FOUND) and counts
+// the stream against the caller's tenant's stream limit (RESOURCE_EXHAUSTED beyond it).
+//
 // The stream ends with OK after the client half-closes and everything pending is written, with
 // INVALID_ARGUMENT / NOT_FOUND for a bad or unknown `start`, CANCELLED when the client cancels,
 // UNAVAILABLE when the server drains.

@@ -10,6 +10,11 @@
 // reserved when the header arrives, so a client over the mesh limit is refused before it sends its
 // bytes.
 //
+// The mesh belongs to the caller's tenant (its slot and memory count against the tenant's
+// limits too). With a store (ServiceCore::store), the header and the upload's bytes are written to
+// it before parsing and kept once the mesh is registered (mesh_store.h); an audit line records
+// the outcome.
+//
 // Threads: gRPC's threads run the reactions and own the upload's buffers until the build is
 // posted; then the build task (a worker) owns them. The outbox and the pump are guarded by the
 // reactor's mutex.

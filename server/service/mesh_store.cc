@@ -6,6 +6,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdint>
 #include <cstring>
@@ -158,7 +159,10 @@ StatusOr<std::unique_ptr<MeshStore>> MeshStore::Open(const std::string& dir) {
 Status MeshStore::WritePending(const StoredMesh& mesh) const {
   const std::string path = PendingPath(mesh.id);
   const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
-  if (fd < 0) return Status::Internal("store: cannot create '" + path + "': " + ErrnoText());
+  if (fd < 0) {
+    spdlog::error("store: cannot create '{}': {}", EscapeForLog(path), ErrnoText());
+    return Status::Internal("the server cannot keep the mesh in its store (see its log)");
+  }
   const std::string header = mesh.header.SerializeAsString();
   HashingWriter writer(fd);
   bool ok = writer.Write(kMagic) &&
@@ -175,7 +179,8 @@ Status MeshStore::WritePending(const StoredMesh& mesh) const {
   ::close(fd);
   if (!ok) {
     ::unlink(path.c_str());
-    return Status::Internal("store: cannot write '" + path + "': " + error);
+    spdlog::error("store: cannot write '{}': {}", EscapeForLog(path), error);
+    return Status::Internal("the server cannot keep the mesh in its store (see its log)");
   }
   return Status::Ok();
 }

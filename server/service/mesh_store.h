@@ -41,7 +41,8 @@ class MeshStore {
   // problem otherwise.
   static StatusOr<std::unique_ptr<MeshStore>> Open(const std::string& dir);
 
-  // Writes `mesh` as a pending entry (durably). INTERNAL naming the file on an I/O error.
+  // Writes `mesh` as a pending entry (durably). INTERNAL on an I/O error (the file and the error
+  // are logged, not told to the client).
   Status WritePending(const StoredMesh& mesh) const;
   // Makes a pending entry the mesh's entry; an error is logged (the mesh then is not kept).
   void Commit(const std::string& id) const;

@@ -1,9 +1,12 @@
 // The real deformd and command-line clients in processes: SIGHUP rotates tokens; plaintext on a
-// non-loopback address needs --plaintext; the health probe and deform-vr talk TLS with a token.
+// non-loopback address needs --plaintext; the health probe and deform-vr talk TLS with a token;
+// --store brings a mesh back after a restart under its id (the same pose, the same frame).
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <cstdlib>
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -101,6 +104,44 @@ TEST(DeformdProcessTest, CommandLineClientsTalkTlsWithAToken) {
   std::getline(err, line);
   EXPECT_THAT(line, HasSubstr("UNAUTHENTICATED"));
   EXPECT_EQ(deformd.Stop(), 0);
+}
+
+std::string ReadFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+TEST(DeformdProcessTest, StoreBringsAMeshBackAfterARestart) {
+  TempDir dir;
+  const std::vector<std::string> args = {"--listen", "127.0.0.1:0", "--workers", "1", "--store",
+                                         dir.Path("store")};
+  std::string mesh_id;
+  {
+    DeformdProcess deformd(args, dir.Path("first.log"));
+    ASSERT_TRUE(deformd.WaitForListening()) << deformd.Log();
+    const std::string vr = std::string(DEFORM_VR_PATH) + " --target " + deformd.target() +
+                           " --phantom-vertices 300 --pose knee:flexion:60 --frames 1 --keep-mesh" +
+                           " --out " + dir.Path("before.obj") + " >/dev/null 2>&1";
+    ASSERT_EQ(std::system(vr.c_str()), 0);
+    client::DeformClient client(deformd.target());
+    std::vector<v1::MeshSummary> meshes;
+    ASSERT_TRUE(client.ListMeshes(&meshes).ok());
+    ASSERT_EQ(meshes.size(), 1u);
+    mesh_id = meshes[0].mesh_id();
+    EXPECT_EQ(deformd.Stop(), 0);
+  }
+  DeformdProcess restarted(args, dir.Path("second.log"));
+  ASSERT_TRUE(restarted.WaitForListening()) << restarted.Log();
+  EXPECT_THAT(restarted.Log(), HasSubstr("store: mesh=" + mesh_id + " tenant=default restored"));
+  const std::string vr = std::string(DEFORM_VR_PATH) + " --target " + restarted.target() +
+                         " --mesh-id " + mesh_id + " --pose knee:flexion:60 --frames 1 --out " +
+                         dir.Path("after.obj") + " >/dev/null 2>&1";
+  ASSERT_EQ(std::system(vr.c_str()), 0);
+  EXPECT_EQ(ReadFile(dir.Path("after.obj")), ReadFile(dir.Path("before.obj")));
+  client::DeformClient client(restarted.target());
+  ASSERT_TRUE(client.UnloadMesh(mesh_id).ok());
+  EXPECT_FALSE(std::ifstream(dir.Path("store") + "/" + mesh_id + ".mesh").good());
+  EXPECT_EQ(restarted.Stop(), 0);
 }
 
 }  // namespace
