@@ -9,17 +9,12 @@
 #include <string>
 #include <utility>
 
-#include "core/geometry/skeleton.h"
-#include "core/io/mesh_io.h"
 #include "core/io/phantom.h"
-#include "core/io/rig_import.h"
-#include "core/io/skeleton_io.h"
-#include "core/io/skin_weights_io.h"
 #include "service/annotated_mutex.h"
 #include "service/audit_log.h"
 #include "service/grpc_stream_sink.h"
-#include "service/log_text.h"
 #include "service/load_request.h"
+#include "service/log_text.h"
 #include "service/mesh_id.h"
 #include "service/mesh_loader.h"
 #include "service/mesh_store.h"

@@ -227,7 +227,24 @@ TEST(TokenTableTest, ParsesCommentsAndRefusesBadLines) {
     SCOPED_TRACE(bad);
     EXPECT_EQ(service::TokenTable::Parse(bad).status().code(), StatusCode::kInvalidArgument);
   }
+  TempDir dir;
+  service::Authenticator tokens;
+  ASSERT_TRUE(tokens.LoadTokenFile(dir.Write("tokens", TokenLine("secret", "ward-1", "tenant")))
+                  .ok());
+  EXPECT_TRUE(tokens.uses_tokens());
+  EXPECT_TRUE(tokens.Authenticate("Bearer secret").ok());
+  EXPECT_TRUE(tokens.Authenticate("bearer secret").ok());  // the scheme is case-insensitive
+  for (const char* refused : {"", "Bearer", "Bearer ", "Basic c2VjcmV0", "secret",
+                              "Bearer secret2", "Bearer SECRET"}) {
+    SCOPED_TRACE(refused);
+    EXPECT_EQ(tokens.Authenticate(refused).status().code(), StatusCode::kUnauthenticated);
+  }
+  EXPECT_EQ(tokens.LoadTokenFile("/nonexistent/tokens").code(), StatusCode::kNotFound);
+  EXPECT_TRUE(tokens.Authenticate("Bearer secret").ok());  // a failed load changes nothing
+
   service::Authenticator none;
+  EXPECT_FALSE(none.uses_tokens());
+  EXPECT_EQ(none.Reload().code(), StatusCode::kFailedPrecondition);
   auto implicit = none.Authenticate("");
   ASSERT_TRUE(implicit.ok());
   EXPECT_EQ(implicit->tenant, service::Identity::Implicit().tenant);
