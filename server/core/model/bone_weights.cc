@@ -183,10 +183,10 @@ StatusOr<BoneWeights> HarmonicBoneWeights(const VertexAdjacency& adjacency,
   for (int i = 0; i < n; ++i) {
     if (fixed_bone[i] >= 0) continue;
     const double sum = result.dense.row(i).sum();
-    if (sum > 1e-12) {
-      result.dense.row(i) /= sum;
+    if (sum <= 1.0) {
+      result.dense(i, allowed_bones[i].front()) += 1.0 - sum;
     } else {
-      result.dense(i, allowed_bones[i].front()) = 1.0;
+      result.dense.row(i) /= sum;
     }
   }
   CompressWeights(&result);

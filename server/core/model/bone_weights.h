@@ -33,10 +33,11 @@ StatusOr<BoneWeights> HarmonicBoneWeights(const VertexAdjacency& adjacency,
 
 // The same with each bone's field kept to the free vertices that may use it: h_k is harmonic on
 // the free vertices whose `allowed_bones[i]` lists k, 1 on k's fixed vertices and 0 everywhere
-// else, so it falls to 0 where k's joints' regions end instead of spreading across the body; each
-// free vertex's weights are then renormalised to sum to 1 (a vertex that no allowed field reaches
-// takes its first allowed bone wholly). `allowed_bones` has one list per vertex (the fixed
-// vertices' are ignored); bones in [0, num_bones).
+// else, so it falls to 0 where k's joints' regions end instead of spreading across the body. Where
+// a free vertex's weights sum to less than 1 (near a region's edge, where every field falls) the
+// rest goes to its first allowed bone, its own, so the field stays continuous with the
+// neighbouring region's; a sum above 1 is scaled down. `allowed_bones` has one list per vertex
+// (the fixed vertices' are ignored); bones in [0, num_bones).
 StatusOr<BoneWeights> HarmonicBoneWeights(const VertexAdjacency& adjacency,
                                           const std::vector<int>& fixed_bone, int num_bones,
                                           const std::vector<std::vector<int>>& allowed_bones);

@@ -145,7 +145,6 @@ StatusOr<JointRegions> ComputeJointRegions(const TriangleMesh& mesh, const Skele
                                            const VertexAdjacency& adjacency,
                                            const std::vector<NearestBone>& nearest,
                                            const JointRegionOptions& options) {
-  const int n = mesh.num_vertices();
   const std::vector<int> inner = skeleton.InnerJoints();
   DEFORM_RETURN_IF_ERROR(CheckRegionOptions(skeleton, inner, options));
   std::vector<JointRegion> regions;
