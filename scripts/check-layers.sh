@@ -17,6 +17,7 @@ declare -A ALLOWED=(
   [solver]="base solver"
   [model]="base geometry solver model"
   [eval]="base geometry solver model eval"
+  [codec]="base codec"
 )
 status=0
 while IFS= read -r -d '' file; do
