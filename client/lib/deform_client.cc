@@ -202,12 +202,17 @@ grpc::Status DeformClient::LoadMeshBytes(const std::string& name, deform::v1::Me
 
 grpc::Status DeformClient::GetMeshInfo(const std::string& mesh_id, bool include_geometry,
                                        deform::v1::GetMeshInfoResponse* info) {
-  grpc::ClientContext context;
-  SetUnaryDeadline(options_, &context);
-  AddCallCredentials(options_, &context);
   deform::v1::GetMeshInfoRequest request;
   request.set_mesh_id(mesh_id);
   request.set_include_geometry(include_geometry);
+  return GetMeshInfo(request, info);
+}
+
+grpc::Status DeformClient::GetMeshInfo(const deform::v1::GetMeshInfoRequest& request,
+                                       deform::v1::GetMeshInfoResponse* info) {
+  grpc::ClientContext context;
+  SetUnaryDeadline(options_, &context);
+  AddCallCredentials(options_, &context);
   return stub_->GetMeshInfo(&context, request, info);
 }
 
@@ -236,7 +241,29 @@ grpc::Status DeformClient::UnloadMesh(const std::string& mesh_id) {
 
 std::unique_ptr<DeformStream> DeformClient::OpenStream(const std::string& mesh_id,
                                                        StreamCallbacks callbacks) {
-  return internal::StartDeformStream(stub_.get(), options_, mesh_id, std::move(callbacks));
+  return OpenStream(mesh_id, std::move(callbacks), StreamOptions{});
+}
+
+std::unique_ptr<DeformStream> DeformClient::OpenStream(const std::string& mesh_id,
+                                                       StreamCallbacks callbacks,
+                                                       const StreamOptions& stream_options) {
+  deform::v1::DeformStart start;
+  start.set_mesh_id(mesh_id);
+  start.set_encoding(stream_options.encoding);
+  start.set_max_error(stream_options.max_error);
+  std::unique_ptr<codec::FrameDecoder> decoder;
+  const bool predicted = stream_options.encoding == deform::v1::FRAME_ENCODING_PREDICTED;
+  if (predicted || stream_options.encoding == deform::v1::FRAME_ENCODING_QUANTIZED) {
+    deform::v1::GetMeshInfoRequest request;
+    request.set_mesh_id(mesh_id);
+    request.set_include_geometry(predicted);
+    request.set_include_prediction_weights(predicted);
+    deform::v1::GetMeshInfoResponse info;
+    // An unknown mesh is answered by the stream itself (NOT_FOUND through on_done).
+    if (GetMeshInfo(request, &info).ok()) decoder = internal::MakeFrameDecoder(info);
+  }
+  return internal::StartDeformStream(stub_.get(), options_, start, std::move(callbacks),
+                                     std::move(decoder));
 }
 
 }  // namespace deform::client

@@ -116,6 +116,23 @@ class DeformClient {
   // on_done / DeformStream::Wait().
   std::unique_ptr<DeformStream> OpenStream(const std::string& mesh_id, StreamCallbacks callbacks);
 
+  // How a stream's frames travel (DeformStart.encoding, max_error). Whatever the encoding, the
+  // library decodes every frame into DeformFrame.positions (float32 x, y, z per vertex, the mesh's
+  // own vertex order) before on_frame; `encoded` stays as received (its size is what travelled).
+  struct StreamOptions {
+    deform::v1::FrameEncoding encoding = deform::v1::FRAME_ENCODING_FLOAT32;
+    double max_error = 0;  // PREDICTED: fraction of the bounding-box diagonal; 0 = the default
+  };
+  // As above with an encoding. For QUANTIZED and PREDICTED it first asks GetMeshInfo for what the
+  // decoder needs (the vertex count; PREDICTED: the rest positions and prediction weights, once).
+  // A frame that does not decode ends the stream with INTERNAL naming the problem.
+  std::unique_ptr<DeformStream> OpenStream(const std::string& mesh_id, StreamCallbacks callbacks,
+                                           const StreamOptions& stream_options);
+
+  // GetMeshInfo with every field of the request (prediction weights included).
+  grpc::Status GetMeshInfo(const deform::v1::GetMeshInfoRequest& request,
+                           deform::v1::GetMeshInfoResponse* info);
+
   deform::v1::DeformService::Stub* stub() { return stub_.get(); }
 
  private:

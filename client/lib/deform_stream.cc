@@ -19,11 +19,12 @@ class DeformStreamImpl final
       public grpc::ClientBidiReactor<deform::v1::DeformRequest, deform::v1::DeformResponse> {
  public:
   DeformStreamImpl(deform::v1::DeformService::Stub* stub, const ClientOptions& options,
-                   const std::string& mesh_id, DeformClient::StreamCallbacks callbacks)
-      : callbacks_(std::move(callbacks)) {
+                   const deform::v1::DeformStart& start, DeformClient::StreamCallbacks callbacks,
+                   std::unique_ptr<codec::FrameDecoder> decoder)
+      : callbacks_(std::move(callbacks)), decoder_(std::move(decoder)) {
     AddCallCredentials(options, &context_);
     stub->async()->Deform(&context_, this);
-    in_flight_.mutable_start()->set_mesh_id(mesh_id);
+    *in_flight_.mutable_start() = start;
     write_in_flight_ = true;
     AddHold();
     StartWrite(&in_flight_);
@@ -99,6 +100,19 @@ class DeformStreamImpl final
       return;
     }
     if (response_.has_frame()) {
+      if (response_.frame().has_encoded()) {
+        deform::v1::DeformFrame* frame = response_.mutable_frame();
+        const grpc::Status decoded =
+            DecodeFrame(frame->encoded(), decoder_.get(), frame->mutable_positions());
+        if (!decoded.ok()) {
+          {
+            std::lock_guard<std::mutex> lock(mutex_);
+            decode_error_ = decoded;
+          }
+          context_.TryCancel();
+          return;
+        }
+      }
       if (callbacks_.on_frame) callbacks_.on_frame(response_.frame());
     } else if (response_.has_notice()) {
       if (callbacks_.on_notice) callbacks_.on_notice(response_.notice());
@@ -106,7 +120,12 @@ class DeformStreamImpl final
     StartRead(&response_);
   }
 
-  void OnDone(const grpc::Status& status) override {
+  void OnDone(const grpc::Status& call_status) override {
+    grpc::Status status = call_status;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (!decode_error_.ok()) status = decode_error_;
+    }
     if (callbacks_.on_done) callbacks_.on_done(status);
     std::lock_guard<std::mutex> lock(mutex_);
     status_ = status;
@@ -139,6 +158,7 @@ class DeformStreamImpl final
   grpc::ClientContext context_;
   DeformClient::StreamCallbacks callbacks_;
   deform::v1::DeformResponse response_;  // read side: one read outstanding at a time
+  std::unique_ptr<codec::FrameDecoder> decoder_;  // read side only
 
   std::mutex mutex_;
   std::condition_variable done_cv_;
@@ -153,15 +173,18 @@ class DeformStreamImpl final
   bool hold_released_ = false;
   bool done_ = false;
   grpc::Status status_;
+  grpc::Status decode_error_;  // a frame that did not decode ends the stream with it
 };
 
 }  // namespace
 
 std::unique_ptr<DeformStream> StartDeformStream(deform::v1::DeformService::Stub* stub,
                                                 const ClientOptions& options,
-                                                const std::string& mesh_id,
-                                                DeformClient::StreamCallbacks callbacks) {
-  return std::make_unique<DeformStreamImpl>(stub, options, mesh_id, std::move(callbacks));
+                                                const deform::v1::DeformStart& start,
+                                                DeformClient::StreamCallbacks callbacks,
+                                                std::unique_ptr<codec::FrameDecoder> decoder) {
+  return std::make_unique<DeformStreamImpl>(stub, options, start, std::move(callbacks),
+                                            std::move(decoder));
 }
 
 }  // namespace deform::client::internal

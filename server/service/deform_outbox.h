@@ -31,7 +31,9 @@ class DeformOutbox {
   static constexpr std::size_t kMaxNoticeBacklog = 1024;
 
   // Sizes the frames (FrameSlots::Allocate).
-  void AllocateFrames(int num_vertices) { frames_.Allocate(num_vertices); }
+  void AllocateFrames(int num_vertices, std::size_t encoded_bytes = 0, int transform_floats = 0) {
+    frames_.Allocate(num_vertices, encoded_bytes, transform_floats);
+  }
   // The frame the next solve fills (FrameSlots::working).
   v1::DeformResponse* working_frame() { return frames_.working(); }
   // The working frame is finished; it goes after the notices added so far.

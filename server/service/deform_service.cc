@@ -4,6 +4,7 @@
 
 #include "service/audit_log.h"
 #include "service/deform_stream_reactor.h"
+#include "service/frame_encoding.h"
 #include "service/load_mesh_reactor.h"
 #include "service/proto_conversion.h"
 #include "service/rejected_call.h"
@@ -60,6 +61,9 @@ grpc::ServerUnaryReactor* DeformServiceImpl::GetMeshInfo(grpc::CallbackServerCon
   }
   FillMeshSummary(**entry, response->mutable_summary());
   if (request->include_geometry()) FillMeshGeometry(**entry, response);
+  if (request->include_prediction_weights()) {
+    FillPredictionWeights(**entry, response->mutable_prediction_weights());
+  }
   reactor->Finish(grpc::Status::OK);
   return reactor;
 }

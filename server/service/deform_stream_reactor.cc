@@ -13,6 +13,7 @@
 #include "service/annotated_mutex.h"
 #include "service/audit_log.h"
 #include "service/deform_outbox.h"
+#include "service/frame_encoding.h"
 #include "service/frame_solver.h"
 #include "service/grpc_stream_sink.h"
 #include "service/log_text.h"
@@ -175,13 +176,20 @@ void DeformStreamReactor::HandleStart() {
   entry_->open_streams.fetch_add(1);
   model_ = entry_->model.get();
   log_context_ += " mesh=" + entry_->id;
+  auto encoder = MakeFrameEncoder(request_.start(), *entry_);
+  if (!encoder.ok()) {
+    Fail(ToGrpcCode(encoder.status().code()), encoder.status().message());
+    return;
+  }
+  const std::size_t encoded_bytes = *encoder ? (*encoder)->max_encoded_bytes() : 0;
+  const int transform_floats = codec::kFloatsPerBoneTransform * model_->skeleton().num_bones();
   // Everything a solve needs, sized once; frames in the client's vertex order.
-  solver_.emplace(*model_, entry_->presentation.file_vertex_to_mesh);
+  solver_.emplace(*model_, entry_->presentation.file_vertex_to_mesh, std::move(*encoder));
   spdlog::info("{} opened", log_context_);
 
   MutexLock lock(&mutex_);
   stiffness_.Reset(model_->default_factorization());
-  outbox_.AllocateFrames(entry_->client_vertex_count());
+  outbox_.AllocateFrames(entry_->client_vertex_count(), encoded_bytes, transform_floats);
   if (!pump_.finish_requested()) StartRead(&request_);
 }
 

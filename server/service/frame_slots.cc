@@ -8,11 +8,18 @@ namespace deform::service {
 
 FrameSlots::FrameSlots() : working_(&frames_[0]), ready_(&frames_[1]), writing_(&frames_[2]) {}
 
-void FrameSlots::Allocate(int num_vertices) {
+void FrameSlots::Allocate(int num_vertices, std::size_t encoded_bytes, int transform_floats) {
   const std::size_t position_bytes = static_cast<std::size_t>(num_vertices) * 12;
   for (v1::DeformResponse& response : frames_) {
     v1::DeformFrame* frame = response.mutable_frame();
-    frame->mutable_positions()->resize(position_bytes);
+    if (encoded_bytes > 0) {
+      v1::EncodedPositions* encoded = frame->mutable_encoded();
+      encoded->mutable_data()->reserve(encoded_bytes);
+      encoded->mutable_origin()->Reserve(3);
+      encoded->mutable_bone_transforms()->Reserve(transform_floats);
+    } else {
+      frame->mutable_positions()->resize(position_bytes);
+    }
     frame->mutable_timings();
   }
 }

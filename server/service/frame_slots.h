@@ -24,9 +24,10 @@ class FrameSlots {
   FrameSlots(const FrameSlots&) = delete;
   FrameSlots& operator=(const FrameSlots&) = delete;
 
-  // Sizes every frame for `num_vertices` (12 bytes of positions per vertex) and creates its
-  // timings: the only allocation.
-  void Allocate(int num_vertices);
+  // Sizes every frame for `num_vertices` (12 bytes of positions per vertex), or with
+  // `encoded_bytes` > 0 its encoded positions for that many bytes and `transform_floats` bone
+  // transform floats, and creates its timings: the only allocation.
+  void Allocate(int num_vertices, std::size_t encoded_bytes = 0, int transform_floats = 0);
 
   // The frame the next solve fills. Its pointer changes only in Publish().
   v1::DeformResponse* working() { return working_; }

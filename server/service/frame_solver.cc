@@ -1,8 +1,12 @@
 #include "service/frame_solver.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstddef>
+#include <string>
+#include <utility>
 
+#include "service/frame_encoding.h"
 #include "service/proto_conversion.h"
 
 namespace deform::service {
@@ -20,11 +24,38 @@ const std::vector<int> kSolvedOrder;
 
 FrameSolver::FrameSolver(const DeformationModel& model) : FrameSolver(model, kSolvedOrder) {}
 
-FrameSolver::FrameSolver(const DeformationModel& model, const std::vector<int>& client_order)
+FrameSolver::FrameSolver(const DeformationModel& model, const std::vector<int>& client_order,
+                         std::unique_ptr<codec::FrameEncoder> encoder)
     : model_(model),
       client_order_(client_order),
       pose_(Pose::Rest(model.skeleton())),
-      scratch_(model.MakeScratch()) {}
+      scratch_(model.MakeScratch()),
+      encoder_(std::move(encoder)),
+      bone_transforms_(static_cast<std::size_t>(codec::kFloatsPerBoneTransform) *
+                       model.skeleton().num_bones()) {}
+
+void FrameSolver::Encode(v1::DeformFrame* frame) {
+  v1::EncodedPositions* encoded = frame->mutable_encoded();
+  std::string* data = encoded->mutable_data();
+  data->resize(encoder_->max_encoded_bytes());  // within its capacity after FrameSlots::Allocate
+  const float* transforms = nullptr;
+  if (encoder_->predicted()) {
+    BoneTransformsAsFloats(scratch_.bone_transforms, bone_transforms_.data());
+    transforms = bone_transforms_.data();
+  }
+  codec::EncodedFrameHeader header;
+  data->resize(encoder_->Encode(scratch_.solution.data(), client_order_, transforms, &header,
+                                reinterpret_cast<unsigned char*>(data->data())));
+  const bool predicted = header.encoding == codec::FrameEncoding::kPredicted;
+  encoded->set_encoding(predicted ? v1::FRAME_ENCODING_PREDICTED : v1::FRAME_ENCODING_QUANTIZED);
+  encoded->set_step(header.step);
+  encoded->set_max_error(header.max_error);
+  encoded->mutable_origin()->Resize(predicted ? 0 : 3, 0.0);
+  for (int a = 0; !predicted && a < 3; ++a) encoded->mutable_origin()->Set(a, header.origin[a]);
+  auto* floats = encoded->mutable_bone_transforms();
+  floats->Resize(predicted ? static_cast<int>(bone_transforms_.size()) : 0, 0.0f);
+  if (predicted) std::copy(bone_transforms_.begin(), bone_transforms_.end(), floats->begin());
+}
 
 Status FrameSolver::Solve(const PoseInput& input, const MaterialFactorization& factorization,
                           const FrameStamp& stamp, v1::DeformFrame* frame) {
@@ -36,9 +67,13 @@ Status FrameSolver::Solve(const PoseInput& input, const MaterialFactorization& f
   const std::size_t client_vertices = client_order_.empty()
                                           ? static_cast<std::size_t>(scratch_.num_vertices)
                                           : client_order_.size();
-  frame->mutable_positions()->resize(client_vertices * 12);  // no-op when sized by FrameSlots
-  EncodeInClientOrder(scratch_.solution.data(), scratch_.num_vertices, client_order_,
-                      frame->mutable_positions()->data());
+  if (encoder_) {
+    Encode(frame);
+  } else {
+    frame->mutable_positions()->resize(client_vertices * 12);  // no-op when sized by FrameSlots
+    EncodeInClientOrder(scratch_.solution.data(), scratch_.num_vertices, client_order_,
+                        frame->mutable_positions()->data());
+  }
   frame->set_sequence(input.sequence);
   frame->set_client_timestamp_ns(input.client_timestamp_ns);
   frame->set_stiffness_version(stamp.stiffness_version);

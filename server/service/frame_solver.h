@@ -10,8 +10,10 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 
 #include "core/base/status.h"
+#include "core/codec/frame_codec.h"
 #include "core/geometry/pose.h"
 #include "core/model/deformation_model.h"
 #include "deform/v1/deform.pb.h"
@@ -29,13 +31,16 @@ struct FrameStamp {
 class FrameSolver {
  public:
   // `client_order`: per client vertex (the file's order) its solved vertex, or empty for the
-  // solved order itself (MeshPresentation); it must outlive the solver.
-  FrameSolver(const DeformationModel& model, const std::vector<int>& client_order);
+  // solved order itself (MeshPresentation); it must outlive the solver. `encoder`: the stream's
+  // compact encoding (frame_encoding.h), or null for float32 positions.
+  FrameSolver(const DeformationModel& model, const std::vector<int>& client_order,
+              std::unique_ptr<codec::FrameEncoder> encoder = nullptr);
   // Frames in the solved order.
   explicit FrameSolver(const DeformationModel& model);
 
-  // Solves `input` with `factorization` (one of the model's) into `frame`; its positions should
-  // already hold 12 bytes per vertex (FrameSlots::Allocate), or they are resized (allocating).
+  // Solves `input` with `factorization` (one of the model's) into `frame`: its positions, or with an
+  // encoder its `encoded` positions. Sized by FrameSlots::Allocate, a frame allocates nothing;
+  // otherwise it is resized (allocating).
   // INVALID_ARGUMENT naming the problem when the pose cannot be built; `frame` is then untouched.
   Status Solve(const PoseInput& input, const MaterialFactorization& factorization,
                const FrameStamp& stamp, v1::DeformFrame* frame);
@@ -43,8 +48,12 @@ class FrameSolver {
  private:
   const DeformationModel& model_;
   const std::vector<int>& client_order_;
+  void Encode(v1::DeformFrame* frame);
+
   Pose pose_;
   DeformScratch scratch_;
+  std::unique_ptr<codec::FrameEncoder> encoder_;
+  std::vector<float> bone_transforms_;  // 12 per bone, for predicted frames
 };
 
 }  // namespace deform::service

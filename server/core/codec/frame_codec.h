@@ -72,6 +72,7 @@ class FrameEncoder {
 class FrameDecoder {
  public:
   explicit FrameDecoder(int num_vertices);
+  int num_vertices() const { return num_vertices_; }
   // What kPredicted frames need (the mesh's rest positions and prediction weights, in the frames'
   // vertex order). INVALID_ARGUMENT when the sizes do not match or a weight is unusable.
   Status SetPrediction(std::vector<float> rest, PredictionWeights weights, int num_bones);
