@@ -4,12 +4,16 @@
 #              the built-in phantom with a 10-frame animation (knee flexion, a hip swing and root
 #              motion), and checks: exit 0, every frame measured, rigid-zone error below 1e-3 on
 #              every frame, the JSON parses, LBS measured beside the method.
+#   gltf       the same through a skinned glTF rig split at seams (WRITER, the 4th argument,
+#              writes it): frames come in the file's vertex order, more vertices than the solve's;
+#              the same checks, and that the frames were mapped (frame vertices > solved).
 #   malformed  an animation with a malformed line, and one with an unknown joint: exit code 2 and
 #              a stderr line naming the line number (checked before any server is contacted).
 set -euo pipefail
 DEFORMD="$1"
 BENCH="$2"
 MODE="$3"
+WRITER="${4:-}"
 WORK="$(mktemp -d)"
 SERVER=""
 cleanup() {
@@ -43,7 +47,15 @@ if [ "$MODE" = malformed ]; then
   exit 0
 fi
 
-[ "$MODE" = phantom ] || fail "unknown mode '$MODE'"
+case "$MODE" in
+  phantom) SOURCE=(); KNEE="knee:flexion" ;;
+  gltf)
+    "$WRITER" "$WORK/split.glb" || fail "cannot write the rig"
+    SOURCE=(--mesh "$WORK/split.glb")
+    KNEE="knee:x"  # a glTF rig's joints have no named degrees of freedom
+    ;;
+  *) fail "unknown mode '$MODE'" ;;
+esac
 "$DEFORMD" --listen 127.0.0.1:0 --log-level info >"$WORK/deformd.log" 2>&1 &
 SERVER=$!
 ADDRESS=""
@@ -59,18 +71,23 @@ done
   echo "# 10 frames: the knee 0 -> 120 -> 0 while the hip swings and the body moves forward"
   for k in 0 1 2 3 4 5 6 7 8 9; do
     knee=$(( k <= 5 ? k * 24 : (10 - k) * 24 ))
-    echo "knee:flexion:$knee, hip:x:$(( k - 5 )) ;root=0,0.$k,$k,0,1,0,$(( k * 2 ))"
+    echo "$KNEE:$knee, hip:x:$(( k - 5 )) ;root=0,0.$k,$k,0,1,0,$(( k * 2 ))"
   done
 } >"$WORK/walk.txt"
 
 code=0
-"$BENCH" --target "$ADDRESS" --poses "$WORK/walk.txt" --json >"$WORK/report.json" \
+"$BENCH" --target "$ADDRESS" "${SOURCE[@]}" --poses "$WORK/walk.txt" --json >"$WORK/report.json" \
   2>"$WORK/err.txt" || code=$?
 cat "$WORK/err.txt" >&2
 [ "$code" -eq 0 ] || fail "exit code $code"
-python3 - "$WORK/report.json" <<'PY'
+python3 - "$WORK/report.json" "$MODE" <<'PY'
 import json, math, sys
 report = json.load(open(sys.argv[1]))
+if sys.argv[2] == "gltf":
+    assert report["frame_vertices"] > report["solved_vertices"], report
+    assert report["binding"] == "given weights", report["binding"]
+else:
+    assert report["frame_vertices"] == report["solved_vertices"], report
 frames = report["per_frame"]
 assert report["frames"] == 10, report["frames"]
 for key in ("volume_change", "lbs_volume_change", "clearance_min", "lbs_clearance_min",
