@@ -109,8 +109,8 @@ double Percentile(std::vector<double> values, double q) {
 
 std::string ReportText(const RunHeader& header, const std::vector<FrameRecord>& frames) {
   std::string out;
-  out += "mesh " + header.mesh + " (" + header.mesh_id + "): " +
-         std::to_string(header.frame_vertices) + " vertices per frame, " +
+  out += "mesh " + header.mesh + " (" + header.mesh_id +
+         "): " + std::to_string(header.frame_vertices) + " vertices per frame, " +
          std::to_string(header.solved_vertices) + " solved, " +
          std::to_string(header.rigid_vertices) + " in rigid zones\n";
   out += "rotation blend " + header.rotation_blend + "; binding " + header.binding +
@@ -129,7 +129,8 @@ std::string ReportText(const RunHeader& header, const std::vector<FrameRecord>& 
                   r.measures.lbs_clearance_min, r.measures.rigid_zone_error, r.round_trip_ms);
     out += line;
   }
-  out += "\nsummary over " + std::to_string(frames.size()) + " frames (worst: largest |volume "
+  out += "\nsummary over " + std::to_string(frames.size()) +
+         " frames (worst: largest |volume "
          "change|, smallest clearance, largest error and latency)\n";
   std::snprintf(line, sizeof(line), "  %-18s %12s %12s %8s\n", "", "median", "worst", "frame");
   out += line;
@@ -193,7 +194,8 @@ nlohmann::ordered_json ReportJson(const RunHeader& header, const std::vector<Fra
   nlohmann::ordered_json summary;
   for (const Metric& metric : Metrics()) {
     const MetricSummary s = Summarize(Column(frames, metric), metric.worst);
-    summary[metric.key] = {{"median", s.median}, {"worst", s.worst}, {"worst_frame", s.worst_frame}};
+    summary[metric.key] = {
+        {"median", s.median}, {"worst", s.worst}, {"worst_frame", s.worst_frame}};
   }
   const std::vector<double> latency = Column(frames, MetricNamed("latency_ms"));
   summary["latency_ms"]["p50"] = Percentile(latency, 0.50);

@@ -34,11 +34,11 @@ Status ParseRoot(std::string_view text, int line, RootPlacement* root) {
   root->translation = {values[0], values[1], values[2]};
   root->axis = {values[3], values[4], values[5]};
   root->degrees = values[6];
-  const double axis_length = std::sqrt(values[3] * values[3] + values[4] * values[4] +
-                                       values[5] * values[5]);
+  const double axis_length =
+      std::sqrt(values[3] * values[3] + values[4] * values[4] + values[5] * values[5]);
   if (root->degrees != 0 && !(axis_length > 0)) {
-    return LineError(line, "root rotation of " + std::string(Trim(fields[6])) +
-                               " degrees about a zero axis");
+    return LineError(
+        line, "root rotation of " + std::string(Trim(fields[6])) + " degrees about a zero axis");
   }
   if (!(axis_length > 0)) root->axis = {1, 0, 0};
   return Status::Ok();
@@ -56,8 +56,8 @@ StatusOr<AnimationFrame> ParseFrame(std::string_view text, int line) {
   if (semicolon != std::string_view::npos) {
     const std::string_view extra = Trim(text.substr(semicolon + 1));
     if (extra.substr(0, kRootPrefix.size()) != kRootPrefix) {
-      return LineError(line, "'" + std::string(extra) +
-                                 "' after ';' is not root=TX,TY,TZ,AX,AY,AZ,DEG");
+      return LineError(line,
+                       "'" + std::string(extra) + "' after ';' is not root=TX,TY,TZ,AX,AY,AZ,DEG");
     }
     DEFORM_RETURN_IF_ERROR(ParseRoot(extra.substr(kRootPrefix.size()), line, &frame.root));
     frame.has_root = true;

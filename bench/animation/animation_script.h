@@ -29,8 +29,8 @@ struct RootPlacement {
 };
 
 struct AnimationFrame {
-  int line = 0;          // 1-based line number in the file
-  std::string text;      // the line as written (trimmed, comment removed), for reports
+  int line = 0;           // 1-based line number in the file
+  std::string text;       // the line as written (trimmed, comment removed), for reports
   std::string pose_spec;  // the part before ';'
   std::vector<PoseSpecTerm> terms;
   bool has_root = false;

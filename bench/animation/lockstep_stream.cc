@@ -58,9 +58,9 @@ grpc::Status LockstepStream::Exchange(deform::v1::PoseUpdate pose, int timeout_m
                         "the stream ended before pose " + std::to_string(sequence) + " was sent");
   }
   std::unique_lock<std::mutex> lock(shared_->mu);
-  shared_->changed.wait_for(
-      lock, std::chrono::milliseconds(timeout_ms),
-      [&] { return shared_->answered || shared_->rejected || shared_->done; });
+  shared_->changed.wait_for(lock, std::chrono::milliseconds(timeout_ms), [&] {
+    return shared_->answered || shared_->rejected || shared_->done;
+  });
   if (shared_->answered) {
     answer->frame = std::move(shared_->frame);
     answer->round_trip_ms = static_cast<double>(shared_->arrival_ns - sent_ns) * 1e-6;
@@ -71,11 +71,10 @@ grpc::Status LockstepStream::Exchange(deform::v1::PoseUpdate pose, int timeout_m
                         "pose " + std::to_string(sequence) + " rejected: " + shared_->rejection);
   }
   if (shared_->done) {
-    return shared_->final_status.ok()
-               ? grpc::Status(grpc::StatusCode::UNAVAILABLE,
-                              "the stream ended before pose " + std::to_string(sequence) +
-                                  " was answered")
-               : shared_->final_status;
+    return shared_->final_status.ok() ? grpc::Status(grpc::StatusCode::UNAVAILABLE,
+                                                     "the stream ended before pose " +
+                                                         std::to_string(sequence) + " was answered")
+                                      : shared_->final_status;
   }
   return grpc::Status(grpc::StatusCode::DEADLINE_EXCEEDED,
                       "no frame for pose " + std::to_string(sequence) + " within " +

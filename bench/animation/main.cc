@@ -97,8 +97,8 @@ int RunOnMesh(deform::client::DeformClient& client, const BenchArgs& args,
     deform::animation::LockstepStream stream(client, summary.mesh_id());
     for (std::size_t k = 0; k < frames.size(); ++k) {
       deform::animation::AnsweredPose answer;
-      const grpc::Status exchanged = stream.Exchange(
-          deform::animation::PoseUpdateOf(frames[k], 0), args.frame_timeout_ms, &answer);
+      const grpc::Status exchanged = stream.Exchange(deform::animation::PoseUpdateOf(frames[k], 0),
+                                                     args.frame_timeout_ms, &answer);
       if (!exchanged.ok()) {
         return Fail(grpc::Status(exchanged.error_code(), "frame " + std::to_string(k) + " (line " +
                                                              std::to_string(frames[k].line) +
@@ -145,8 +145,7 @@ void AddFlags(CLI::App& app, BenchArgs& args) {
                  "about the axis AX,AY,AZ); blank lines and # comments ignored")
       ->required();
   app.add_flag("--json", args.json, "Print one JSON object (per-frame arrays and a summary)");
-  app.add_option("--frame-timeout-ms", args.frame_timeout_ms,
-                 "How long to wait for each frame")
+  app.add_option("--frame-timeout-ms", args.frame_timeout_ms, "How long to wait for each frame")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
 }
@@ -180,7 +179,8 @@ int main(int argc, char** argv) {
   }
   const auto build_start = std::chrono::steady_clock::now();
   auto model = deform::DeformationModel::Build(
-      reference->input.mesh, reference->input.skeleton, ReferenceOptions(args.source.rotation_blend),
+      reference->input.mesh, reference->input.skeleton,
+      ReferenceOptions(args.source.rotation_blend),
       reference->input.weights.has_value() ? &*reference->input.weights : nullptr);
   if (!model.ok()) return Fail(model.status().WithContext("local reference model"));
   reference->model = std::move(*model);

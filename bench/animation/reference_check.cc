@@ -22,7 +22,8 @@ grpc::Status CheckServerMatchesReference(client::DeformClient& client,
   if (static_cast<int>(summary.vertex_count()) != order.frame_vertices()) {
     return Differs("vertices per frame", summary.vertex_count(), order.frame_vertices());
   }
-  if (summary.solved_vertex_count() != 0 && static_cast<int>(summary.solved_vertex_count()) != solved) {
+  if (summary.solved_vertex_count() != 0 &&
+      static_cast<int>(summary.solved_vertex_count()) != solved) {
     return Differs("solved vertices", summary.solved_vertex_count(), solved);
   }
   if (static_cast<int>(summary.triangle_count()) != model.mesh().num_triangles()) {

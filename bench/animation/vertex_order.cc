@@ -33,14 +33,13 @@ StatusOr<VertexOrder> VertexOrder::Create(const std::vector<int>& file_vertex_to
   return order;
 }
 
-Status VertexOrder::ToModelOrder(const std::string& positions_bytes,
-                                 Positions* model_order) const {
+Status VertexOrder::ToModelOrder(const std::string& positions_bytes, Positions* model_order) const {
   const std::size_t expected = static_cast<std::size_t>(frame_vertices_) * 3 * sizeof(float);
   if (positions_bytes.size() != expected) {
     return Status::InvalidArgument("a frame of " + std::to_string(positions_bytes.size()) +
                                    " position bytes, expected " + std::to_string(expected) +
-                                   " (3 float32 per vertex for " +
-                                   std::to_string(frame_vertices_) + " vertices)");
+                                   " (3 float32 per vertex for " + std::to_string(frame_vertices_) +
+                                   " vertices)");
   }
   const auto* data = reinterpret_cast<const unsigned char*>(positions_bytes.data());
   const auto mesh_vertices = static_cast<Eigen::Index>(source_of_mesh_vertex_.size());
@@ -50,10 +49,9 @@ Status VertexOrder::ToModelOrder(const std::string& positions_bytes,
     for (int c = 0; c < 3; ++c) {
       // Little-endian float32 whatever the host's byte order (as DecodePositions).
       const unsigned char* bytes = data + 4 * (first + static_cast<std::size_t>(c));
-      const std::uint32_t bits = static_cast<std::uint32_t>(bytes[0]) |
-                                 static_cast<std::uint32_t>(bytes[1]) << 8 |
-                                 static_cast<std::uint32_t>(bytes[2]) << 16 |
-                                 static_cast<std::uint32_t>(bytes[3]) << 24;
+      const std::uint32_t bits =
+          static_cast<std::uint32_t>(bytes[0]) | static_cast<std::uint32_t>(bytes[1]) << 8 |
+          static_cast<std::uint32_t>(bytes[2]) << 16 | static_cast<std::uint32_t>(bytes[3]) << 24;
       float value;
       std::memcpy(&value, &bits, sizeof(float));
       (*model_order)(m, c) = static_cast<double>(value);

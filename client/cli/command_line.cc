@@ -35,8 +35,8 @@ MeshSourceOptions AddMeshSourceFlags(CLI::App& app, MeshSource* source) {
   options.skeleton->needs(options.mesh);
   options.weights->needs(options.mesh);
   app.parse_complete_callback([source] {
-    const bool rig = !source->mesh_path.empty() && client::MeshFormatFromPath(source->mesh_path) ==
-                                                       deform::v1::MESH_FORMAT_GLTF;
+    const bool rig = !source->mesh_path.empty() &&
+                     client::MeshFormatFromPath(source->mesh_path) == deform::v1::MESH_FORMAT_GLTF;
     if (!source->mesh_path.empty() && source->skeleton_path.empty() && !rig) {
       throw CLI::RequiresError("--mesh", "--skeleton (only a .gltf/.glb rig brings its own)");
     }

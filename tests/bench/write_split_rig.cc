@@ -27,9 +27,9 @@ int main(int argc, char** argv) {
   weights.num_bones = phantom->skeleton.num_bones();
   const auto add_weights_of = [&](int v) {
     const auto first = harmonic.offsets[v], last = harmonic.offsets[v + 1];
-    weights.AddVertex(std::vector<int>(harmonic.bones.begin() + first, harmonic.bones.begin() + last),
-                      std::vector<double>(harmonic.weights.begin() + first,
-                                          harmonic.weights.begin() + last));
+    weights.AddVertex(
+        std::vector<int>(harmonic.bones.begin() + first, harmonic.bones.begin() + last),
+        std::vector<double>(harmonic.weights.begin() + first, harmonic.weights.begin() + last));
   };
   const int n = phantom->mesh.num_vertices();
   for (int v = 0; v < n; ++v) add_weights_of(v);
