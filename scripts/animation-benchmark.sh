@@ -96,15 +96,23 @@ else
   cmake --build "$BIN" --parallel "$(nproc)" --target deformd deform-animation-bench >&2
 fi
 
-"$BIN/server/deformd/deformd" --listen 127.0.0.1:0 --log-level info >"$WORK/deformd.log" 2>&1 &
-SERVER=$!
-ADDRESS=""
-for _ in $(seq 1 300); do
-  ADDRESS="$(sed -n 's/.*listening on \([0-9.]*:[0-9]*\).*/\1/p' "$WORK/deformd.log" | head -n 1)"
-  [ -n "$ADDRESS" ] && break
-  kill -0 "$SERVER" 2>/dev/null || { echo "animation-benchmark: deformd exited:" >&2; cat "$WORK/deformd.log" >&2; exit 1; }
-  sleep 0.1
-done
+# Port 0: the kernel picks a free port. 50051 is left to the demo and to others' servers.
+start_server() {
+  "$BIN/server/deformd/deformd" --listen 127.0.0.1:0 --log-level info >"$WORK/deformd.log" 2>&1 &
+  SERVER=$!
+  ADDRESS=""
+  for _ in $(seq 1 300); do
+    ADDRESS="$(sed -n 's/.*listening on \([0-9.]*:[0-9]*\).*/\1/p' "$WORK/deformd.log" | head -n 1)"
+    [ -n "$ADDRESS" ] && return 0
+    kill -0 "$SERVER" 2>/dev/null || { echo "animation-benchmark: deformd exited:" >&2; cat "$WORK/deformd.log" >&2; exit 1; }
+    sleep 0.1
+  done
+}
+start_server
+if [ "${ADDRESS##*:}" = 50051 ]; then
+  kill -TERM "$SERVER"; wait "$SERVER" || true
+  start_server
+fi
 [ -n "$ADDRESS" ] || { echo "animation-benchmark: deformd did not report its address" >&2; exit 1; }
 
 "$BIN/bench/animation/deform-animation-bench" --target "$ADDRESS" "${SOURCE[@]}" \

@@ -35,7 +35,8 @@ class LockstepStream {
   grpc::Status Finish(int timeout_ms);
 
  private:
-  // The state the stream's callbacks (gRPC threads) share with the caller.
+  // The state the stream's callbacks (gRPC threads) share with the caller; `mu` guards every
+  // other field. Shared-owned so that a callback arriving after this object is gone finds it alive.
   struct Shared {
     std::mutex mu;
     std::condition_variable changed;
