@@ -7,7 +7,38 @@
 
 namespace deform::cli {
 
+void AddSecurityFlags(CLI::App& app, SecurityArgs* args) {
+  app.add_flag("--tls", args->tls, "Connect with TLS (the system's trusted roots unless --tls-ca)")
+      ->envname("DEFORM_TLS");
+  app.add_option("--tls-ca", args->ca_file, "PEM CA of the server's certificate (implies --tls)")
+      ->envname("DEFORM_TLS_CA");
+  app.add_option("--tls-cert", args->cert_file,
+                 "PEM client certificate for mutual TLS (with --tls-key; implies --tls)")
+      ->envname("DEFORM_TLS_CERT");
+  app.add_option("--tls-key", args->key_file, "PEM private key of --tls-cert")
+      ->envname("DEFORM_TLS_KEY");
+  app.add_option("--tls-server-name", args->server_name,
+                 "Name the server's certificate carries, when not the target's host (implies --tls)")
+      ->envname("DEFORM_TLS_SERVER_NAME");
+  app.add_option("--token", args->token,
+                 "Bearer token sent with every call (deformd --token-file); prefer DEFORM_TOKEN, "
+                 "which other users cannot read in the process list")
+      ->envname("DEFORM_TOKEN");
+}
+
+grpc::Status MakeClientOptions(const SecurityArgs& args, client::ClientOptions* options) {
+  options->token = args.token;
+  const bool tls = args.tls || !args.ca_file.empty() || !args.cert_file.empty() ||
+                   !args.key_file.empty() || !args.server_name.empty();
+  if (!tls) return grpc::Status::OK;
+  const grpc::Status loaded =
+      client::LoadClientTlsFiles(args.ca_file, args.cert_file, args.key_file, &options->tls);
+  options->tls.server_name = args.server_name;
+  return loaded;
+}
+
 void AddConnectionFlags(CLI::App& app, ConnectionArgs* args) {
+  AddSecurityFlags(app, &args->security);
   app.add_option("--target", args->target, "Server address host:port")->capture_default_str();
   app.add_option("--connect-timeout-ms", args->connect_timeout_ms,
                  "How long to wait for the server to be reachable")
@@ -78,7 +109,10 @@ int RunOnAcquiredMesh(
     const char* program, const ConnectionArgs& connection, const MeshSource& source,
     const std::function<int(client::DeformClient&, const deform::v1::MeshSummary&)>& run_on_mesh,
     const std::function<bool(bool loaded)>& unload) {
-  client::DeformClient client(connection.target);
+  client::ClientOptions options;
+  const grpc::Status configured = MakeClientOptions(connection.security, &options);
+  if (!configured.ok()) return ReportFailure(program, configured);
+  client::DeformClient client(connection.target, options);
   const grpc::Status connected = WaitForServer(client, connection);
   if (!connected.ok()) return ReportFailure(program, connected);
   deform::v1::MeshSummary summary;

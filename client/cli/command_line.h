@@ -13,12 +13,32 @@
 
 namespace deform::cli {
 
+// How to talk to a secured server: TLS files and the bearer token.
+struct SecurityArgs {
+  bool tls = false;          // --tls: TLS with the system's trusted roots
+  std::string ca_file;       // --tls-ca: the server's CA (implies TLS)
+  std::string cert_file;     // --tls-cert / --tls-key: client certificate for mutual TLS
+  std::string key_file;
+  std::string server_name;   // --tls-server-name: the name the server's certificate carries
+  std::string token;         // --token: bearer token
+};
+
+// --tls, --tls-ca, --tls-cert, --tls-key, --tls-server-name, --token; each also read from the
+// environment (DEFORM_TLS=1, DEFORM_TLS_CA, DEFORM_TLS_CERT, DEFORM_TLS_KEY,
+// DEFORM_TLS_SERVER_NAME, DEFORM_TOKEN), the command line winning.
+void AddSecurityFlags(CLI::App& app, SecurityArgs* args);
+
+// Client options from the security flags (TLS when any TLS flag is given, reading the files):
+// NOT_FOUND naming an unreadable file, INVALID_ARGUMENT for a certificate without its key.
+grpc::Status MakeClientOptions(const SecurityArgs& args, client::ClientOptions* options);
+
 struct ConnectionArgs {
   std::string target = "127.0.0.1:50051";  // host:port
   int connect_timeout_ms = 5000;           // how long to wait for the server to be reachable
+  SecurityArgs security;
 };
 
-// --target and --connect-timeout-ms.
+// --target, --connect-timeout-ms and the security flags (AddSecurityFlags).
 void AddConnectionFlags(CLI::App& app, ConnectionArgs* args);
 
 // The options AddMeshSourceFlags adds, for further constraints (e.g. excludes).

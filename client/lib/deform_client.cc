@@ -11,14 +11,6 @@
 namespace deform::client {
 namespace {
 
-std::shared_ptr<grpc::Channel> MakeChannel(const std::string& target,
-                                           const ClientOptions& options) {
-  grpc::ChannelArguments arguments;
-  arguments.SetMaxReceiveMessageSize(options.max_receive_message_bytes);
-  arguments.SetMaxSendMessageSize(-1);
-  return grpc::CreateCustomChannel(target, grpc::InsecureChannelCredentials(), arguments);
-}
-
 grpc::Status ReadWholeFile(const std::string& path, std::string* contents) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return grpc::Status(grpc::StatusCode::NOT_FOUND, "cannot open '" + path + "'");
@@ -52,6 +44,7 @@ grpc::Status RunLoadMesh(deform::v1::DeformService::Stub* stub, const ClientOpti
                          const deform::v1::LoadMeshHeader& header, const std::string* mesh_bytes,
                          deform::v1::MeshSummary* summary, const ProgressCallback& progress) {
   grpc::ClientContext context;
+  AddCallCredentials(options, &context);
   auto stream = stub->LoadMesh(&context);
   deform::v1::LoadMeshRequest request;
   *request.mutable_header() = header;
@@ -82,8 +75,49 @@ grpc::Status RunLoadMesh(deform::v1::DeformService::Stub* stub, const ClientOpti
 
 }  // namespace
 
+grpc::Status LoadClientTlsFiles(const std::string& ca_file, const std::string& cert_file,
+                                const std::string& key_file, ClientTls* tls) {
+  if (cert_file.empty() != key_file.empty()) {
+    return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
+                        "a client certificate needs its key and a key its certificate");
+  }
+  tls->enabled = true;
+  if (!ca_file.empty()) {
+    const grpc::Status read = ReadWholeFile(ca_file, &tls->ca_pem);
+    if (!read.ok()) return read;
+  }
+  if (!cert_file.empty()) {
+    grpc::Status read = ReadWholeFile(cert_file, &tls->cert_pem);
+    if (read.ok()) read = ReadWholeFile(key_file, &tls->key_pem);
+    if (!read.ok()) return read;
+  }
+  return grpc::Status::OK;
+}
+
+std::shared_ptr<grpc::Channel> MakeDeformChannel(const std::string& target,
+                                                 const ClientOptions& options) {
+  grpc::ChannelArguments arguments;
+  arguments.SetMaxReceiveMessageSize(options.max_receive_message_bytes);
+  arguments.SetMaxSendMessageSize(-1);
+  if (!options.tls.enabled) {
+    return grpc::CreateCustomChannel(target, grpc::InsecureChannelCredentials(), arguments);
+  }
+  grpc::SslCredentialsOptions ssl;
+  ssl.pem_root_certs = options.tls.ca_pem;
+  ssl.pem_cert_chain = options.tls.cert_pem;
+  ssl.pem_private_key = options.tls.key_pem;
+  if (!options.tls.server_name.empty()) {
+    arguments.SetSslTargetNameOverride(options.tls.server_name);
+  }
+  return grpc::CreateCustomChannel(target, grpc::SslCredentials(ssl), arguments);
+}
+
+void AddCallCredentials(const ClientOptions& options, grpc::ClientContext* context) {
+  if (!options.token.empty()) context->AddMetadata("authorization", "Bearer " + options.token);
+}
+
 DeformClient::DeformClient(const std::string& target, ClientOptions options)
-    : DeformClient(MakeChannel(target, options), options) {}
+    : DeformClient(MakeDeformChannel(target, options), options) {}
 
 DeformClient::DeformClient(std::shared_ptr<grpc::Channel> channel, ClientOptions options)
     : channel_(std::move(channel)),
@@ -170,6 +204,7 @@ grpc::Status DeformClient::GetMeshInfo(const std::string& mesh_id, bool include_
                                        deform::v1::GetMeshInfoResponse* info) {
   grpc::ClientContext context;
   SetUnaryDeadline(options_, &context);
+  AddCallCredentials(options_, &context);
   deform::v1::GetMeshInfoRequest request;
   request.set_mesh_id(mesh_id);
   request.set_include_geometry(include_geometry);
@@ -179,6 +214,7 @@ grpc::Status DeformClient::GetMeshInfo(const std::string& mesh_id, bool include_
 grpc::Status DeformClient::ListMeshes(std::vector<deform::v1::MeshSummary>* meshes) {
   grpc::ClientContext context;
   SetUnaryDeadline(options_, &context);
+  AddCallCredentials(options_, &context);
   deform::v1::ListMeshesResponse response;
   const grpc::Status status =
       stub_->ListMeshes(&context, deform::v1::ListMeshesRequest(), &response);
@@ -191,6 +227,7 @@ grpc::Status DeformClient::ListMeshes(std::vector<deform::v1::MeshSummary>* mesh
 grpc::Status DeformClient::UnloadMesh(const std::string& mesh_id) {
   grpc::ClientContext context;
   SetUnaryDeadline(options_, &context);
+  AddCallCredentials(options_, &context);
   deform::v1::UnloadMeshRequest request;
   request.set_mesh_id(mesh_id);
   deform::v1::UnloadMeshResponse response;
@@ -199,7 +236,7 @@ grpc::Status DeformClient::UnloadMesh(const std::string& mesh_id) {
 
 std::unique_ptr<DeformStream> DeformClient::OpenStream(const std::string& mesh_id,
                                                        StreamCallbacks callbacks) {
-  return internal::StartDeformStream(stub_.get(), mesh_id, std::move(callbacks));
+  return internal::StartDeformStream(stub_.get(), options_, mesh_id, std::move(callbacks));
 }
 
 }  // namespace deform::client

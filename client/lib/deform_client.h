@@ -18,6 +18,28 @@
 
 namespace deform::client {
 
+// TLS towards the server. PEM contents, not paths (LoadClientTlsFiles reads the files).
+struct ClientTls {
+  // Use TLS. Default: false (plaintext, which deformd serves on loopback addresses only unless
+  // started with --plaintext).
+  bool enabled = false;
+  // The CA that signed the server's certificate; empty: the system's trusted roots.
+  std::string ca_pem;
+  // The client's own certificate chain and key, for a server that requires mutual TLS; empty:
+  // none.
+  std::string cert_pem;
+  std::string key_pem;
+  // The name the server's certificate must carry when it differs from the target's host (e.g.
+  // connecting to an IP address). Default: the target's host.
+  std::string server_name;
+};
+
+// Reads PEM files into `tls` (and sets tls->enabled): `ca_file` may be empty (system roots),
+// `cert_file` and `key_file` both or neither. NOT_FOUND naming an unreadable file,
+// INVALID_ARGUMENT for a certificate without its key or the reverse.
+grpc::Status LoadClientTlsFiles(const std::string& ca_file, const std::string& cert_file,
+                                const std::string& key_file, ClientTls* tls);
+
 struct ClientOptions {
   // Largest message accepted (a 133k-vertex mesh's geometry is about 5 MB). Default: 256 MiB.
   int max_receive_message_bytes = 256 << 20;
@@ -27,7 +49,19 @@ struct ClientOptions {
   // this long. LoadMesh and Deform streams have none (a load's time grows with the mesh; a stream
   // lives as long as the session). Default: 30 s.
   int unary_deadline_ms = 30'000;
+  // Transport security (above). Default: plaintext.
+  ClientTls tls;
+  // Bearer token sent with every call as the metadata "authorization: Bearer <token>" (a server
+  // with a token file refuses calls without a valid one). Default: none.
+  std::string token;
 };
+
+// The channel DeformClient(target, options) uses: TLS or plaintext, message limits. For other
+// stubs on the same server (e.g. the health service).
+std::shared_ptr<grpc::Channel> MakeDeformChannel(const std::string& target,
+                                                 const ClientOptions& options);
+// Adds options.token (if any) to `context` as "authorization: Bearer <token>".
+void AddCallCredentials(const ClientOptions& options, grpc::ClientContext* context);
 
 using ProgressCallback = std::function<void(const deform::v1::LoadMeshResponse&)>;
 
@@ -35,7 +69,7 @@ class DeformStream;
 
 class DeformClient {
  public:
-  // Connects lazily to `target` ("host:port"), insecure channel.
+  // Connects lazily to `target` ("host:port") through MakeDeformChannel(target, options).
   explicit DeformClient(const std::string& target, ClientOptions options = {});
   explicit DeformClient(std::shared_ptr<grpc::Channel> channel, ClientOptions options = {});
 

@@ -18,9 +18,10 @@ class DeformStreamImpl final
     : public DeformStream,
       public grpc::ClientBidiReactor<deform::v1::DeformRequest, deform::v1::DeformResponse> {
  public:
-  DeformStreamImpl(deform::v1::DeformService::Stub* stub, const std::string& mesh_id,
-                   DeformClient::StreamCallbacks callbacks)
+  DeformStreamImpl(deform::v1::DeformService::Stub* stub, const ClientOptions& options,
+                   const std::string& mesh_id, DeformClient::StreamCallbacks callbacks)
       : callbacks_(std::move(callbacks)) {
+    AddCallCredentials(options, &context_);
     stub->async()->Deform(&context_, this);
     in_flight_.mutable_start()->set_mesh_id(mesh_id);
     write_in_flight_ = true;
@@ -157,9 +158,10 @@ class DeformStreamImpl final
 }  // namespace
 
 std::unique_ptr<DeformStream> StartDeformStream(deform::v1::DeformService::Stub* stub,
+                                                const ClientOptions& options,
                                                 const std::string& mesh_id,
                                                 DeformClient::StreamCallbacks callbacks) {
-  return std::make_unique<DeformStreamImpl>(stub, mesh_id, std::move(callbacks));
+  return std::make_unique<DeformStreamImpl>(stub, options, mesh_id, std::move(callbacks));
 }
 
 }  // namespace deform::client::internal

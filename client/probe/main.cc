@@ -1,7 +1,11 @@
 // deform-health-probe: asks a server's standard gRPC health service whether it is serving.
 //
 //   deform-health-probe [--target HOST:PORT] [--service NAME] [--timeout-ms MS]
+//                       [--tls-ca PEM] [--tls-cert PEM --tls-key PEM] [--tls-server-name NAME]
 //
+// The TLS flags (and their environment variables, DEFORM_TLS_CA etc.) are the other clients'
+// (client/cli/command_line.h), so a container that sets them for deformd's clients health-checks a
+// TLS server too. The health service itself needs no token.
 // Exit code 0 when the status is SERVING, 1 otherwise (with the reason on stderr), 2 for bad flags.
 // Used by the container's HEALTHCHECK (no such probe is packaged in Debian).
 #include <grpcpp/grpcpp.h>
@@ -11,7 +15,9 @@
 #include <iostream>
 #include <string>
 
+#include "cli/command_line.h"
 #include "health.grpc.pb.h"
+#include "lib/deform_client.h"
 
 int main(int argc, char** argv) {
   std::string target = "127.0.0.1:50051";
@@ -23,6 +29,8 @@ int main(int argc, char** argv) {
   app.add_option("--timeout-ms", timeout_ms, "Deadline of the check")
       ->capture_default_str()
       ->check(CLI::Range(1, 600000));
+  deform::cli::SecurityArgs security;
+  deform::cli::AddSecurityFlags(app, &security);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -31,9 +39,16 @@ int main(int argc, char** argv) {
     return 2;
   }
 
-  auto channel = grpc::CreateChannel(target, grpc::InsecureChannelCredentials());
+  deform::client::ClientOptions options;
+  const grpc::Status configured = deform::cli::MakeClientOptions(security, &options);
+  if (!configured.ok()) {
+    std::cerr << "deform-health-probe: " << configured.error_message() << "\n";
+    return 1;
+  }
+  auto channel = deform::client::MakeDeformChannel(target, options);
   auto stub = grpc::health::v1::Health::NewStub(channel);
   grpc::ClientContext context;
+  deform::client::AddCallCredentials(options, &context);
   context.set_deadline(std::chrono::system_clock::now() + std::chrono::milliseconds(timeout_ms));
   grpc::health::v1::HealthCheckRequest request;
   request.set_service(service);

@@ -3,9 +3,21 @@
 //   deformd [--listen ADDR] [--workers N] [--max-vertices N] [--max-meshes N] [--max-memory-mb N]
 //           [--max-message-mb N] [--max-upload-mb N] [--log-level LEVEL]
 //           [--preload MESH:SKELETON]... [--preload-phantom N]...
+//           [--tls-cert PEM --tls-key PEM [--tls-client-ca PEM]] [--plaintext]
+//           [--token-file FILE] [--tenant-max-meshes N] [--tenant-max-streams N]
+//           [--tenant-max-memory-mb N] [--preload-tenant NAME] [--store DIR]
+//
+// --store DIR keeps loaded meshes on disk and builds them again, under their ids and owners, when
+// the server starts (service/mesh_store.h); preloads are not kept (their flags bring them back).
+//
+// Transport: TLS with --tls-cert/--tls-key (mutual TLS with --tls-client-ca); without a
+// certificate, plaintext on a loopback address only, unless --plaintext (service/transport_security.h).
+// Each of these flags also reads an environment variable (DEFORMD_TLS_CERT, DEFORMD_TLS_KEY,
+// DEFORMD_TLS_CLIENT_CA, DEFORMD_PLAINTEXT=1); a flag given on the command line wins.
 //
 // Preloaded meshes are built before the server listens. SIGTERM or SIGINT drains: open streams
-// end with UNAVAILABLE, calls in progress get a few seconds, then the process exits 0.
+// end with UNAVAILABLE, calls in progress get a few seconds, then the process exits 0. SIGHUP
+// reloads the token file (service/identity.h; a bad file keeps the old tokens, logged).
 #include <pthread.h>
 #include <spdlog/spdlog.h>
 
@@ -17,6 +29,7 @@
 
 #include "core/io/model_input.h"
 #include "service/deform_server.h"
+#include "service/identity.h"
 #include "service/service_options.h"
 
 namespace {
@@ -33,6 +46,10 @@ struct Args {
   std::vector<std::string> preload;
   std::vector<int> preload_phantom;
   double shutdown_grace_s = 5;
+  std::string token_file;
+  std::string store_dir;
+  std::size_t tenant_max_memory_mb = 0;
+  std::string preload_tenant = deform::service::Identity::Implicit().tenant;
 };
 
 // One mesh to load before serving: files (--preload MESH:SKELETON) or the phantom
@@ -74,7 +91,7 @@ bool PreloadAll(const Args& args, DeformServer* server) {
       return false;
     }
     const std::string name = input->description;
-    auto entry = server->Preload(std::move(*input), name);
+    auto entry = server->Preload(std::move(*input), name, args.preload_tenant);
     if (!entry.ok()) {
       spdlog::error("{}: {}", request.flag, entry.status().ToString());
       return false;
@@ -91,6 +108,7 @@ int main(int argc, char** argv) {
   sigemptyset(&stop_signals);
   sigaddset(&stop_signals, SIGINT);
   sigaddset(&stop_signals, SIGTERM);
+  sigaddset(&stop_signals, SIGHUP);
   pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
 
   Args args;
@@ -125,6 +143,43 @@ int main(int argc, char** argv) {
                  "On SIGTERM/SIGINT, seconds given to calls in progress")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 600.0));
+  app.add_option("--tls-cert", args.server.security.cert_file,
+                 "PEM certificate chain: serve TLS (with --tls-key)")
+      ->envname("DEFORMD_TLS_CERT");
+  app.add_option("--tls-key", args.server.security.key_file, "PEM private key of --tls-cert")
+      ->envname("DEFORMD_TLS_KEY");
+  app.add_option("--tls-client-ca", args.server.security.client_ca_file,
+                 "PEM CA of client certificates: mutual TLS, clients without one are refused")
+      ->envname("DEFORMD_TLS_CLIENT_CA");
+  app.add_flag("--plaintext", args.server.security.allow_plaintext,
+               "Without a certificate, serve plaintext on a non-loopback address too")
+      ->envname("DEFORMD_PLAINTEXT");
+  app.add_option("--token-file", args.token_file,
+                 "Bearer tokens: lines 'SHA256-HEX TENANT tenant|operator'; reloaded on SIGHUP. "
+                 "Without it every caller is one implicit tenant")
+      ->envname("DEFORMD_TOKEN_FILE");
+  app.add_option("--tenant-max-meshes", args.server.limits.tenant_max_meshes,
+                 "Meshes loaded at once per tenant; 0 = no per-tenant limit")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1 << 20));
+  app.add_option("--tenant-max-streams", args.server.limits.tenant_max_streams,
+                 "Open Deform streams per tenant; 0 = no per-tenant limit")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1 << 20));
+  app.add_option("--tenant-max-memory-mb", args.tenant_max_memory_mb,
+                 "Memory budget per tenant (same estimate as --max-memory-mb), MiB; 0 = none")
+      ->capture_default_str();
+  app.add_option("--store", args.store_dir,
+                 "Keep loaded meshes in DIR (0700) and restore them at start-up")
+      ->envname("DEFORMD_STORE");
+  app.add_option("--preload-tenant", args.preload_tenant,
+                 "Tenant that owns the --preload and --preload-phantom meshes")
+      ->capture_default_str()
+      ->check([](const std::string& name) {
+        return deform::service::IsValidTenantName(name)
+                   ? std::string()
+                   : std::string("a tenant is 1 to 64 characters of A-Z a-z 0-9 . _ -");
+      });
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -136,8 +191,23 @@ int main(int argc, char** argv) {
   args.server.limits.max_memory_bytes = args.max_memory_mb << 20;
   args.server.limits.max_upload_bytes = args.max_upload_mb << 20;
   args.server.max_message_bytes = args.max_message_mb << 20;
+  args.server.limits.tenant_max_memory_bytes = args.tenant_max_memory_mb << 20;
 
   DeformServer server(args.server);
+  if (!args.token_file.empty()) {
+    const deform::Status tokens = server.UseTokenFile(args.token_file);
+    if (!tokens.ok()) {
+      spdlog::error("--token-file: {}", tokens.ToString());
+      return 1;
+    }
+  }
+  if (!args.store_dir.empty()) {
+    const deform::Status store = server.UseStore(args.store_dir);
+    if (!store.ok()) {
+      spdlog::error("--store: {}", store.ToString());
+      return 1;
+    }
+  }
   if (!PreloadAll(args, &server)) return 1;
   const deform::Status started = server.Start();
   if (!started.ok()) {
@@ -146,7 +216,16 @@ int main(int argc, char** argv) {
   }
 
   int signal_number = 0;
-  sigwait(&stop_signals, &signal_number);
+  for (;;) {
+    sigwait(&stop_signals, &signal_number);
+    if (signal_number != SIGHUP) break;
+    if (args.token_file.empty()) {
+      spdlog::info("received SIGHUP: no token file to reload");
+    } else {
+      spdlog::info("received SIGHUP: reloading the token file");
+      (void)server.ReloadTokens();  // logs the outcome; a bad file keeps the old tokens
+    }
+  }
   spdlog::info("received {}, shutting down", signal_number == SIGTERM ? "SIGTERM" : "SIGINT");
   server.Shutdown(std::chrono::milliseconds(static_cast<long>(args.shutdown_grace_s * 1000)));
   return 0;

@@ -7,8 +7,12 @@
 
 #include "service/annotated_mutex.h"
 #include "service/deform_service.h"
+#include "service/load_request.h"
+#include "service/log_text.h"
 #include "service/mesh_loader.h"
+#include "service/mesh_store.h"
 #include "service/service_core.h"
+#include "service/transport_security.h"
 
 namespace deform::service {
 
@@ -33,9 +37,12 @@ Status DeformServer::Start() {
   if (impl_->server != nullptr) return Status::FailedPrecondition("the server is already started");
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
+  std::string transport;
+  DEFORM_ASSIGN_OR_RETURN(
+      std::shared_ptr<grpc::ServerCredentials> credentials,
+      MakeServerCredentials(impl_->options.security, impl_->options.listen_address, &transport));
   grpc::ServerBuilder builder;
-  builder.AddListeningPort(impl_->options.listen_address, grpc::InsecureServerCredentials(),
-                           &impl_->port);
+  builder.AddListeningPort(impl_->options.listen_address, credentials, &impl_->port);
   builder.RegisterService(&impl_->service);
   builder.SetMaxReceiveMessageSize(impl_->options.max_message_bytes);
   builder.SetMaxSendMessageSize(impl_->options.max_message_bytes);
@@ -47,8 +54,62 @@ Status DeformServer::Start() {
   if (grpc::HealthCheckServiceInterface* health = impl_->server->GetHealthCheckService()) {
     health->SetServingStatus(v1::DeformService::service_full_name(), true);
   }
-  spdlog::info("listening on {} with {} workers", listening_address(), impl_->core.pool.size());
+  spdlog::info("listening on {} ({}) with {} workers", listening_address(), transport,
+               impl_->core.pool.size());
+  if (!impl_->core.auth.uses_tokens()) {
+    spdlog::warn("no token file: every caller is the single implicit tenant '{}' and sees every "
+                 "mesh (give --token-file for per-client tokens)",
+                 Identity::Implicit().tenant);
+  }
   return Status::Ok();
+}
+
+Status DeformServer::UseStore(const std::string& dir, int* restored) {
+  DEFORM_ASSIGN_OR_RETURN(std::unique_ptr<MeshStore> store, MeshStore::Open(dir));
+  ServiceCore& core = impl_->core;
+  int count = 0;
+  for (StoredMesh& stored : store->LoadAll()) {
+    const auto start = std::chrono::steady_clock::now();
+    StatusOr<LoadJob> job = LoadJobFromRequest(stored.header, &stored.mesh_bytes, core.limits);
+    StatusOr<std::shared_ptr<const MeshEntry>> entry = job.status();
+    if (job.ok()) {
+      job->id = stored.id;
+      job->start = start;
+      auto reservation = core.registry.Reserve(stored.tenant);
+      entry = reservation.ok() ? BuildAndRegister(&core.registry, std::move(*reservation),
+                                                  std::move(*job))
+                               : StatusOr<std::shared_ptr<const MeshEntry>>(reservation.status());
+    }
+    if (!entry.ok()) {
+      spdlog::error("store: mesh={} tenant={} not restored: {}", stored.id,
+                    EscapeForLog(stored.tenant), entry.status().ToString());
+      continue;
+    }
+    ++count;
+    spdlog::info("store: mesh={} tenant={} restored in {:.0f} ms", stored.id,
+                 EscapeForLog(stored.tenant),
+                 std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                     .count());
+  }
+  spdlog::info("store: {} meshes restored from '{}'", count, EscapeForLog(dir));
+  core.store = std::move(store);
+  if (restored != nullptr) *restored = count;
+  return Status::Ok();
+}
+
+Status DeformServer::UseTokenFile(const std::string& path) {
+  return impl_->core.auth.LoadTokenFile(path);
+}
+
+Status DeformServer::ReloadTokens() {
+  const Status reloaded = impl_->core.auth.Reload();
+  if (reloaded.ok()) {
+    spdlog::info("token file reloaded");
+  } else {
+    spdlog::error("token file reload failed, the previous tokens stay in force: {}",
+                  reloaded.ToString());
+  }
+  return reloaded;
 }
 
 int DeformServer::port() const { return impl_->port; }
@@ -61,8 +122,10 @@ std::string DeformServer::listening_address() const {
 }
 
 StatusOr<std::shared_ptr<const MeshEntry>> DeformServer::Preload(ModelInput input,
-                                                                 const std::string& name) {
-  DEFORM_ASSIGN_OR_RETURN(MeshRegistry::Reservation reservation, impl_->core.registry.Reserve());
+                                                                 const std::string& name,
+                                                                 const std::string& tenant) {
+  DEFORM_ASSIGN_OR_RETURN(MeshRegistry::Reservation reservation,
+                          impl_->core.registry.Reserve(tenant));
   LoadJob job;
   job.name = name.empty() ? input.description : name;
   job.mesh = std::move(input.mesh);

@@ -13,6 +13,7 @@
 
 #include "core/base/status.h"
 #include "core/io/model_input.h"
+#include "service/identity.h"
 #include "service/mesh_registry.h"
 #include "service/service_options.h"
 
@@ -27,16 +28,35 @@ class DeformServer {
   DeformServer(const DeformServer&) = delete;
   DeformServer& operator=(const DeformServer&) = delete;
 
-  // Binds options.listen_address and starts serving. FAILED_PRECONDITION if the address cannot
-  // be bound or the server was already started.
+  // Binds options.listen_address and starts serving, with TLS or plaintext as options.security
+  // says (transport_security.h). FAILED_PRECONDITION if the address cannot be bound, the server
+  // was already started, or the transport policy refuses (plaintext on a non-loopback address
+  // without allow_plaintext); NOT_FOUND for an unreadable certificate or key file.
   Status Start();
   // The bound port (useful with port 0), or 0 before Start().
   int port() const;
   // "host:port" with the bound port.
   std::string listening_address() const;
 
-  // Builds and registers a mesh directly (no RPC), on the calling thread; for --preload.
-  StatusOr<std::shared_ptr<const MeshEntry>> Preload(ModelInput input, const std::string& name);
+  // Builds and registers a mesh directly (no RPC), on the calling thread, owned by `tenant`; for
+  // --preload.
+  StatusOr<std::shared_ptr<const MeshEntry>> Preload(
+      ModelInput input, const std::string& name,
+      const std::string& tenant = Identity::Implicit().tenant);
+
+  // Keeps loaded meshes in the store at `dir` (mesh_store.h) from now on, and first builds every
+  // mesh stored there under its id and owner, on the calling thread; before Start(). A corrupt or
+  // failing entry is logged and skipped. FAILED_PRECONDITION when the directory cannot be used.
+  // `restored` (optional) receives the number of meshes restored.
+  Status UseStore(const std::string& dir, int* restored = nullptr);
+
+  // Authenticates calls with the token file at `path` from now on (identity.h); before Start().
+  // NOT_FOUND or INVALID_ARGUMENT (naming the line) for a bad file. Without it, every caller is
+  // the single implicit tenant.
+  Status UseTokenFile(const std::string& path);
+  // Reads the token file again (deformd's SIGHUP): new tokens work and removed ones stop working
+  // for the next call. On error the old tokens stay and the error is returned (and logged).
+  Status ReloadTokens();
 
   // Drains: marks the server not serving, ends open Deform streams with UNAVAILABLE, stops
   // accepting calls, waits up to `grace` for calls in progress (then cancels them), and stops the

@@ -2,23 +2,58 @@
 
 #include <spdlog/spdlog.h>
 
+#include "service/audit_log.h"
 #include "service/deform_stream_reactor.h"
 #include "service/load_mesh_reactor.h"
 #include "service/proto_conversion.h"
+#include "service/rejected_call.h"
 #include "service/status_mapping.h"
 
 namespace deform::service {
+namespace {
+
+// The value of the call's "authorization" metadata, or empty.
+std::string_view AuthorizationOf(const grpc::CallbackServerContext* context) {
+  const auto& metadata = context->client_metadata();
+  const auto it = metadata.find("authorization");
+  if (it == metadata.end()) return {};
+  return std::string_view(it->second.data(), it->second.size());
+}
+
+// The caller of `context`; an unauthenticated call is audited ("-" as its tenant) here.
+StatusOr<Identity> Caller(const ServiceCore& core, const grpc::CallbackServerContext* context,
+                          std::string_view action, std::string_view mesh_id) {
+  StatusOr<Identity> caller = core.auth.Authenticate(AuthorizationOf(context));
+  if (!caller.ok()) Audit("-", action, mesh_id, caller.status().ToString());
+  return caller;
+}
+
+std::string ResultText(const Status& status) { return status.ok() ? "OK" : status.ToString(); }
+
+}  // namespace
 
 grpc::ServerBidiReactor<v1::LoadMeshRequest, v1::LoadMeshResponse>* DeformServiceImpl::LoadMesh(
-    grpc::CallbackServerContext* /*context*/) {
-  return NewLoadMeshReactor(core_);
+    grpc::CallbackServerContext* context) {
+  StatusOr<Identity> caller = Caller(*core_, context, "load", "");
+  if (!caller.ok()) {
+    return new RejectedBidiCall<v1::LoadMeshRequest, v1::LoadMeshResponse>(
+        ToGrpcStatus(caller.status()));
+  }
+  return NewLoadMeshReactor(core_, std::move(*caller));
 }
 
 grpc::ServerUnaryReactor* DeformServiceImpl::GetMeshInfo(grpc::CallbackServerContext* context,
                                                          const v1::GetMeshInfoRequest* request,
                                                          v1::GetMeshInfoResponse* response) {
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
-  auto entry = core_->registry.Find(request->mesh_id());
+  const char* action = request->include_geometry() ? "download" : "get_mesh_info";
+  StatusOr<Identity> caller = Caller(*core_, context, action, request->mesh_id());
+  if (!caller.ok()) {
+    reactor->Finish(ToGrpcStatus(caller.status()));
+    return reactor;
+  }
+  auto entry = core_->registry.Find(request->mesh_id(), *caller);
+  Audit(caller->tenant, action, request->mesh_id(), ResultText(entry.status()));
   if (!entry.ok()) {
     reactor->Finish(ToGrpcStatus(entry.status()));
     return reactor;
@@ -32,8 +67,15 @@ grpc::ServerUnaryReactor* DeformServiceImpl::GetMeshInfo(grpc::CallbackServerCon
 grpc::ServerUnaryReactor* DeformServiceImpl::ListMeshes(grpc::CallbackServerContext* context,
                                                         const v1::ListMeshesRequest* /*request*/,
                                                         v1::ListMeshesResponse* response) {
-  for (const auto& entry : core_->registry.List()) FillMeshSummary(*entry, response->add_meshes());
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  StatusOr<Identity> caller = Caller(*core_, context, "list", "");
+  if (!caller.ok()) {
+    reactor->Finish(ToGrpcStatus(caller.status()));
+    return reactor;
+  }
+  const auto meshes = core_->registry.List(*caller);
+  for (const auto& entry : meshes) FillMeshSummary(*entry, response->add_meshes());
+  Audit(caller->tenant, "list", "", "OK: " + std::to_string(meshes.size()) + " meshes");
   reactor->Finish(grpc::Status::OK);
   return reactor;
 }
@@ -41,16 +83,27 @@ grpc::ServerUnaryReactor* DeformServiceImpl::ListMeshes(grpc::CallbackServerCont
 grpc::ServerUnaryReactor* DeformServiceImpl::UnloadMesh(grpc::CallbackServerContext* context,
                                                         const v1::UnloadMeshRequest* request,
                                                         v1::UnloadMeshResponse* /*response*/) {
-  const Status status = core_->registry.Unload(request->mesh_id());
-  if (status.ok()) spdlog::info("mesh={} unloaded", request->mesh_id());
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  StatusOr<Identity> caller = Caller(*core_, context, "unload", request->mesh_id());
+  if (!caller.ok()) {
+    reactor->Finish(ToGrpcStatus(caller.status()));
+    return reactor;
+  }
+  const Status status = core_->registry.Unload(request->mesh_id(), *caller);
+  if (status.ok() && core_->store != nullptr) core_->store->Remove(request->mesh_id());
+  Audit(caller->tenant, "unload", request->mesh_id(), ResultText(status));
   reactor->Finish(ToGrpcStatus(status));
   return reactor;
 }
 
 grpc::ServerBidiReactor<v1::DeformRequest, v1::DeformResponse>* DeformServiceImpl::Deform(
-    grpc::CallbackServerContext* /*context*/) {
-  return NewDeformStreamReactor(core_);
+    grpc::CallbackServerContext* context) {
+  StatusOr<Identity> caller = Caller(*core_, context, "deform", "");
+  if (!caller.ok()) {
+    return new RejectedBidiCall<v1::DeformRequest, v1::DeformResponse>(
+        ToGrpcStatus(caller.status()));
+  }
+  return NewDeformStreamReactor(core_, std::move(*caller));
 }
 
 }  // namespace deform::service

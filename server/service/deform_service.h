@@ -1,6 +1,11 @@
 // The deform.v1.DeformService implementation: a thin layer that converts messages, looks things
 // up in the ServiceCore and maps statuses. Streaming RPCs get their own reactors
 // (load_mesh_reactor.h, deform_stream_reactor.h). Thread-safe; `core` must outlive it.
+//
+// Every call is authenticated first (core->auth, from the "authorization" metadata): without a
+// valid token it ends with UNAUTHENTICATED before anything else is looked at. Then the caller's
+// identity scopes what it sees (MeshRegistry's caller-scoped lookups), and each call leaves an
+// audit line (audit_log.h).
 #pragma once
 
 #include "deform/v1/deform.grpc.pb.h"

@@ -11,9 +11,11 @@
 
 #include "core/model/deformation_model.h"
 #include "service/annotated_mutex.h"
+#include "service/audit_log.h"
 #include "service/deform_outbox.h"
 #include "service/frame_solver.h"
 #include "service/grpc_stream_sink.h"
+#include "service/log_text.h"
 #include "service/pending_pose_slot.h"
 #include "service/pose_input.h"
 #include "service/proto_conversion.h"
@@ -41,9 +43,9 @@ class DeformStreamReactor final
       private Drainable,
       private StreamWriteSource<v1::DeformResponse> {
  public:
-  explicit DeformStreamReactor(ServiceCore* core)
-      : core_(core), stream_id_(core->next_stream_id.fetch_add(1)) {
-    log_context_ = "stream=" + std::to_string(stream_id_);
+  DeformStreamReactor(ServiceCore* core, Identity caller)
+      : core_(core), caller_(std::move(caller)), stream_id_(core->next_stream_id.fetch_add(1)) {
+    log_context_ = "stream=" + std::to_string(stream_id_) + " tenant=" + EscapeForLog(caller_.tenant);
     StartRead(&request_);
   }
 
@@ -79,13 +81,15 @@ class DeformStreamReactor final
   bool ReadyToFinish() override;
 
   ServiceCore* const core_;
+  const Identity caller_;
   const std::uint64_t stream_id_;
-  std::string log_context_;  // "stream=N mesh=ID", for logs
+  std::string log_context_;  // "stream=N tenant=T mesh=ID", for logs
 
   // Set by HandleStart before any worker can see the stream; read-only afterwards.
   std::shared_ptr<const MeshEntry> entry_;
   const DeformationModel* model_ = nullptr;  // non-null once started
   bool registered_ = false;                  // in core_->streams
+  bool counted_ = false;                     // in core_->tenant_streams
 
   // Reader-owned (one read outstanding at a time).
   v1::DeformRequest request_;
@@ -149,11 +153,19 @@ void DeformStreamReactor::HandleStart() {
     return;
   }
   const std::string mesh_id = request_.start().mesh_id();
-  auto entry = core_->registry.Find(mesh_id);
+  auto entry = core_->registry.Find(mesh_id, caller_);
   if (!entry.ok()) {
+    Audit(caller_.tenant, "deform", mesh_id, entry.status().ToString());
     Fail(ToGrpcCode(entry.status().code()), entry.status().message());
     return;
   }
+  const Status quota = core_->tenant_streams.Acquire(caller_.tenant);
+  Audit(caller_.tenant, "deform", mesh_id, quota.ok() ? "OK" : quota.ToString());
+  if (!quota.ok()) {
+    Fail(ToGrpcCode(quota.code()), quota.message());
+    return;
+  }
+  counted_ = true;
   if (!core_->streams.Add(this)) {
     Fail(grpc::StatusCode::UNAVAILABLE, "the server is shutting down");
     return;
@@ -346,6 +358,7 @@ void DeformStreamReactor::Drain() {
 
 void DeformStreamReactor::OnDone() {
   if (registered_) core_->streams.Remove(this);
+  if (counted_) core_->tenant_streams.Release(caller_.tenant);
   if (entry_ != nullptr) entry_->open_streams.fetch_sub(1);
   {
     MutexLock lock(&mutex_);
@@ -360,8 +373,8 @@ void DeformStreamReactor::OnDone() {
 }  // namespace
 
 grpc::ServerBidiReactor<v1::DeformRequest, v1::DeformResponse>* NewDeformStreamReactor(
-    ServiceCore* core) {
-  return DeformStreamReactor::Create(core);
+    ServiceCore* core, Identity caller) {
+  return DeformStreamReactor::Create(core, std::move(caller));
 }
 
 }  // namespace deform::service

@@ -31,6 +31,9 @@
 //  - The parts are guarded by the reactor's mutex (annotated, thread_annotations.h); the solver
 //    and the pose being solved belong to the solve task, the request buffers to the reader.
 //
+// `start` finds the mesh as the caller may see it (another tenant's mesh is NOT_FOUND) and counts
+// the stream against the caller's tenant's stream limit (RESOURCE_EXHAUSTED beyond it).
+//
 // The stream ends with OK after the client half-closes and everything pending is written, with
 // INVALID_ARGUMENT / NOT_FOUND for a bad or unknown `start`, CANCELLED when the client cancels,
 // UNAVAILABLE when the server drains.
@@ -39,12 +42,13 @@
 #include <grpcpp/support/server_callback.h>
 
 #include "deform/v1/deform.pb.h"
+#include "service/identity.h"
 #include "service/service_core.h"
 
 namespace deform::service {
 
 // A new reactor for one Deform call. `core` must outlive it.
 grpc::ServerBidiReactor<v1::DeformRequest, v1::DeformResponse>* NewDeformStreamReactor(
-    ServiceCore* core);
+    ServiceCore* core, Identity caller);
 
 }  // namespace deform::service

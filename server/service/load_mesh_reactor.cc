@@ -9,15 +9,15 @@
 #include <string>
 #include <utility>
 
-#include "core/geometry/skeleton.h"
-#include "core/io/mesh_io.h"
 #include "core/io/phantom.h"
-#include "core/io/rig_import.h"
-#include "core/io/skeleton_io.h"
-#include "core/io/skin_weights_io.h"
 #include "service/annotated_mutex.h"
+#include "service/audit_log.h"
 #include "service/grpc_stream_sink.h"
+#include "service/load_request.h"
+#include "service/log_text.h"
+#include "service/mesh_id.h"
 #include "service/mesh_loader.h"
+#include "service/mesh_store.h"
 #include "service/proto_conversion.h"
 #include "service/shared_reactor.h"
 #include "service/status_mapping.h"
@@ -31,34 +31,6 @@ using Clock = std::chrono::steady_clock;
 
 // Bytes reserved up front for an upload; larger uploads grow as their chunks arrive.
 constexpr std::size_t kMaxInitialReserve = std::size_t{64} << 20;
-
-StatusOr<MeshFormat> CoreMeshFormat(v1::MeshFormat format) {
-  switch (format) {
-    case v1::MESH_FORMAT_OBJ:
-      return MeshFormat::kObj;
-    case v1::MESH_FORMAT_PLY:
-      return MeshFormat::kPly;
-    case v1::MESH_FORMAT_STL:
-      return MeshFormat::kStl;
-    case v1::MESH_FORMAT_OFF:
-      return MeshFormat::kOff;
-    default:
-      return Status::InvalidArgument("upload.format is unspecified or unknown (" +
-                                     std::to_string(static_cast<int>(format)) + ")");
-  }
-}
-
-StatusOr<SkinWeightsFormat> CoreWeightsFormat(v1::SkinWeightsFormat format) {
-  switch (format) {
-    case v1::SKIN_WEIGHTS_FORMAT_DMAT:
-      return SkinWeightsFormat::kDmat;
-    case v1::SKIN_WEIGHTS_FORMAT_CSV:
-      return SkinWeightsFormat::kCsv;
-    default:
-      return Status::InvalidArgument("upload.weights_format is unspecified or unknown (" +
-                                     std::to_string(static_cast<int>(format)) + ")");
-  }
-}
 
 // The header checks of an upload's skeleton and weights: a glTF rig carries both, so neither may
 // be given beside it; other formats need a skeleton, and weights only with their format.
@@ -83,18 +55,6 @@ Status CheckUploadParts(const v1::UploadSource& upload) {
   return Status::Ok();
 }
 
-StatusOr<Skeleton> ParseSkeleton(v1::SkeletonFormat format, const std::string& bytes) {
-  switch (format) {
-    case v1::SKELETON_FORMAT_TGF:
-      return ParseTgf(bytes);
-    case v1::SKELETON_FORMAT_JSON:
-      return ParseSkeletonJson(bytes);
-    default:
-      return Status::InvalidArgument("upload.skeleton_format is unspecified or unknown (" +
-                                     std::to_string(static_cast<int>(format)) + ")");
-  }
-}
-
 double MillisecondsSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
@@ -104,8 +64,11 @@ class LoadMeshReactor final
       public SharedReactor<LoadMeshReactor>,
       private StreamWriteSource<v1::LoadMeshResponse> {
  public:
-  explicit LoadMeshReactor(ServiceCore* core)
-      : core_(core), log_context_("load=" + std::to_string(core->next_load_id.fetch_add(1))) {
+  LoadMeshReactor(ServiceCore* core, Identity caller)
+      : core_(core),
+        caller_(std::move(caller)),
+        log_context_("load=" + std::to_string(core->next_load_id.fetch_add(1)) +
+                     " tenant=" + EscapeForLog(caller_.tenant)) {
     StartRead(&request_);
   }
 
@@ -121,8 +84,6 @@ class LoadMeshReactor final
   // On a worker: parse, validate, precompute, register.
   void Build() DEFORM_EXCLUDES(mutex_);
   StatusOr<std::shared_ptr<const MeshEntry>> ParseAndBuild() DEFORM_EXCLUDES(mutex_);
-  // The upload's mesh, skeleton and weights (a glTF rig gives all three) into `job`.
-  Status ParseUpload(LoadJob* job) DEFORM_EXCLUDES(mutex_);
 
   void Fail(const Status& status) DEFORM_EXCLUDES(mutex_);
   void AddProgressLocked(v1::LoadMeshResponse::Stage stage, double elapsed_ms,
@@ -134,6 +95,7 @@ class LoadMeshReactor final
   bool ReadyToFinish() override { return true; }  // a finish is only requested when all is queued
 
   ServiceCore* const core_;
+  const Identity caller_;
   std::string log_context_;
   Clock::time_point start_;
 
@@ -195,7 +157,7 @@ Status LoadMeshReactor::HandleHeader() {
             std::to_string(limits.max_vertices) + " vertices per mesh");
       }
       spdlog::info("{} phantom of {} vertices requested, name='{}'", log_context_, effective,
-                   header_.name());
+                   EscapeForLog(header_.name()));
       break;
     }
     case v1::LoadMeshHeader::kUpload: {
@@ -218,13 +180,13 @@ Status LoadMeshReactor::HandleHeader() {
       expected_bytes_ = upload.mesh_size_bytes();
       mesh_bytes_.reserve(std::min<std::size_t>(expected_bytes_, kMaxInitialReserve));
       spdlog::info("{} upload of {} mesh bytes announced, name='{}'", log_context_, expected_bytes_,
-                   header_.name());
+                   EscapeForLog(header_.name()));
       break;
     }
     case v1::LoadMeshHeader::SOURCE_NOT_SET:
       return Status::InvalidArgument("the header names no source (phantom or upload)");
   }
-  DEFORM_ASSIGN_OR_RETURN(reservation_, core_->registry.Reserve());
+  DEFORM_ASSIGN_OR_RETURN(reservation_, core_->registry.Reserve(caller_.tenant));
   return Status::Ok();
 }
 
@@ -273,35 +235,37 @@ void LoadMeshReactor::Build() {
     if (cancelled_) {
       // Nobody is waiting for it: the mesh would be unreachable.
       (void)core_->registry.Unload((*entry)->id);
+      if (core_->store != nullptr) core_->store->Remove((*entry)->id);
+      Audit(caller_.tenant, "load", (*entry)->id, "CANCELLED");
     } else {
+      Audit(caller_.tenant, "load", (*entry)->id, "OK");
       AddProgressLocked(v1::LoadMeshResponse::STAGE_READY, MillisecondsSince(start_), entry->get());
       pump_.RequestFinish(grpc::Status::OK);
     }
   } else if (!skip) {
     spdlog::warn("{} failed: {}", log_context_, entry.status().ToString());
+    Audit(caller_.tenant, "load", "", entry.status().ToString());
     pump_.RequestFinish(ToGrpcStatus(entry.status()));
   }
   pump_.Pump();
 }
 
 StatusOr<std::shared_ptr<const MeshEntry>> LoadMeshReactor::ParseAndBuild() {
-  LoadJob job;
-  job.start = start_;
-  job.name = header_.name();
-  if (header_.has_phantom()) {
-    const int vertices =
-        header_.phantom().vertices() == 0 ? kDefaultPhantomVertices : header_.phantom().vertices();
-    DEFORM_ASSIGN_OR_RETURN(KneePhantom phantom, MakeKneePhantom(vertices));
-    job.mesh = std::move(phantom.mesh);
-    job.skeleton = std::move(phantom.skeleton);
-    if (job.name.empty()) job.name = "phantom:" + std::to_string(vertices);
-  } else {
-    DEFORM_RETURN_IF_ERROR(ParseUpload(&job));
-    if (job.name.empty()) job.name = "upload";
+  std::string pending_id;
+  if (core_->store != nullptr) {
+    // Kept on disk as uploaded (before parsing frees the bytes); committed once registered.
+    pending_id = NewMeshId();
+    DEFORM_RETURN_IF_ERROR(
+        core_->store->WritePending({pending_id, caller_.tenant, header_, mesh_bytes_}));
   }
-  auto options = ModelOptionsFromProto(header_.options(), job.skeleton);
-  if (!options.ok()) return options.status().WithContext("options");
-  job.options = std::move(*options);
+  StatusOr<LoadJob> parsed = LoadJobFromRequest(header_, &mesh_bytes_, core_->limits);
+  if (!parsed.ok()) {
+    if (!pending_id.empty()) core_->store->Discard(pending_id);
+    return parsed.status();
+  }
+  LoadJob job = std::move(*parsed);
+  job.start = start_;
+  job.id = pending_id;
 
   const auto progress = [this](LoadStage stage, double elapsed_ms) {
     MutexLock lock(&mutex_);
@@ -318,46 +282,21 @@ StatusOr<std::shared_ptr<const MeshEntry>> LoadMeshReactor::ParseAndBuild() {
     }
     pump_.Pump();
   };
-  return BuildAndRegister(&core_->registry, std::move(reservation_), std::move(job), progress);
-}
-
-Status LoadMeshReactor::ParseUpload(LoadJob* job) {
-  const v1::UploadSource& upload = header_.upload();
-  MeshLimits limits;
-  limits.max_vertices = core_->limits.max_vertices;
-  if (upload.format() == v1::MESH_FORMAT_GLTF) {
-    auto rig = ReadGltf(mesh_bytes_, limits);
-    std::string().swap(mesh_bytes_);
-    if (!rig.ok()) return rig.status().WithContext("glTF");
-    job->mesh = std::move(rig->mesh);
-    job->skeleton = std::move(rig->skeleton);
-    job->weights = std::move(rig->weights);
-    job->presentation.file_vertex_to_mesh = std::move(rig->file_vertex_to_mesh);
-    job->presentation.units = std::move(rig->units);
-    job->presentation.up_axis = std::move(rig->up_axis);
-    return Status::Ok();
+  auto entry =
+      BuildAndRegister(&core_->registry, std::move(reservation_), std::move(job), progress);
+  if (!pending_id.empty()) {
+    if (entry.ok()) {
+      core_->store->Commit(pending_id);
+    } else {
+      core_->store->Discard(pending_id);
+    }
   }
-  DEFORM_ASSIGN_OR_RETURN(const MeshFormat format, CoreMeshFormat(upload.format()));
-  auto mesh = ReadMesh(mesh_bytes_, format, limits);
-  if (!mesh.ok()) return mesh.status().WithContext("mesh");
-  job->mesh = std::move(*mesh);
-  std::string().swap(mesh_bytes_);  // the bytes are no longer needed
-  auto skeleton = ParseSkeleton(upload.skeleton_format(), upload.skeleton());
-  if (!skeleton.ok()) return skeleton.status().WithContext("skeleton");
-  job->skeleton = std::move(*skeleton);
-  if (!upload.weights().empty()) {
-    DEFORM_ASSIGN_OR_RETURN(const SkinWeightsFormat format,
-                            CoreWeightsFormat(upload.weights_format()));
-    auto weights = ReadSkinWeights(upload.weights(), format, limits);
-    if (!weights.ok()) return weights.status().WithContext("weights");
-    WidenSkinWeights(format, job->mesh.num_vertices(), job->skeleton.num_bones(), &*weights);
-    job->weights = std::move(*weights);
-  }
-  return Status::Ok();
+  return entry;
 }
 
 void LoadMeshReactor::Fail(const Status& status) {
   spdlog::warn("{} refused: {}", log_context_, status.ToString());
+  Audit(caller_.tenant, "load", "", status.ToString());
   MutexLock lock(&mutex_);
   pump_.RequestFinish(ToGrpcStatus(status));
   pump_.Pump();
@@ -403,8 +342,8 @@ void LoadMeshReactor::OnDone() {
 }  // namespace
 
 grpc::ServerBidiReactor<v1::LoadMeshRequest, v1::LoadMeshResponse>* NewLoadMeshReactor(
-    ServiceCore* core) {
-  return LoadMeshReactor::Create(core);
+    ServiceCore* core, Identity caller) {
+  return LoadMeshReactor::Create(core, std::move(caller));
 }
 
 }  // namespace deform::service

@@ -10,6 +10,11 @@
 // reserved when the header arrives, so a client over the mesh limit is refused before it sends its
 // bytes.
 //
+// The mesh belongs to the caller's tenant (its slot and memory count against the tenant's
+// limits too). With a store (ServiceCore::store), the header and the upload's bytes are written to
+// it before parsing and kept once the mesh is registered (mesh_store.h); an audit line records
+// the outcome.
+//
 // Threads: gRPC's threads run the reactions and own the upload's buffers until the build is
 // posted; then the build task (a worker) owns them. The outbox and the pump are guarded by the
 // reactor's mutex.
@@ -18,12 +23,13 @@
 #include <grpcpp/support/server_callback.h>
 
 #include "deform/v1/deform.pb.h"
+#include "service/identity.h"
 #include "service/service_core.h"
 
 namespace deform::service {
 
 // A new reactor for one LoadMesh call. `core` must outlive it.
 grpc::ServerBidiReactor<v1::LoadMeshRequest, v1::LoadMeshResponse>* NewLoadMeshReactor(
-    ServiceCore* core);
+    ServiceCore* core, Identity caller);
 
 }  // namespace deform::service

@@ -24,9 +24,10 @@ StatusOr<std::shared_ptr<const MeshEntry>> BuildAndRegister(MeshRegistry* regist
   const std::size_t bytes_before_build =
       DeformationModel::EstimateBytesBeforeBuild(job.mesh.num_vertices(), job.mesh.num_triangles());
   const int vertices = job.mesh.num_vertices();
+  const std::string tenant = reservation.tenant();
   BuildHooks hooks;
   hooks.validated = [&] {
-    DEFORM_RETURN_IF_ERROR(registry->CheckMemoryAvailable(bytes_before_build));
+    DEFORM_RETURN_IF_ERROR(registry->CheckMemoryAvailable(bytes_before_build, tenant));
     if (progress) progress(LoadStage::kValidated, MillisecondsSince(job.start));
     return Status::Ok();
   };
@@ -40,11 +41,11 @@ StatusOr<std::shared_ptr<const MeshEntry>> BuildAndRegister(MeshRegistry* regist
   if (progress) progress(LoadStage::kFactorised, MillisecondsSince(job.start));
   DEFORM_ASSIGN_OR_RETURN(std::shared_ptr<const MeshEntry> entry,
                           registry->Register(std::move(reservation), job.name, std::move(model),
-                                             std::move(job.presentation)));
+                                             std::move(job.presentation), std::move(job.id)));
   spdlog::info(
-      "mesh={} name='{}' loaded: {} vertices, precompute {:.1f} ms, factor {:.1f} ms, "
+      "mesh={} tenant={} name='{}' loaded: {} vertices, precompute {:.1f} ms, factor {:.1f} ms, "
       "about {} KiB",
-      entry->id, EscapeForLog(entry->name), vertices, entry->precompute_ms, entry->factor_ms,
+      entry->id, EscapeForLog(entry->tenant), EscapeForLog(entry->name), vertices, entry->precompute_ms, entry->factor_ms,
       entry->memory_bytes >> 10);
   for (const std::string& warning : entry->model->binding_report().warnings) {
     spdlog::warn("mesh={} binding: {}", entry->id, EscapeForLog(warning));

@@ -32,6 +32,7 @@ using LoadProgress = std::function<void(LoadStage stage, double elapsed_ms)>;
 
 struct LoadJob {
   std::string name;
+  std::string id;  // empty: a new id (MeshRegistry::Register); a stored mesh's own id on restore
   TriangleMesh mesh;
   Skeleton skeleton;
   ModelOptions options;  // options.limits.max_vertices is set from the registry's limits

@@ -1,37 +1,35 @@
 #include "service/mesh_registry.h"
 
-#include <charconv>
-#include <optional>
-#include <string_view>
 #include <utility>
+
+#include "service/mesh_id.h"
 
 namespace deform::service {
 namespace {
-
-constexpr std::string_view kIdPrefix = "mesh-";
-
-std::optional<std::uint64_t> NumberOfId(std::string_view id) {
-  if (id.substr(0, kIdPrefix.size()) != kIdPrefix) return std::nullopt;
-  id.remove_prefix(kIdPrefix.size());
-  std::uint64_t number = 0;
-  const auto [end, error] = std::from_chars(id.data(), id.data() + id.size(), number);
-  if (error != std::errc() || end != id.data() + id.size() || id.empty()) return std::nullopt;
-  return number;
-}
 
 std::string MebiBytes(std::size_t bytes) {
   return std::to_string((bytes + (std::size_t{1} << 20) - 1) >> 20) + " MiB";
 }
 
+Status NotLoaded(const std::string& mesh_id) {
+  return Status::NotFound("no mesh with id '" + mesh_id + "' is loaded");
+}
+
+const Identity& Unscoped() {
+  static const Identity kOperator{"", Role::kOperator};
+  return kOperator;
+}
+
 }  // namespace
 
 MeshRegistry::Reservation::Reservation(Reservation&& other) noexcept
-    : registry_(std::exchange(other.registry_, nullptr)) {}
+    : registry_(std::exchange(other.registry_, nullptr)), tenant_(std::move(other.tenant_)) {}
 
 MeshRegistry::Reservation& MeshRegistry::Reservation::operator=(Reservation&& other) noexcept {
   if (this != &other) {
     Release();
     registry_ = std::exchange(other.registry_, nullptr);
+    tenant_ = std::move(other.tenant_);
   }
   return *this;
 }
@@ -39,12 +37,12 @@ MeshRegistry::Reservation& MeshRegistry::Reservation::operator=(Reservation&& ot
 MeshRegistry::Reservation::~Reservation() { Release(); }
 
 void MeshRegistry::Reservation::Release() {
-  if (registry_ != nullptr) std::exchange(registry_, nullptr)->ReleaseSlot();
+  if (registry_ != nullptr) std::exchange(registry_, nullptr)->ReleaseSlot(tenant_);
 }
 
 MeshRegistry::MeshRegistry(const ServiceLimits& limits) : limits_(limits) {}
 
-StatusOr<MeshRegistry::Reservation> MeshRegistry::Reserve() {
+StatusOr<MeshRegistry::Reservation> MeshRegistry::Reserve(const std::string& tenant) {
   MutexLock lock(&mutex_);
   const int in_use = static_cast<int>(meshes_.size()) + reserved_;
   if (in_use >= limits_.max_meshes) {
@@ -53,31 +51,55 @@ StatusOr<MeshRegistry::Reservation> MeshRegistry::Reserve() {
                                      " loading, of at most " + std::to_string(limits_.max_meshes) +
                                      " (unload a mesh first)");
   }
+  TenantUsage& usage = tenants_[tenant];
+  if (limits_.tenant_max_meshes > 0 && usage.loaded + usage.reserved >= limits_.tenant_max_meshes) {
+    return Status::ResourceExhausted(
+        "tenant mesh limit reached (--tenant-max-meshes): " + std::to_string(usage.loaded) +
+        " loaded and " + std::to_string(usage.reserved) + " loading, of at most " +
+        std::to_string(limits_.tenant_max_meshes) + " per tenant (unload a mesh first)");
+  }
   ++reserved_;
-  return Reservation(this);
+  ++usage.reserved;
+  return Reservation(this, tenant);
 }
 
-void MeshRegistry::ReleaseSlot() {
+void MeshRegistry::ReleaseSlot(const std::string& tenant) {
   MutexLock lock(&mutex_);
   --reserved_;
+  --tenants_[tenant].reserved;
 }
 
-Status MeshRegistry::CheckMemoryAvailable(std::size_t bytes) const {
-  MutexLock lock(&mutex_);
+Status MeshRegistry::CheckMemoryLocked(std::size_t bytes, const std::string& tenant) const {
   if (memory_used_ + bytes > limits_.max_memory_bytes) {
     return Status::ResourceExhausted("memory budget exceeded: the mesh needs about " +
                                      MebiBytes(bytes) + ", " + MebiBytes(memory_used_) +
                                      " of the " + MebiBytes(limits_.max_memory_bytes) +
                                      " budget are in use");
   }
+  if (limits_.tenant_max_memory_bytes > 0) {
+    const auto it = tenants_.find(tenant);
+    const std::size_t used = it == tenants_.end() ? 0 : it->second.memory_bytes;
+    if (used + bytes > limits_.tenant_max_memory_bytes) {
+      return Status::ResourceExhausted(
+          "tenant memory budget exceeded (--tenant-max-memory-mb): the mesh needs about " +
+          MebiBytes(bytes) + ", " + MebiBytes(used) + " of the tenant's " +
+          MebiBytes(limits_.tenant_max_memory_bytes) + " are in use");
+    }
+  }
   return Status::Ok();
+}
+
+Status MeshRegistry::CheckMemoryAvailable(std::size_t bytes, const std::string& tenant) const {
+  MutexLock lock(&mutex_);
+  return CheckMemoryLocked(bytes, tenant);
 }
 
 StatusOr<std::shared_ptr<const MeshEntry>> MeshRegistry::Register(
     Reservation reservation, std::string name, std::shared_ptr<const DeformationModel> model,
-    MeshPresentation presentation) {
+    MeshPresentation presentation, std::string id) {
   auto entry = std::make_shared<MeshEntry>();
   entry->name = std::move(name);
+  entry->tenant = reservation.tenant();
   entry->precompute_ms = model->precompute_seconds() * 1e3;
   entry->factor_ms = model->default_factorization()->factor_seconds() * 1e3;
   entry->factor_bytes = model->default_factorization()->factor().bytes();
@@ -86,53 +108,75 @@ StatusOr<std::shared_ptr<const MeshEntry>> MeshRegistry::Register(
   entry->presentation = std::move(presentation);
 
   MutexLock lock(&mutex_);
-  if (memory_used_ + entry->memory_bytes > limits_.max_memory_bytes) {
-    const Status status = Status::ResourceExhausted(
-        "memory budget exceeded: the mesh needs about " + MebiBytes(entry->memory_bytes) + ", " +
-        MebiBytes(memory_used_) + " of the " + MebiBytes(limits_.max_memory_bytes) +
-        " budget are in use");
-    --reserved_;
-    reservation.registry_ = nullptr;
-    return status;
-  }
-  const std::uint64_t number = next_number_++;
-  entry->id = std::string(kIdPrefix) + std::to_string(number);
-  memory_used_ += entry->memory_bytes;
-  // The reservation's slot becomes the loaded mesh's slot.
-  --reserved_;
+  // From here the reservation's slot is released here (failure) or becomes the mesh's.
   reservation.registry_ = nullptr;
-  meshes_.emplace(number, entry);
+  TenantUsage& usage = tenants_[entry->tenant];
+  --reserved_;
+  --usage.reserved;
+  DEFORM_RETURN_IF_ERROR(CheckMemoryLocked(entry->memory_bytes, entry->tenant));
+  if (!id.empty() && order_of_id_.count(id) != 0) {
+    return Status::InvalidArgument("mesh id '" + id + "' is already loaded");
+  }
+  if (id.empty()) {
+    do id = NewMeshId();
+    while (order_of_id_.count(id) != 0);
+  }
+  entry->id = std::move(id);
+  const std::uint64_t order = next_order_++;
+  order_of_id_.emplace(entry->id, order);
+  memory_used_ += entry->memory_bytes;
+  ++usage.loaded;
+  usage.memory_bytes += entry->memory_bytes;
+  meshes_.emplace(order, entry);
   return std::shared_ptr<const MeshEntry>(std::move(entry));
 }
 
-StatusOr<std::shared_ptr<const MeshEntry>> MeshRegistry::Find(const std::string& mesh_id) const {
-  const std::optional<std::uint64_t> number = NumberOfId(mesh_id);
+StatusOr<std::shared_ptr<const MeshEntry>> MeshRegistry::Find(const std::string& mesh_id,
+                                                              const Identity& caller) const {
   MutexLock lock(&mutex_);
-  if (number) {
-    const auto it = meshes_.find(*number);
-    if (it != meshes_.end()) return std::shared_ptr<const MeshEntry>(it->second);
-  }
-  return Status::NotFound("no mesh with id '" + mesh_id + "' is loaded");
+  const auto order = order_of_id_.find(mesh_id);
+  if (order == order_of_id_.end()) return NotLoaded(mesh_id);
+  const std::shared_ptr<MeshEntry>& entry = meshes_.at(order->second);
+  if (!caller.CanAccess(entry->tenant)) return NotLoaded(mesh_id);
+  return std::shared_ptr<const MeshEntry>(entry);
 }
 
-std::vector<std::shared_ptr<const MeshEntry>> MeshRegistry::List() const {
+std::vector<std::shared_ptr<const MeshEntry>> MeshRegistry::List(const Identity& caller) const {
   MutexLock lock(&mutex_);
   std::vector<std::shared_ptr<const MeshEntry>> list;
   list.reserve(meshes_.size());
-  for (const auto& [number, entry] : meshes_) list.push_back(entry);
+  for (const auto& [order, entry] : meshes_) {
+    if (caller.CanAccess(entry->tenant)) list.push_back(entry);
+  }
   return list;
 }
 
-Status MeshRegistry::Unload(const std::string& mesh_id) {
-  const std::optional<std::uint64_t> number = NumberOfId(mesh_id);
+Status MeshRegistry::Unload(const std::string& mesh_id, const Identity& caller) {
   MutexLock lock(&mutex_);
-  const auto it = number ? meshes_.find(*number) : meshes_.end();
-  if (it == meshes_.end()) return Status::NotFound("no mesh with id '" + mesh_id + "' is loaded");
-  it->second->unloaded.store(true);
-  memory_used_ -= it->second->memory_bytes;
+  const auto order = order_of_id_.find(mesh_id);
+  if (order == order_of_id_.end()) return NotLoaded(mesh_id);
+  const auto it = meshes_.find(order->second);
+  MeshEntry& entry = *it->second;
+  if (!caller.CanAccess(entry.tenant)) return NotLoaded(mesh_id);
+  entry.unloaded.store(true);
+  memory_used_ -= entry.memory_bytes;
+  TenantUsage& usage = tenants_[entry.tenant];
+  --usage.loaded;
+  usage.memory_bytes -= entry.memory_bytes;
+  order_of_id_.erase(order);
   meshes_.erase(it);
   return Status::Ok();
 }
+
+StatusOr<std::shared_ptr<const MeshEntry>> MeshRegistry::Find(const std::string& mesh_id) const {
+  return Find(mesh_id, Unscoped());
+}
+
+std::vector<std::shared_ptr<const MeshEntry>> MeshRegistry::List() const {
+  return List(Unscoped());
+}
+
+Status MeshRegistry::Unload(const std::string& mesh_id) { return Unload(mesh_id, Unscoped()); }
 
 std::size_t MeshRegistry::memory_bytes_used() const {
   MutexLock lock(&mutex_);

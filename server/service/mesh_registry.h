@@ -5,8 +5,13 @@
 //
 // Limits: the number of meshes loaded or being loaded (a Reservation is taken before the
 // expensive work, so a client learns early that no slot is free) and a memory budget checked
-// against DeformationModel::EstimatedBytes() when the mesh is registered. Memory is released from
-// the budget at unload, even while open streams still use the model until they end.
+// against DeformationModel::EstimatedBytes() when the mesh is registered; both server-wide and
+// per tenant (ServiceLimits::tenant_*). Memory is released from the budget at unload, even while
+// open streams still use the model until they end.
+//
+// Tenancy: every mesh belongs to the tenant that loaded it. The lookups that take a caller
+// (Identity) answer another tenant's id exactly as an unknown id (NOT_FOUND, same message), so a
+// caller cannot learn that it exists; an operator sees every mesh.
 //
 // Thread safety: all methods may be called from any thread.
 #pragma once
@@ -17,11 +22,13 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "core/base/status.h"
 #include "core/model/deformation_model.h"
 #include "service/annotated_mutex.h"
+#include "service/identity.h"
 #include "service/service_options.h"
 #include "service/thread_annotations.h"
 
@@ -38,8 +45,9 @@ struct MeshPresentation {
 };
 
 struct MeshEntry {
-  std::string id;    // "mesh-<n>", never reused within a server's life
+  std::string id;    // NewMeshId(): "mesh-" and 128 random bits in hex (mesh_id.h)
   std::string name;  // the client's label
+  std::string tenant;  // the owner: the tenant that loaded it
   std::shared_ptr<const DeformationModel> model;
   double precompute_ms = 0;
   double factor_ms = 0;
@@ -68,12 +76,15 @@ class MeshRegistry {
     Reservation& operator=(Reservation&& other) noexcept;
     ~Reservation();
     bool valid() const { return registry_ != nullptr; }
+    const std::string& tenant() const { return tenant_; }
     void Release();
 
    private:
     friend class MeshRegistry;
-    explicit Reservation(MeshRegistry* registry) : registry_(registry) {}
+    Reservation(MeshRegistry* registry, std::string tenant)
+        : registry_(registry), tenant_(std::move(tenant)) {}
     MeshRegistry* registry_ = nullptr;
+    std::string tenant_;
   };
 
   explicit MeshRegistry(const ServiceLimits& limits);
@@ -82,38 +93,58 @@ class MeshRegistry {
 
   const ServiceLimits& limits() const { return limits_; }
 
-  // RESOURCE_EXHAUSTED when max_meshes are loaded or being loaded. The registry must outlive it.
-  StatusOr<Reservation> Reserve();
-  // RESOURCE_EXHAUSTED when `bytes` more would not fit in the memory budget now (an early check
-  // before the expensive precomputation; Register checks again).
-  Status CheckMemoryAvailable(std::size_t bytes) const;
+  // A slot for a mesh `tenant` loads. RESOURCE_EXHAUSTED (naming the limit) when max_meshes are
+  // loaded or being loaded, or tenant_max_meshes of `tenant`'s. The registry must outlive it.
+  StatusOr<Reservation> Reserve(const std::string& tenant = Identity::Implicit().tenant);
+  // RESOURCE_EXHAUSTED when `bytes` more would not fit in the memory budget now, the server's or
+  // `tenant`'s (an early check before the expensive precomputation; Register checks again).
+  Status CheckMemoryAvailable(std::size_t bytes,
+                              const std::string& tenant = Identity::Implicit().tenant) const;
 
-  // Registers a built model under a new id, using `reservation`'s slot. RESOURCE_EXHAUSTED (the
-  // slot is released) when the model does not fit in the memory budget.
+  // Registers a built model using `reservation`'s slot, owned by the reservation's tenant, under `id` if given (a mesh restored from
+  // a store keeps its id; an id already loaded is INVALID_ARGUMENT), else under a new NewMeshId().
+  // RESOURCE_EXHAUSTED (the slot is released) when the model does not fit in the memory budget.
   StatusOr<std::shared_ptr<const MeshEntry>> Register(Reservation reservation, std::string name,
                                                       std::shared_ptr<const DeformationModel> model,
-                                                      MeshPresentation presentation = {});
+                                                      MeshPresentation presentation = {},
+                                                      std::string id = {});
 
-  // NOT_FOUND for an unknown (or unloaded) id.
+  // The mesh `caller` may access; NOT_FOUND for an unknown (or unloaded) id and, with the same
+  // message, for another tenant's mesh.
+  StatusOr<std::shared_ptr<const MeshEntry>> Find(const std::string& mesh_id,
+                                                  const Identity& caller) const;
+  // The meshes `caller` may access, in the order they were loaded.
+  std::vector<std::shared_ptr<const MeshEntry>> List(const Identity& caller) const;
+  // Removes the mesh and marks it unloaded; NOT_FOUND as Find.
+  Status Unload(const std::string& mesh_id, const Identity& caller);
+  // Unscoped (the server's own use: preloads, a load whose client went away, tests).
   StatusOr<std::shared_ptr<const MeshEntry>> Find(const std::string& mesh_id) const;
-  // Loaded meshes in the order they were loaded.
   std::vector<std::shared_ptr<const MeshEntry>> List() const;
-  // Removes the mesh and marks it unloaded; NOT_FOUND for an unknown id.
   Status Unload(const std::string& mesh_id);
 
   std::size_t memory_bytes_used() const;
   int mesh_count() const;
 
  private:
-  void ReleaseSlot();
+  // Per-tenant counts: slots held by loads in progress, loaded meshes, their memory.
+  struct TenantUsage {
+    int reserved = 0;
+    int loaded = 0;
+    std::size_t memory_bytes = 0;
+  };
+  void ReleaseSlot(const std::string& tenant);
+  Status CheckMemoryLocked(std::size_t bytes, const std::string& tenant) const
+      DEFORM_REQUIRES(mutex_);
 
   const ServiceLimits limits_;
   mutable Mutex mutex_;
-  // By sequence number.
+  // By load order (a sequence number), and the sequence number of each id.
   std::map<std::uint64_t, std::shared_ptr<MeshEntry>> meshes_ DEFORM_GUARDED_BY(mutex_);
+  std::unordered_map<std::string, std::uint64_t> order_of_id_ DEFORM_GUARDED_BY(mutex_);
   int reserved_ DEFORM_GUARDED_BY(mutex_) = 0;             // slots held by loads in progress
   std::size_t memory_used_ DEFORM_GUARDED_BY(mutex_) = 0;  // sum of memory_bytes of loaded meshes
-  std::uint64_t next_number_ DEFORM_GUARDED_BY(mutex_) = 1;
+  std::uint64_t next_order_ DEFORM_GUARDED_BY(mutex_) = 1;
+  std::map<std::string, TenantUsage> tenants_ DEFORM_GUARDED_BY(mutex_);
 };
 
 }  // namespace deform::service

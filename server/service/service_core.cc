@@ -25,4 +25,22 @@ int ActiveStreams::count() const {
   return static_cast<int>(streams_.size());
 }
 
+Status TenantStreamQuota::Acquire(const std::string& tenant) {
+  MutexLock lock(&mutex_);
+  int& open = open_[tenant];
+  if (max_per_tenant_ > 0 && open >= max_per_tenant_) {
+    return Status::ResourceExhausted("tenant stream limit reached (--tenant-max-streams): " +
+                                     std::to_string(open) + " streams open, of at most " +
+                                     std::to_string(max_per_tenant_) + " per tenant");
+  }
+  ++open;
+  return Status::Ok();
+}
+
+void TenantStreamQuota::Release(const std::string& tenant) {
+  MutexLock lock(&mutex_);
+  const auto it = open_.find(tenant);
+  if (it != open_.end() && --it->second == 0) open_.erase(it);
+}
+
 }  // namespace deform::service

@@ -1,4 +1,5 @@
-// Everything the service's RPCs share: the mesh registry, the worker pool and the open streams.
+// Everything the service's RPCs share: who may call (the authenticator), the mesh registry, the
+// worker pool and the open streams.
 // The gRPC service class is a thin layer over this object (no gRPC types here).
 //
 // Ownership: the server owns one ServiceCore; it must outlive every reactor (the server shuts
@@ -7,10 +8,15 @@
 
 #include <atomic>
 #include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
 #include <unordered_set>
 
 #include "service/annotated_mutex.h"
+#include "service/identity.h"
 #include "service/mesh_registry.h"
+#include "service/mesh_store.h"
 #include "service/service_options.h"
 #include "service/thread_annotations.h"
 #include "service/worker_pool.h"
@@ -45,14 +51,38 @@ class ActiveStreams {
   bool draining_ DEFORM_GUARDED_BY(mutex_) = false;
 };
 
+// Open Deform streams per tenant, against ServiceLimits::tenant_max_streams. Thread-safe.
+class TenantStreamQuota {
+ public:
+  // `max_per_tenant` <= 0: no limit (streams are still counted).
+  explicit TenantStreamQuota(int max_per_tenant) : max_per_tenant_(max_per_tenant) {}
+  // Counts one more stream of `tenant`; RESOURCE_EXHAUSTED naming the limit when it has
+  // max_per_tenant open already. Release() once for every successful Acquire().
+  Status Acquire(const std::string& tenant) DEFORM_EXCLUDES(mutex_);
+  void Release(const std::string& tenant) DEFORM_EXCLUDES(mutex_);
+
+ private:
+  const int max_per_tenant_;
+  Mutex mutex_;
+  std::map<std::string, int> open_ DEFORM_GUARDED_BY(mutex_);
+};
+
 struct ServiceCore {
   explicit ServiceCore(const ServerOptions& options)
-      : limits(options.limits), registry(options.limits), pool(options.workers) {}
+      : limits(options.limits),
+        registry(options.limits),
+        pool(options.workers),
+        tenant_streams(options.limits.tenant_max_streams) {}
 
   const ServiceLimits limits;
+  // Who may call (token file, or the single implicit tenant).
+  Authenticator auth;
   MeshRegistry registry;
   WorkerPool pool;
   ActiveStreams streams;
+  TenantStreamQuota tenant_streams;
+  // Where loaded meshes are kept across restarts (--store); null: nowhere. Set before serving.
+  std::unique_ptr<MeshStore> store;
   std::atomic<std::uint64_t> next_stream_id{1};
   std::atomic<std::uint64_t> next_load_id{1};
 };

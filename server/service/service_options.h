@@ -16,6 +16,25 @@ struct ServiceLimits {
   std::size_t max_memory_bytes = std::size_t{4} << 30;
   // Largest upload (mesh file plus skeleton file) accepted by LoadMesh. Default: 256 MiB.
   std::size_t max_upload_bytes = std::size_t{256} << 20;
+  // Per tenant (identity.h), on top of the server-wide limits above; 0 means no per-tenant limit.
+  // Meshes loaded or being loaded by one tenant. Default: 0.
+  int tenant_max_meshes = 0;
+  // Open Deform streams of one tenant. Default: 0.
+  int tenant_max_streams = 0;
+  // Memory budget of one tenant's loaded meshes (the same estimate as max_memory_bytes). Default: 0.
+  std::size_t tenant_max_memory_bytes = 0;
+};
+
+// How the gRPC port is secured (policy and credentials: transport_security.h).
+struct TransportSecurity {
+  // PEM files: the server's certificate chain and its private key. Both or neither.
+  std::string cert_file;
+  std::string key_file;
+  // PEM file of the CA that signs client certificates. Given (with a certificate): mutual TLS,
+  // a client without a certificate signed by it is refused during the handshake. Default: none.
+  std::string client_ca_file;
+  // Without a certificate, serve plaintext on a non-loopback address too. Default: false.
+  bool allow_plaintext = false;
 };
 
 struct ServerOptions {
@@ -26,6 +45,7 @@ struct ServerOptions {
   // Largest gRPC message received or sent. Default: 64 MiB.
   int max_message_bytes = 64 << 20;
   ServiceLimits limits;
+  TransportSecurity security;
 };
 
 }  // namespace deform::service

@@ -22,8 +22,14 @@ inline service::ServerOptions TestServerOptions() {
 
 class TestServer {
  public:
-  explicit TestServer(service::ServerOptions options = TestServerOptions())
+  // `token_file`: authenticate calls with it (DeformServer::UseTokenFile); empty: no tokens.
+  explicit TestServer(service::ServerOptions options = TestServerOptions(),
+                      const std::string& token_file = "")
       : server_(std::make_unique<service::DeformServer>(options)) {
+    if (!token_file.empty()) {
+      const Status tokens = server_->UseTokenFile(token_file);
+      EXPECT_TRUE(tokens.ok()) << tokens.ToString();
+    }
     const Status started = server_->Start();
     EXPECT_TRUE(started.ok()) << started.ToString();
     target_ = "127.0.0.1:" + std::to_string(server_->port());
@@ -32,8 +38,8 @@ class TestServer {
   service::DeformServer& server() { return *server_; }
   const std::string& target() const { return target_; }
   // A new client (its own channel, so its own connection).
-  std::unique_ptr<client::DeformClient> NewClient() const {
-    return std::make_unique<client::DeformClient>(target_);
+  std::unique_ptr<client::DeformClient> NewClient(client::ClientOptions options = {}) const {
+    return std::make_unique<client::DeformClient>(target_, options);
   }
 
  private:

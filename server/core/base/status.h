@@ -20,6 +20,7 @@ enum class StatusCode {
   kResourceExhausted,   // a configured limit would be exceeded
   kFailedPrecondition,  // the operation does not apply in the current state
   kInternal,            // a numerical or programming failure (e.g. factorisation broke down)
+  kUnauthenticated,     // the caller presented no valid credentials (the service's token check)
 };
 
 const char* StatusCodeName(StatusCode code);
@@ -41,6 +42,9 @@ class [[nodiscard]] Status {
     return {StatusCode::kFailedPrecondition, std::move(msg)};
   }
   static Status Internal(std::string msg) { return {StatusCode::kInternal, std::move(msg)}; }
+  static Status Unauthenticated(std::string msg) {
+    return {StatusCode::kUnauthenticated, std::move(msg)};
+  }
 
   bool ok() const { return code_ == StatusCode::kOk; }
   StatusCode code() const { return code_; }

@@ -1,0 +1,112 @@
+#include "service/load_request.h"
+
+#include <utility>
+
+#include "core/geometry/skeleton.h"
+#include "core/io/phantom.h"
+#include "core/io/rig_import.h"
+#include "core/io/skeleton_io.h"
+#include "service/proto_conversion.h"
+
+namespace deform::service {
+namespace {
+
+StatusOr<Skeleton> ParseSkeleton(v1::SkeletonFormat format, const std::string& bytes) {
+  switch (format) {
+    case v1::SKELETON_FORMAT_TGF:
+      return ParseTgf(bytes);
+    case v1::SKELETON_FORMAT_JSON:
+      return ParseSkeletonJson(bytes);
+    default:
+      return Status::InvalidArgument("upload.skeleton_format is unspecified or unknown (" +
+                                     std::to_string(static_cast<int>(format)) + ")");
+  }
+}
+
+Status ParseUpload(const v1::UploadSource& upload, std::string* mesh_bytes,
+                   const ServiceLimits& service_limits, LoadJob* job) {
+  MeshLimits limits;
+  limits.max_vertices = service_limits.max_vertices;
+  if (upload.format() == v1::MESH_FORMAT_GLTF) {
+    auto rig = ReadGltf(*mesh_bytes, limits);
+    std::string().swap(*mesh_bytes);
+    if (!rig.ok()) return rig.status().WithContext("glTF");
+    job->mesh = std::move(rig->mesh);
+    job->skeleton = std::move(rig->skeleton);
+    job->weights = std::move(rig->weights);
+    job->presentation.file_vertex_to_mesh = std::move(rig->file_vertex_to_mesh);
+    job->presentation.units = std::move(rig->units);
+    job->presentation.up_axis = std::move(rig->up_axis);
+    return Status::Ok();
+  }
+  DEFORM_ASSIGN_OR_RETURN(const MeshFormat format, CoreMeshFormat(upload.format()));
+  auto mesh = ReadMesh(*mesh_bytes, format, limits);
+  if (!mesh.ok()) return mesh.status().WithContext("mesh");
+  job->mesh = std::move(*mesh);
+  std::string().swap(*mesh_bytes);  // the bytes are no longer needed
+  auto skeleton = ParseSkeleton(upload.skeleton_format(), upload.skeleton());
+  if (!skeleton.ok()) return skeleton.status().WithContext("skeleton");
+  job->skeleton = std::move(*skeleton);
+  if (!upload.weights().empty()) {
+    DEFORM_ASSIGN_OR_RETURN(const SkinWeightsFormat format,
+                            CoreWeightsFormat(upload.weights_format()));
+    auto weights = ReadSkinWeights(upload.weights(), format, limits);
+    if (!weights.ok()) return weights.status().WithContext("weights");
+    WidenSkinWeights(format, job->mesh.num_vertices(), job->skeleton.num_bones(), &*weights);
+    job->weights = std::move(*weights);
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+StatusOr<MeshFormat> CoreMeshFormat(v1::MeshFormat format) {
+  switch (format) {
+    case v1::MESH_FORMAT_OBJ:
+      return MeshFormat::kObj;
+    case v1::MESH_FORMAT_PLY:
+      return MeshFormat::kPly;
+    case v1::MESH_FORMAT_STL:
+      return MeshFormat::kStl;
+    case v1::MESH_FORMAT_OFF:
+      return MeshFormat::kOff;
+    default:
+      return Status::InvalidArgument("upload.format is unspecified or unknown (" +
+                                     std::to_string(static_cast<int>(format)) + ")");
+  }
+}
+
+StatusOr<SkinWeightsFormat> CoreWeightsFormat(v1::SkinWeightsFormat format) {
+  switch (format) {
+    case v1::SKIN_WEIGHTS_FORMAT_DMAT:
+      return SkinWeightsFormat::kDmat;
+    case v1::SKIN_WEIGHTS_FORMAT_CSV:
+      return SkinWeightsFormat::kCsv;
+    default:
+      return Status::InvalidArgument("upload.weights_format is unspecified or unknown (" +
+                                     std::to_string(static_cast<int>(format)) + ")");
+  }
+}
+
+StatusOr<LoadJob> LoadJobFromRequest(const v1::LoadMeshHeader& header, std::string* mesh_bytes,
+                                     const ServiceLimits& limits) {
+  LoadJob job;
+  job.name = header.name();
+  if (header.has_phantom()) {
+    const int vertices =
+        header.phantom().vertices() == 0 ? kDefaultPhantomVertices : header.phantom().vertices();
+    DEFORM_ASSIGN_OR_RETURN(KneePhantom phantom, MakeKneePhantom(vertices));
+    job.mesh = std::move(phantom.mesh);
+    job.skeleton = std::move(phantom.skeleton);
+    if (job.name.empty()) job.name = "phantom:" + std::to_string(vertices);
+  } else {
+    DEFORM_RETURN_IF_ERROR(ParseUpload(header.upload(), mesh_bytes, limits, &job));
+    if (job.name.empty()) job.name = "upload";
+  }
+  auto options = ModelOptionsFromProto(header.options(), job.skeleton);
+  if (!options.ok()) return options.status().WithContext("options");
+  job.options = std::move(*options);
+  return job;
+}
+
+}  // namespace deform::service
