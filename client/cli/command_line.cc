@@ -49,16 +49,34 @@ void AddConnectionFlags(CLI::App& app, ConnectionArgs* args) {
 MeshSourceOptions AddMeshSourceFlags(CLI::App& app, MeshSource* source) {
   MeshSourceOptions options;
   options.mesh = app.add_option("--mesh", source->mesh_path,
-                                "Mesh file to upload (.obj .ply .stl .off); default: the "
+                                "Mesh file to upload (.obj .ply .stl .off), or a skinned glTF rig "
+                                "(.gltf .glb) that brings its skeleton and weights; default: the "
                                 "built-in knee phantom");
   options.skeleton = app.add_option("--skeleton", source->skeleton_path,
-                                    "Skeleton file (.tgf or JSON); required with --mesh");
+                                    "Skeleton file (.tgf or JSON); required with --mesh, except a "
+                                    "glTF rig");
+  options.weights = app.add_option("--weights", source->weights_path,
+                                   "The rig's skinning weights (.dmat or .csv: a row per vertex, "
+                                   "a column per bone) to bind with; default: binding through "
+                                   "the body");
   options.phantom_vertices = app.add_option("--phantom-vertices", source->phantom_vertices,
                                             "Phantom resolution (0 = the server's default)")
                                  ->capture_default_str()
                                  ->check(CLI::NonNegativeNumber);
-  options.mesh->needs(options.skeleton);
   options.skeleton->needs(options.mesh);
+  options.weights->needs(options.mesh);
+  app.parse_complete_callback([source] {
+    const bool rig = !source->mesh_path.empty() &&
+                     client::MeshFormatFromPath(source->mesh_path) == deform::v1::MESH_FORMAT_GLTF;
+    if (!source->mesh_path.empty() && source->skeleton_path.empty() && !rig) {
+      throw CLI::RequiresError("--mesh", "--skeleton (only a .gltf/.glb rig brings its own)");
+    }
+    if (rig && (!source->skeleton_path.empty() || !source->weights_path.empty())) {
+      throw CLI::ValidationError("--mesh",
+                                 "a glTF rig brings its own skeleton and weights: give neither "
+                                 "--skeleton nor --weights");
+    }
+  });
   options.mesh->excludes(options.phantom_vertices);
   options.rotation_blend = AddRotationBlendFlag(app, &source->rotation_blend);
   return options;

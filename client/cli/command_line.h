@@ -45,12 +45,15 @@ void AddConnectionFlags(CLI::App& app, ConnectionArgs* args);
 struct MeshSourceOptions {
   CLI::Option* mesh = nullptr;
   CLI::Option* skeleton = nullptr;
+  CLI::Option* weights = nullptr;
   CLI::Option* phantom_vertices = nullptr;
   CLI::Option* rotation_blend = nullptr;
 };
 
-// --mesh and --skeleton (each needs the other), --phantom-vertices (excludes --mesh) and
-// --rotation-blend, filling `source` (which must outlive the parse).
+// --mesh and --skeleton (each needs the other, except that a .gltf/.glb rig takes no skeleton),
+// --weights (needs --mesh), --phantom-vertices (excludes --mesh) and --rotation-blend, filling
+// `source` (which must outlive the parse). The skeleton rule is checked once parsing completes
+// (app's parse_complete_callback: a usage error).
 MeshSourceOptions AddMeshSourceFlags(CLI::App& app, MeshSource* source);
 
 // Parses the command line. Returns the exit code the program should end with (0 after --help or

@@ -21,7 +21,8 @@ grpc::Status AcquireMesh(client::DeformClient& client, const MeshSource& source,
   grpc::Status status =
       source.mesh_path.empty()
           ? client.LoadPhantom(source.phantom_vertices, options, summary)
-          : client.LoadMeshFiles(source.mesh_path, source.skeleton_path, options, summary);
+          : client.LoadMeshFiles(source.mesh_path, source.skeleton_path, options, summary,
+                                 /*progress=*/{}, source.weights_path);
   *loaded = status.ok();
   return status;
 }

@@ -10,8 +10,9 @@ namespace deform::cli {
 
 struct MeshSource {
   std::string mesh_id;    // non-empty: use this loaded mesh (nothing is loaded)
-  std::string mesh_path;  // non-empty: upload this file with `skeleton_path`
+  std::string mesh_path;  // non-empty: upload this file with `skeleton_path` (none for a glTF rig)
   std::string skeleton_path;
+  std::string weights_path;  // optional with `mesh_path`: the rig's skinning weights (.dmat, .csv)
   int phantom_vertices = 0;  // otherwise: load the phantom at this resolution (0 = default)
   // When loading: how the server blends bone rotations near a joint.
   deform::v1::RotationBlend rotation_blend = deform::v1::ROTATION_BLEND_UNSPECIFIED;
