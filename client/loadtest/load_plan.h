@@ -13,7 +13,9 @@ namespace deform::loadtest {
 
 struct LoadPlan {
   std::string mesh_id;
-  std::size_t vertex_count = 0;  // frames must carry 12 bytes per vertex
+  std::size_t vertex_count = 0;  // frames must carry 12 bytes per vertex (decoded)
+  // How frames travel; the client library decodes them into positions.
+  deform::v1::FrameEncoding encoding = deform::v1::FRAME_ENCODING_FLOAT32;
   int streams = 1;
   // Stream i sends pose k at t0 + (k + i / streams) / rate_hz: the streams are evenly staggered
   // within one period, each on an absolute (drift-free) schedule.

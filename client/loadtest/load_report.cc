@@ -69,6 +69,7 @@ LoadReport BuildReport(const RunDescription& run, const LoadPlan& plan, RunOutco
     report.poses_rejected += stats.poses_rejected;
     report.stiffness_rejected += stats.stiffness_rejected;
     report.bad_frames += stats.bad_frames;
+    report.payload_bytes += stats.payload_bytes;
     report.stiffness_sent += stream.stiffness_sent;
     report.stiffness_applied += stats.stiffness_applied;
     report.max_gap_ms = std::max(report.max_gap_ms, stream.max_gap_ms);
@@ -111,6 +112,7 @@ nlohmann::ordered_json ReportJson(const LoadReport& report) {
   out["vertices"] = report.run.vertices;
   out["triangles"] = report.run.triangles;
   out["rotation_blend"] = report.run.rotation_blend;
+  out["encoding"] = report.run.encoding;
   out["streams"] = plan.streams;
   out["rate_hz"] = plan.rate_hz;
   out["duration_s"] = plan.duration_s;
@@ -126,6 +128,12 @@ nlohmann::ordered_json ReportJson(const LoadReport& report) {
   out["rejected_notices"] = {{"KIND_POSE_REJECTED", report.poses_rejected},
                              {"KIND_STIFFNESS_REJECTED", report.stiffness_rejected}};
   out["throughput_fps"] = Round(report.throughput_fps(), 1);
+  const double frames = static_cast<double>(std::max<std::uint64_t>(report.frames_received, 1));
+  out["bytes_per_frame"] = Round(static_cast<double>(report.payload_bytes) / frames, 1);
+  out["bytes_per_vertex"] =
+      Round(static_cast<double>(report.payload_bytes) / frames /
+                static_cast<double>(std::max(report.run.vertices, 1u)),
+            3);
   out["latency_ms"] = {{"p50", Ms(report.latency.p50)}, {"p90", Ms(report.latency.p90)},
                        {"p99", Ms(report.latency.p99)}, {"p999", Ms(report.latency.p999)},
                        {"max", Ms(report.latency.max)}, {"mean", Ms(report.latency.mean)}};
@@ -162,6 +170,10 @@ std::string ReportText(const LoadReport& report) {
   add("target %s, mesh %s (%s): %u vertices, %u triangles, %s rotation blend\n",
       report.run.target.c_str(), report.run.mesh.c_str(), report.run.mesh_id.c_str(),
       report.run.vertices, report.run.triangles, report.run.rotation_blend.c_str());
+  const double frames = static_cast<double>(std::max<std::uint64_t>(report.frames_received, 1));
+  add("frames %s: %.0f bytes per frame, %.3f bytes per vertex\n", report.run.encoding.c_str(),
+      static_cast<double>(report.payload_bytes) / frames,
+      static_cast<double>(report.payload_bytes) / frames / std::max(report.run.vertices, 1u));
   add("%d streams x %.1f Hz posing %s:%s, %.1f s measured after %.1f s warm-up\n", plan.streams,
       plan.rate_hz, plan.posed.joint.c_str(), plan.posed.axis.c_str(), plan.duration_s,
       plan.warmup_s);

@@ -21,6 +21,7 @@ struct RunDescription {
   unsigned vertices = 0;
   unsigned triangles = 0;
   std::string rotation_blend;   // as the server reports the mesh loaded
+  std::string encoding;         // the frames' (--encoding)
   std::string stiffness_joint;  // empty without stiffness updates
 };
 
@@ -37,6 +38,7 @@ struct LoadReport {
   std::uint64_t poses_rejected = 0;
   std::uint64_t stiffness_rejected = 0;
   std::uint64_t bad_frames = 0;
+  std::uint64_t payload_bytes = 0;  // measured frames' positions as they travelled
   std::string first_stream_error;  // "CODE: message" of the first failed stream
   std::vector<double> latency_ms;  // every measured frame's, ascending
   LatencySummary latency;

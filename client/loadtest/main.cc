@@ -13,6 +13,7 @@
 
 #include "cli/command_line.h"
 #include "cli/mesh_source.h"
+#include "cli/frame_encoding_flag.h"
 #include "cli/rotation_blend_flag.h"
 #include "lib/deform_client.h"
 #include "lib/joint_choice.h"
@@ -40,6 +41,7 @@ struct LoadtestArgs {
   double peak_degrees = 120.0;
   double cycle_s = 2.0;
   double drain_s = 2.0;
+  deform::v1::FrameEncoding encoding = deform::v1::FRAME_ENCODING_FLOAT32;
   bool keep_mesh = false;
   bool json = false;
   bool fail_on_errors = false;
@@ -61,6 +63,7 @@ int RunOnMesh(deform::client::DeformClient& client, const LoadtestArgs& args,
   plan.peak_degrees = args.peak_degrees;
   plan.cycle_s = args.cycle_s;
   plan.drain_s = args.drain_s;
+  plan.encoding = args.encoding;
 
   deform::loadtest::RunDescription run;
   run.target = args.connection.target;
@@ -69,6 +72,7 @@ int RunOnMesh(deform::client::DeformClient& client, const LoadtestArgs& args,
   run.vertices = summary.vertex_count();
   run.triangles = summary.triangle_count();
   run.rotation_blend = deform::cli::RotationBlendName(summary.rotation_blend());
+  run.encoding = deform::cli::FrameEncodingName(args.encoding);
   if (args.stiffness_every_s > 0) {
     run.stiffness_joint = deform::client::ChooseRegionJoint(summary, plan.posed.joint);
     if (run.stiffness_joint.empty()) {
@@ -106,6 +110,7 @@ void AddFlags(CLI::App& app, LoadtestArgs& args) {
   deform::cli::AddConnectionFlags(app, &args.connection);
   deform::cli::AddMeshSourceFlags(app, &args.source);
 
+  deform::cli::AddFrameEncodingFlag(app, &args.encoding);
   app.add_option("--streams", args.streams, "Concurrent Deform streams on the mesh")
       ->capture_default_str()
       ->check(CLI::Range(1, 100000));

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "cli/frame_encoding_flag.h"
 #include "lib/deform_client.h"
 
 namespace deform::loadtest {
@@ -34,6 +35,7 @@ void StreamRecorder::OnFrame(const deform::v1::DeformFrame& frame) {
   stats_.last_receipt_ns = now_ns;
   if (measured) {
     ++stats_.frames_received;
+    stats_.payload_bytes += cli::FramePayloadBytes(frame);
     stats_.skipped_by_server += frame.skipped_poses();
     stats_.latency_ms.push_back(static_cast<double>(now_ns - frame.client_timestamp_ns()) * 1e-6);
     stats_.timings.push_back({t.queue_ms(), t.rhs_ms(), t.solve_ms(), t.encode_ms()});

@@ -32,6 +32,7 @@ struct StreamStats {
   std::uint64_t frames_received_total = 0;  // including the warm-up
   std::uint64_t skipped_by_server = 0;      // sum of measured frames' skipped_poses
   std::uint64_t bad_frames = 0;             // positions not 12 bytes per vertex
+  std::uint64_t payload_bytes = 0;          // measured frames' positions as they travelled
   double max_gap_ms = 0;  // largest interval between consecutive receipts after the warm-up
   std::int64_t last_receipt_ns = 0;  // MonotonicNanos() of the last frame; 0 before any
   std::uint64_t poses_rejected = 0;

@@ -14,6 +14,7 @@
 #include <string>
 
 #include "cli/command_line.h"
+#include "cli/frame_encoding_flag.h"
 #include "cli/mesh_source.h"
 #include "core/io/mesh_io.h"
 #include "lib/deform_client.h"
@@ -35,6 +36,7 @@ struct VrArgs {
   std::string joint;
   std::string axis;
   double rate_hz = 90.0;
+  deform::v1::FrameEncoding encoding = deform::v1::FRAME_ENCODING_FLOAT32;
   double duration_s = 4.0;
   double cycle_s = 2.0;
   double peak_degrees = 120.0;
@@ -98,6 +100,7 @@ int RunOnMesh(deform::client::DeformClient& client, const VrArgs& args,
   settings.rate_hz = args.rate_hz;
   settings.poses = PosesToSend(args);
   settings.answer_timeout_ms = args.answer_timeout_ms;
+  settings.encoding = args.encoding;
   const deform::vr::PlaybackResult result =
       deform::vr::PlayPoses(client, summary.mesh_id(), settings, MakePoseGenerator(args, knee));
   if (!result.status.ok()) return Fail(result.status);
@@ -118,6 +121,7 @@ int RunOnMesh(deform::client::DeformClient& client, const VrArgs& args,
   run.knee = knee;
   run.peak_degrees = args.peak_degrees;
   run.cycle_s = args.cycle_s;
+  run.encoding = deform::cli::FrameEncodingName(args.encoding);
   run.rate_hz = args.rate_hz;
   run.out_path = args.out_path;
   if (args.json) {
@@ -151,6 +155,7 @@ void AddFlags(CLI::App& app, VrArgs& args) {
                  "skeleton has a knee with a flexion dof, else 1)");
   app.add_option("--axis", args.axis,
                  "Axis of the bend: a dof name or x|y|z (default: flexion for the knee, else x)");
+  deform::cli::AddFrameEncodingFlag(app, &args.encoding);
   app.add_option("--rate", args.rate_hz, "Poses per second")
       ->capture_default_str()
       ->check(CLI::Range(0.001, 100000.0));

@@ -5,6 +5,8 @@
 #include <mutex>
 #include <thread>
 
+#include "cli/frame_encoding_flag.h"
+
 namespace deform::vr {
 namespace {
 
@@ -25,6 +27,7 @@ class PlaybackState {
     result_.skipped_by_server += frame.skipped_poses();
     result_.latency_ms.push_back(static_cast<double>(now_ns - frame.client_timestamp_ns()) * 1e-6);
     result_.solve_ms.push_back(frame.timings().solve_ms());
+    result_.payload_bytes += cli::FramePayloadBytes(frame);
     if (frame.sequence() == last_sequence_) {
       result_.last_frame = frame;
       result_.last_pose_answered = true;
@@ -93,7 +96,10 @@ PlaybackResult PlayPoses(client::DeformClient& client, const std::string& mesh_i
   callbacks.on_frame = [&state](const deform::v1::DeformFrame& frame) { state.OnFrame(frame); };
   callbacks.on_notice = [&state](const deform::v1::Notice& notice) { state.OnNotice(notice); };
   callbacks.on_done = [&state](const grpc::Status& status) { state.OnDone(status); };
-  std::unique_ptr<client::DeformStream> stream = client.OpenStream(mesh_id, std::move(callbacks));
+  client::DeformClient::StreamOptions options;
+  options.encoding = settings.encoding;
+  std::unique_ptr<client::DeformStream> stream =
+      client.OpenStream(mesh_id, std::move(callbacks), options);
   if (stream == nullptr) {
     PlaybackResult failed;
     failed.status = grpc::Status(grpc::StatusCode::INTERNAL, "the stream could not be opened");

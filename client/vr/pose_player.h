@@ -16,6 +16,8 @@ struct PlaybackSettings {
   // After the last send: how long to wait for the last pose's frame, and then for the stream to
   // finish after the half-close.
   int answer_timeout_ms = 5000;
+  // How frames travel; the client library decodes them into positions.
+  deform::v1::FrameEncoding encoding = deform::v1::FRAME_ENCODING_FLOAT32;
 };
 
 // Builds pose k (0-based): its angles and rotations. The player sets `sequence` (k + 1) and
@@ -30,6 +32,7 @@ struct PlaybackResult {
   std::string first_rejection;          // "pose rejected: " + the first one's message
   std::vector<double> latency_ms;       // per frame: receipt minus the echoed client timestamp
   std::vector<double> solve_ms;         // per frame: timings.solve_ms
+  std::uint64_t payload_bytes = 0;      // all frames' positions as they travelled
   double send_lag_max_ms = 0;           // worst lateness of a send against its schedule
   bool last_pose_answered = false;
   deform::v1::DeformFrame last_frame;  // the frame answering the last pose, when answered

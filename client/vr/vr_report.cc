@@ -32,6 +32,15 @@ int FramesSkipped(const PlaybackResult& result) {
 
 }  // namespace
 
+namespace {
+
+// Mean bytes of a frame's positions as they travelled.
+double BytesPerFrame(const PlaybackResult& result) {
+  return static_cast<double>(result.payload_bytes) / std::max(result.frames_received, 1);
+}
+
+}  // namespace
+
 nlohmann::ordered_json ReportJson(const RunDescription& run, const PlaybackResult& result) {
   nlohmann::ordered_json out;
   out["mesh_id"] = run.mesh_id;
@@ -56,6 +65,8 @@ nlohmann::ordered_json ReportJson(const RunDescription& run, const PlaybackResul
                        {"max", Round3(Max(result.latency_ms))}};
   out["server_solve_ms_p50"] = Round3(Percentile(result.solve_ms, 0.50));
   out["send_lag_max_ms"] = Round3(result.send_lag_max_ms);
+  out["encoding"] = run.encoding;
+  out["bytes_per_frame"] = Round3(BytesPerFrame(result));
   if (!run.out_path.empty()) out["out"] = run.out_path;
   return out;
 }
@@ -87,6 +98,10 @@ std::string ReportText(const RunDescription& run, const PlaybackResult& result) 
   text += buffer;
   std::snprintf(buffer, sizeof(buffer), "server solve: median %.3f ms; worst send lag %.3f ms\n",
                 Percentile(result.solve_ms, 0.50), result.send_lag_max_ms);
+  text += buffer;
+  std::snprintf(buffer, sizeof(buffer), "frames %s: %.0f bytes per frame, %.3f bytes per vertex\n",
+                run.encoding.c_str(), BytesPerFrame(result),
+                BytesPerFrame(result) / std::max(run.vertices, 1u));
   text += buffer;
   if (!run.out_path.empty()) text += "wrote " + run.out_path + "\n";
   return text;

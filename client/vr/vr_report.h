@@ -19,6 +19,7 @@ struct RunDescription {
   double peak_degrees = 0;
   double cycle_s = 0;
   double rate_hz = 0;
+  std::string encoding;  // the frames' (--encoding)
   std::string out_path;
 };
 
