@@ -25,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench_meshes.h"
 #include "bench/memory_bandwidth.h"
 #include "core/io/model_input.h"
 #include "core/io/phantom.h"
@@ -34,37 +35,6 @@ namespace deform::bench {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-struct BenchMesh {
-  std::string name;
-  std::string mesh_path;  // empty: the phantom
-  std::string skeleton_path;
-  std::string pose_spec;
-};
-
-std::map<std::string, std::shared_ptr<const DeformationModel>> g_models;
-
-// The paper's model of `mesh` (built once per rotation blend and kept for the later benchmarks).
-std::shared_ptr<const DeformationModel> ModelFor(const BenchMesh& mesh,
-                                                 RotationBlend blend = RotationBlend::kQuaternion) {
-  const std::string key = mesh.name + (blend == RotationBlend::kLinear ? "/linear" : "");
-  auto it = g_models.find(key);
-  if (it != g_models.end()) return it->second;
-  auto input = LoadModelInput(mesh.mesh_path, mesh.skeleton_path, kDefaultPhantomVertices);
-  if (!input.ok()) return nullptr;
-  ModelOptions options = ModelOptions::Paper();
-  options.rotation_blend = blend;
-  auto model = DeformationModel::Build(input->mesh, input->skeleton, options);
-  if (!model.ok()) return nullptr;
-  return g_models[key] = *model;
-}
-
-Pose PoseFor(const DeformationModel& model, const BenchMesh& mesh) {
-  Pose pose;
-  auto terms = ParsePoseSpec(mesh.pose_spec, model.skeleton());
-  if (terms.ok()) (void)PoseFromTerms(model.skeleton(), *terms, &pose);
-  return pose;
-}
 
 double Median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
@@ -123,7 +93,7 @@ std::unique_ptr<FrameSetup> SetUpFrames(benchmark::State& state, const BenchMesh
     return nullptr;
   }
   auto setup = std::make_unique<FrameSetup>();
-  setup->pose = PoseFor(*model, mesh);
+  setup->pose = PoseFromSpecOrRest(*model, mesh.pose_spec);
   setup->factorization = model->default_factorization().get();
   setup->scratch = model->MakeScratch();
   setup->model = std::move(model);
@@ -227,25 +197,6 @@ void BM_Precompute(benchmark::State& state, BenchMesh mesh) {
   }  // the model is freed outside the timed span
   state.counters["median_ms"] = Median(seconds) * 1e3;
   state.counters["precompute_ms"] = Median(precompute) * 1e3;  // before the first factorisation
-}
-
-std::vector<BenchMesh> AvailableMeshes() {
-  const std::string data = std::getenv("DEFORM_SHARED_DATA") ? std::getenv("DEFORM_SHARED_DATA")
-                                                             : DEFORM_SHARED_DATA_DIR;
-  std::vector<BenchMesh> meshes = {{"phantom_2k", "", "", "knee:flexion:60"}};
-  const std::vector<BenchMesh> shared = {
-      {"leg_1633", data + "/leg/leg_1633.obj", data + "/leg/leg.tgf", "1:x:60"},
-      {"leg_25969", data + "/leg/leg_25969.obj", data + "/leg/leg.tgf", "1:x:60"},
-      {"arm_132946", data + "/arm/arm_132946.obj", data + "/arm/arm.tgf", "2:z:-60"},
-  };
-  for (const auto& m : shared) {
-    if (std::filesystem::exists(m.mesh_path)) {
-      meshes.push_back(m);
-    } else {
-      std::fprintf(stderr, "shared mesh %s absent; skipping its benchmarks\n", m.mesh_path.c_str());
-    }
-  }
-  return meshes;
 }
 
 // Registers benchmark `name`/<mesh> of `function`(state, mesh, extra...), timed in milliseconds.

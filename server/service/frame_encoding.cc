@@ -11,8 +11,6 @@
 namespace deform::service {
 namespace {
 
-constexpr int kSlots = codec::kPredictionBonesPerVertex;
-
 std::vector<float> RestInClientOrder(const MeshEntry& entry) {
   const TriangleMesh& mesh = entry.model->mesh();
   std::vector<float> rest(3 * static_cast<std::size_t>(entry.client_vertex_count()));
@@ -25,24 +23,8 @@ std::vector<float> RestInClientOrder(const MeshEntry& entry) {
 
 codec::PredictionWeights PredictionWeightsOf(const MeshEntry& entry) {
   const BoneWeights& bw = entry.model->bone_weights();
-  const std::vector<int>& order = entry.presentation.file_vertex_to_mesh;
-  const int n = entry.client_vertex_count();
-  codec::PredictionWeights weights;
-  weights.bones.assign(static_cast<std::size_t>(kSlots) * n, 0);
-  weights.weights.assign(static_cast<std::size_t>(kSlots) * n, 0.0f);
-  for (int c = 0; c < n; ++c) {
-    const int i = order.empty() ? c : order[c];
-    // BoneWeights lists a vertex's weights largest first: keep four, renormalised.
-    const int begin = bw.offsets[i];
-    const int count = std::min(kSlots, bw.offsets[i + 1] - begin);
-    double sum = 0;
-    for (int j = 0; j < count; ++j) sum += bw.weights[begin + j];
-    for (int j = 0; j < count; ++j) {
-      weights.bones[kSlots * c + j] = static_cast<std::uint16_t>(bw.bones[begin + j]);
-      weights.weights[kSlots * c + j] = static_cast<float>(bw.weights[begin + j] / sum);
-    }
-  }
-  return weights;
+  return codec::TopFourWeights(bw.offsets, bw.bones, bw.weights,
+                               entry.presentation.file_vertex_to_mesh);
 }
 
 void FillPredictionWeights(const MeshEntry& entry, v1::PredictionWeights* proto) {

@@ -1,5 +1,6 @@
 #include "core/codec/skinning_prediction.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace deform::codec {
@@ -26,6 +27,27 @@ void PredictPositions(const float* rest, const PredictionWeights& weights, const
     predicted[3 * i + 1] = p[1];
     predicted[3 * i + 2] = p[2];
   }
+}
+
+PredictionWeights TopFourWeights(const std::vector<int>& offsets, const std::vector<int>& bones,
+                                 const std::vector<double>& weights, const std::vector<int>& order) {
+  const int n = order.empty() ? static_cast<int>(offsets.size()) - 1 : static_cast<int>(order.size());
+  constexpr int kSlots = kPredictionBonesPerVertex;
+  PredictionWeights result;
+  result.bones.assign(static_cast<std::size_t>(kSlots) * n, 0);
+  result.weights.assign(static_cast<std::size_t>(kSlots) * n, 0.0f);
+  for (int c = 0; c < n; ++c) {
+    const int i = order.empty() ? c : order[c];
+    const int begin = offsets[i];
+    const int count = std::min(kSlots, offsets[i + 1] - begin);
+    double sum = 0;
+    for (int j = 0; j < count; ++j) sum += weights[begin + j];
+    for (int j = 0; j < count; ++j) {
+      result.bones[kSlots * c + j] = static_cast<std::uint16_t>(bones[begin + j]);
+      result.weights[kSlots * c + j] = static_cast<float>(weights[begin + j] / sum);
+    }
+  }
+  return result;
 }
 
 bool CheckPredictionWeights(const PredictionWeights& weights, int num_bones) {

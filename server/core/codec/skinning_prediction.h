@@ -34,6 +34,13 @@ struct PredictionWeights {
   int num_vertices() const { return static_cast<int>(bones.size()) / kPredictionBonesPerVertex; }
 };
 
+// The prediction weights of a skinning given per vertex as lists (vertex i's bones and weights at
+// [offsets[i], offsets[i + 1]), largest weight first, as the model's BoneWeights holds them), in
+// the vertex order `order` (frame vertex c is vertex order[c]; empty: the same order): the four
+// largest of each vertex, renormalised to sum to 1.
+PredictionWeights TopFourWeights(const std::vector<int>& offsets, const std::vector<int>& bones,
+                                 const std::vector<double>& weights, const std::vector<int>& order);
+
 // predicted (3 n floats) = the prediction of every vertex. `rest` holds 3 n floats, `transforms`
 // 12 per bone. Bones out of range are the caller's error (decoders check them first:
 // CheckPredictionWeights). No allocation.

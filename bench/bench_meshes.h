@@ -1,0 +1,32 @@
+// The meshes the benchmarks run on (the built-in phantom and, where ../shared/data is present,
+// the 1.6k and 26k legs and the 133k arm) and their models, built once per rotation blend.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/model/deformation_model.h"
+
+namespace deform::bench {
+
+struct BenchMesh {
+  std::string name;
+  std::string mesh_path;  // empty: the phantom
+  std::string skeleton_path;
+  std::string pose_spec;         // the benchmarks' pose
+  std::string flexion_prefix;    // the flexion at DEG degrees is flexion_prefix + DEG
+};
+
+// The meshes present (a line on stderr for each shared mesh absent).
+std::vector<BenchMesh> AvailableMeshes();
+
+// The paper's model of `mesh` (built once per rotation blend and kept for the later benchmarks);
+// null when it cannot be built.
+std::shared_ptr<const DeformationModel> ModelFor(const BenchMesh& mesh,
+                                                 RotationBlend blend = RotationBlend::kQuaternion);
+
+// The pose `spec` on `model`'s skeleton (the rest pose when it does not parse).
+Pose PoseFromSpecOrRest(const DeformationModel& model, const std::string& spec);
+
+}  // namespace deform::bench
