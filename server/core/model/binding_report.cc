@@ -6,6 +6,8 @@
 #include <functional>
 #include <limits>
 #include <queue>
+#include <set>
+#include <string>
 #include <utility>
 
 #include "core/base/median.h"
@@ -122,6 +124,46 @@ Status CheckSkeletonAgainstMesh(const TriangleMesh& mesh, const Skeleton& skelet
   return Status::Ok();
 }
 
+namespace {
+
+// A warning for each connected piece of the mesh whose vertices follow bones of more than one tree
+// of the skeleton: a tree's root joint then turns its part with no joint region between them (a
+// crease), as when a TGF file's bones do not join a hip to the pelvis.
+void ReportSeparateTrees(const Skeleton& skeleton, const VertexAdjacency& adjacency,
+                         const std::vector<int>& bound_bone, std::vector<std::string>* warnings) {
+  std::vector<int> root_joint(skeleton.num_bones(), -1);
+  for (int k : skeleton.BonesParentsFirst()) {
+    const Bone& bone = skeleton.bone(k);
+    root_joint[k] = bone.parent_bone < 0 ? bone.head_joint : root_joint[bone.parent_bone];
+  }
+  std::vector<int> component;
+  const int count = ConnectedComponents(adjacency, &component);
+  std::vector<std::set<int>> roots(count);
+  std::vector<int> size(count, 0);
+  for (std::size_t i = 0; i < component.size(); ++i) {
+    ++size[component[i]];
+    if (bound_bone[i] >= 0) roots[component[i]].insert(root_joint[bound_bone[i]]);
+  }
+  for (int c = 0; c < count; ++c) {
+    if (roots[c].size() < 2) continue;
+    std::string names;
+    for (int joint : roots[c]) {
+      if (names.size() > 200) {
+        names += ", ...";
+        break;
+      }
+      names += (names.empty() ? "'" : ", '") + skeleton.joint(joint).name + "'";
+    }
+    warnings->push_back("one connected piece of the mesh (" + std::to_string(size[c]) +
+                        " vertices) follows " + std::to_string(roots[c].size()) +
+                        " separate skeleton trees (root joints " + names +
+                        "): a root joint's rotation has no joint region there; join the trees "
+                        "with bones");
+  }
+}
+
+}  // namespace
+
 BindingReport ReportBinding(const TriangleMesh& mesh, const Skeleton& skeleton,
                             const VertexAdjacency& adjacency, const TriangleBvh& bvh,
                             const std::vector<int>& bound_bone, const std::vector<int>& rigid_bone,
@@ -140,6 +182,7 @@ BindingReport ReportBinding(const TriangleMesh& mesh, const Skeleton& skeleton,
   for (int a : anchors) {
     if (rigid_bone[a] >= 0) ++report.bones[rigid_bone[a]].anchors;
   }
+  ReportSeparateTrees(skeleton, adjacency, bound_bone, &report.warnings);
   for (const Joint& joint : skeleton.joints()) {
     const double distance = bvh.DistanceToSurface(joint.rest_position);
     const bool outside = closed ? !bvh.Contains(joint.rest_position) : false;
