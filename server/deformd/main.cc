@@ -2,7 +2,8 @@
 //
 //   deformd [--listen ADDR] [--workers N] [--max-vertices N] [--max-meshes N] [--max-memory-mb N]
 //           [--max-message-mb N] [--max-upload-mb N] [--log-level LEVEL]
-//           [--preload MESH:SKELETON]... [--preload-phantom N]...
+//           [--preload MESH:SKELETON]... [--preload-phantom N]... [--shutdown-grace-s S]
+//           [--keepalive-s S] [--keepalive-timeout-s S] [--idle-timeout-s S]
 //
 // Preloaded meshes are built before the server listens. SIGTERM or SIGINT drains: open streams
 // end with UNAVAILABLE, calls in progress get a few seconds, then the process exits 0.
@@ -33,6 +34,9 @@ struct Args {
   std::vector<std::string> preload;
   std::vector<int> preload_phantom;
   double shutdown_grace_s = 5;
+  double keepalive_s = 30;
+  double keepalive_timeout_s = 10;
+  double idle_timeout_s = 300;
 };
 
 // One mesh to load before serving: files (--preload MESH:SKELETON) or the phantom
@@ -125,6 +129,18 @@ int main(int argc, char** argv) {
                  "On SIGTERM/SIGINT, seconds given to calls in progress")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 600.0));
+  app.add_option("--keepalive-s", args.keepalive_s,
+                 "Ping a connection after this many seconds without activity")
+      ->capture_default_str()
+      ->check(CLI::Range(1.0, 86400.0));
+  app.add_option("--keepalive-timeout-s", args.keepalive_timeout_s,
+                 "Close a connection whose ping is unanswered for this many seconds")
+      ->capture_default_str()
+      ->check(CLI::Range(0.1, 3600.0));
+  app.add_option("--idle-timeout-s", args.idle_timeout_s,
+                 "Close a connection without any call for this many seconds")
+      ->capture_default_str()
+      ->check(CLI::Range(0.1, 86400.0));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -136,6 +152,9 @@ int main(int argc, char** argv) {
   args.server.limits.max_memory_bytes = args.max_memory_mb << 20;
   args.server.limits.max_upload_bytes = args.max_upload_mb << 20;
   args.server.max_message_bytes = args.max_message_mb << 20;
+  args.server.connections.keepalive_time_ms = static_cast<int>(args.keepalive_s * 1000);
+  args.server.connections.keepalive_timeout_ms = static_cast<int>(args.keepalive_timeout_s * 1000);
+  args.server.connections.max_connection_idle_ms = static_cast<int>(args.idle_timeout_s * 1000);
 
   DeformServer server(args.server);
   if (!PreloadAll(args, &server)) return 1;

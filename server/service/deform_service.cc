@@ -5,6 +5,7 @@
 #include "service/deform_stream_reactor.h"
 #include "service/load_mesh_reactor.h"
 #include "service/proto_conversion.h"
+#include "service/request_limits.h"
 #include "service/status_mapping.h"
 
 namespace deform::service {
@@ -18,6 +19,11 @@ grpc::ServerUnaryReactor* DeformServiceImpl::GetMeshInfo(grpc::CallbackServerCon
                                                          const v1::GetMeshInfoRequest* request,
                                                          v1::GetMeshInfoResponse* response) {
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  const Status id_length = CheckLength(request->mesh_id(), kMaxMeshIdBytes, "mesh_id");
+  if (!id_length.ok()) {
+    reactor->Finish(ToGrpcStatus(id_length));
+    return reactor;
+  }
   auto entry = core_->registry.Find(request->mesh_id());
   if (!entry.ok()) {
     reactor->Finish(ToGrpcStatus(entry.status()));
@@ -41,7 +47,8 @@ grpc::ServerUnaryReactor* DeformServiceImpl::ListMeshes(grpc::CallbackServerCont
 grpc::ServerUnaryReactor* DeformServiceImpl::UnloadMesh(grpc::CallbackServerContext* context,
                                                         const v1::UnloadMeshRequest* request,
                                                         v1::UnloadMeshResponse* /*response*/) {
-  const Status status = core_->registry.Unload(request->mesh_id());
+  Status status = CheckLength(request->mesh_id(), kMaxMeshIdBytes, "mesh_id");
+  if (status.ok()) status = core_->registry.Unload(request->mesh_id());
   if (status.ok()) spdlog::info("mesh={} unloaded", request->mesh_id());
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
   reactor->Finish(ToGrpcStatus(status));
