@@ -4,43 +4,38 @@
 # LoadMesh header) with ASan and UBSan, and runs each from its seed corpus
 # (tests/fuzz/corpus/<target>/) for DEFORM_FUZZ_SECONDS seconds (default 20). Prints every
 # target's executions; exits non-zero on any crash, sanitizer report, timeout or leak (the input
-# is kept under $DEFORM_FUZZ_ARTIFACTS, default build-fuzz/artifacts), or when fewer than
+# is kept under $DEFORM_FUZZ_ARTIFACTS, default build-asan/fuzz-artifacts), or when fewer than
 # DEFORM_FUZZ_MIN_RUNS executions (default 1,000,000) ran in total.
 #
-# Builds in its own directory (build-fuzz, or $DEFORM_FUZZ_BUILD_DIR) with clang++, ccache when
-# installed, -O1 and line tables; only the fuzz targets and what they link are compiled. New inputs
-# found go to a temporary corpus, never into the repository. Installs what is missing
-# (scripts/packages/build.txt and checks.txt: clang, libclang-rt-14-dev).
+# Builds in build-asan ($DEFORM_ASAN_BUILD_DIR), the ASan+UBSan build it shares with
+# scripts/check-sanitizers.sh (scripts/sanitizers/asan-build.sh: clang++, ccache when installed,
+# -O1 and line tables; one sanitizer build of the core instead of two keeps .ci/run in its time);
+# only the fuzz targets and what they link are compiled here. New inputs found go to a temporary
+# corpus, never into the repository. Installs what is missing (scripts/packages/build.txt and
+# checks.txt: clang, libclang-rt-14-dev).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 start=$(date +%s)
-BUILD_DIR="${DEFORM_FUZZ_BUILD_DIR:-build-fuzz}"
+# shellcheck source=scripts/sanitizers/asan-build.sh
+source scripts/sanitizers/asan-build.sh
+BUILD_DIR="$DEFORM_ASAN_BUILD_DIR"
 SECONDS_PER_TARGET="${DEFORM_FUZZ_SECONDS:-20}"
 MIN_TOTAL_RUNS="${DEFORM_FUZZ_MIN_RUNS:-1000000}"
-ARTIFACTS="${DEFORM_FUZZ_ARTIFACTS:-$BUILD_DIR/artifacts}"
+ARTIFACTS="${DEFORM_FUZZ_ARTIFACTS:-$BUILD_DIR/fuzz-artifacts}"
 TARGETS=(mesh_obj_fuzz mesh_off_fuzz mesh_ply_fuzz mesh_stl_fuzz gltf_fuzz skeleton_tgf_fuzz
   skeleton_json_fuzz weights_dmat_fuzz weights_csv_fuzz phantom_fuzz pose_request_fuzz
   stiffness_request_fuzz load_header_fuzz)
 
 scripts/install-deps.sh scripts/packages/build.txt scripts/packages/checks.txt
 
-launcher=()
-command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
-sanitizers="-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer"
-cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_CXX_COMPILER=clang++ "${launcher[@]}" \
-  -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" \
-  -DCMAKE_CXX_FLAGS="$sanitizers -fsanitize=fuzzer-no-link" \
-  -DCMAKE_EXE_LINKER_FLAGS="$sanitizers" \
-  -DDEFORM_BUILD_FUZZERS=ON -DDEFORM_BUILD_TESTS=OFF -DDEFORM_BUILD_BENCHMARKS=OFF >/dev/null
+configure_asan_build "$BUILD_DIR"
 cmake --build "$BUILD_DIR" --target fuzzers --parallel "$(nproc)"
 echo "run-fuzz: built in $(($(date +%s) - start)) s"
 
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 mkdir -p "$ARTIFACTS"
-export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1:allocator_may_return_null=1}"
-export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}"
+export_sanitizer_options
 total=0
 failed=()
 for target in "${TARGETS[@]}"; do

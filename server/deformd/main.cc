@@ -94,19 +94,19 @@ bool PreloadAll(const Args& args, DeformServer* server) {
 }
 
 // Drains `server` and ends the process with exit code 0 within `grace_s` seconds of being called,
-// whatever the clients do: calls in progress get 80% of the grace period, then gRPC cancels them;
-// should the drain still not be done when the period ends (a frozen stream's write that never
-// completes, gRPC waiting on an idle connection), the process exits without it. Destructors are
-// skipped either way: gRPC's library teardown can wait on idle client connections.
+// whatever the clients do: calls in progress get 70% of the grace period, then gRPC cancels them
+// (an idle client connection makes gRPC wait that long too); should the drain still not be done
+// at 95% of the period (a frozen stream's write that never completes), the process exits without
+// it. Destructors are skipped either way: gRPC's library teardown can wait on idle connections.
 [[noreturn]] void ExitWithinGrace(DeformServer* server, double grace_s) {
   const auto grace = std::chrono::milliseconds(static_cast<long>(grace_s * 1000));
   std::promise<void> drained;
   std::future<void> done = drained.get_future();
   std::thread drainer([server, grace, &drained] {
-    server->Shutdown(grace * 4 / 5);
+    server->Shutdown(grace * 7 / 10);
     drained.set_value();
   });
-  if (done.wait_for(grace) == std::future_status::ready) {
+  if (done.wait_for(grace * 19 / 20) == std::future_status::ready) {
     drainer.join();
   } else {
     spdlog::warn("the drain did not finish within the {} s grace period; exiting without it",
