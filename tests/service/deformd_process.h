@@ -12,6 +12,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <optional>
 #include <regex>
@@ -24,7 +25,7 @@ namespace deform::test_support {
 
 class DeformdProcess {
  public:
-  // Starts DEFORMD_BINARY with `args`.
+  // Starts DEFORMD_BINARY (or $DEFORM_TEST_DEFORMD, to probe another build) with `args`.
   explicit DeformdProcess(const std::vector<std::string>& args) {
     char path[] = "/tmp/deformd-test-XXXXXX";
     const int fd = mkstemp(path);
@@ -35,7 +36,8 @@ class DeformdProcess {
       dup2(fd, STDOUT_FILENO);
       dup2(fd, STDERR_FILENO);
       std::vector<char*> argv;
-      std::string binary = DEFORMD_BINARY;
+      const char* other = std::getenv("DEFORM_TEST_DEFORMD");
+      std::string binary = other != nullptr ? other : DEFORMD_BINARY;
       argv.push_back(binary.data());
       std::vector<std::string> copies = args;
       for (std::string& arg : copies) argv.push_back(arg.data());
