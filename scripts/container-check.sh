@@ -1,14 +1,20 @@
 #!/usr/bin/env bash
 # Builds the deformd image for real without a Docker engine (podman + a base image made by
-# mmdebstrap), runs it, waits for its health check, load-tests it, checks that it runs as
-# non-root and exits cleanly on SIGTERM, validates the compose file, and prints the image size.
-# Exits non-zero on any failure with the reason on its last line.
+# mmdebstrap), runs it the way docker/compose.yaml does (read-only root file system, every
+# capability dropped, no-new-privileges, the port from DEFORMD_PORT, a phantom preloaded through
+# DEFORMD_PRELOAD, an extra deformd flag after the image), checks that it listens on 0.0.0.0
+# despite the extra flag, waits for its health check (which follows DEFORMD_PORT), load-tests it,
+# checks that it runs as non-root and exits cleanly on SIGTERM, validates the compose file, and
+# prints the image size. Exits non-zero on any failure with the reason on its last line.
+#
+# DEFORM_IMAGE (default localhost/deformd:check) and DEFORM_CHECK_PORT (default 50051) let two
+# checks run side by side.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 
 IMAGE="${DEFORM_IMAGE:-localhost/deformd:check}"
 CONTAINER="deformd-check-$$"
-PORT=50051  # the image's HEALTHCHECK probes this port
+PORT="${DEFORM_CHECK_PORT:-50051}"  # given to the container as DEFORMD_PORT
 BASE_IMAGE="docker.io/library/debian:bookworm-slim"
 WORK="$(mktemp -d)"
 
@@ -70,9 +76,10 @@ esac
 leftovers=$(printf '%s\n' "$inventory" | grep -v '^inventory-complete$' || true)
 [ -z "$leftovers" ] || fail "runtime image contains build tools or -dev packages: $leftovers"
 
-step "starting the container"
-"${PODMAN[@]}" run -d --name "$CONTAINER" "${RUN_FLAGS[@]}" "$IMAGE" >/dev/null ||
-  fail "container did not start"
+step "starting the container hardened (read-only, no capabilities, no-new-privileges) with --log-level debug"
+"${PODMAN[@]}" run -d --name "$CONTAINER" "${RUN_FLAGS[@]}" --read-only --cap-drop=ALL \
+  --security-opt=no-new-privileges -e DEFORMD_PORT="$PORT" -e DEFORMD_PRELOAD=phantom:500 \
+  "$IMAGE" --log-level debug >/dev/null || fail "container did not start"
 
 step "waiting for the health check to pass"
 healthy=0
@@ -84,6 +91,14 @@ done
   "${PODMAN[@]}" logs "$CONTAINER" 2>&1 | tail -20
   fail "health check did not pass within 60 s"
 }
+
+step "checking that the extra flag kept the listen address and the preload"
+logs=$("${PODMAN[@]}" logs "$CONTAINER" 2>&1)
+printf '%s\n' "$logs" | grep -q "listening on 0.0.0.0:$PORT " ||
+  fail "deformd does not listen on 0.0.0.0:$PORT: $(printf '%s\n' "$logs" | grep listening)"
+printf '%s\n' "$logs" | grep -q "\[debug\]" || fail "the extra --log-level debug was not applied"
+"${PODMAN[@]}" exec "$CONTAINER" deformd-healthcheck >/dev/null ||
+  fail "the health check script does not reach port $PORT"
 
 step "checking the server process runs as non-root"
 uid=$("${PODMAN[@]}" exec "$CONTAINER" awk '/^Uid:/ {print $2}' /proc/1/status)

@@ -2,7 +2,8 @@
 //
 //   deformd [--listen ADDR] [--workers N] [--max-vertices N] [--max-meshes N] [--max-memory-mb N]
 //           [--max-message-mb N] [--max-upload-mb N] [--log-level LEVEL]
-//           [--preload MESH:SKELETON]... [--preload-phantom N]...
+//           [--preload MESH:SKELETON]... [--preload-phantom N]... [--shutdown-grace-s S]
+//           [--keepalive-s S] [--keepalive-timeout-s S] [--idle-timeout-s S]
 //           [--tls-cert PEM --tls-key PEM [--tls-client-ca PEM]] [--plaintext]
 //           [--token-file FILE] [--tenant-max-meshes N] [--tenant-max-streams N]
 //           [--tenant-max-memory-mb N] [--preload-tenant NAME] [--store DIR]
@@ -16,14 +17,20 @@
 // DEFORMD_TLS_CLIENT_CA, DEFORMD_PLAINTEXT=1); a flag given on the command line wins.
 //
 // Preloaded meshes are built before the server listens. SIGTERM or SIGINT drains: open streams
-// end with UNAVAILABLE, calls in progress get a few seconds, then the process exits 0. SIGHUP
-// reloads the token file (service/identity.h; a bad file keeps the old tokens, logged).
+// end with UNAVAILABLE, calls in progress get most of --shutdown-grace-s, and the process exits 0
+// within the grace period whatever the clients do (ExitWithinGrace). SIGHUP reloads the token
+// file (service/identity.h; a bad file keeps the old tokens, logged).
 #include <pthread.h>
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
+#include <chrono>
 #include <csignal>
 #include <cstddef>
+#include <cstdio>
+#include <cstdlib>
+#include <future>
+#include <thread>
 #include <string>
 #include <vector>
 
@@ -50,6 +57,9 @@ struct Args {
   std::string store_dir;
   std::size_t tenant_max_memory_mb = 0;
   std::string preload_tenant = deform::service::Identity::Implicit().tenant;
+  double keepalive_s = 30;
+  double keepalive_timeout_s = 10;
+  double idle_timeout_s = 300;
 };
 
 // One mesh to load before serving: files (--preload MESH:SKELETON) or the phantom
@@ -98,6 +108,31 @@ bool PreloadAll(const Args& args, DeformServer* server) {
     }
   }
   return true;
+}
+
+// Drains `server` and ends the process with exit code 0 within `grace_s` seconds of being called,
+// whatever the clients do: calls in progress get 70% of the grace period, then gRPC cancels them
+// (an idle client connection makes gRPC wait that long too); should the drain still not be done
+// at 95% of the period (a frozen stream's write that never completes), the process exits without
+// it. Destructors are skipped either way: gRPC's library teardown can wait on idle connections.
+[[noreturn]] void ExitWithinGrace(DeformServer* server, double grace_s) {
+  const auto grace = std::chrono::milliseconds(static_cast<long>(grace_s * 1000));
+  std::promise<void> drained;
+  std::future<void> done = drained.get_future();
+  std::thread drainer([server, grace, &drained] {
+    server->Shutdown(grace * 7 / 10);
+    drained.set_value();
+  });
+  if (done.wait_for(grace * 19 / 20) == std::future_status::ready) {
+    drainer.join();
+  } else {
+    spdlog::warn("the drain did not finish within the {} s grace period; exiting without it",
+                 grace_s);
+    drainer.detach();
+  }
+  spdlog::default_logger()->flush();
+  std::fflush(nullptr);
+  std::_Exit(0);
 }
 
 }  // namespace
@@ -180,6 +215,18 @@ int main(int argc, char** argv) {
                    ? std::string()
                    : std::string("a tenant is 1 to 64 characters of A-Z a-z 0-9 . _ -");
       });
+  app.add_option("--keepalive-s", args.keepalive_s,
+                 "Ping a connection after this many seconds without activity")
+      ->capture_default_str()
+      ->check(CLI::Range(1.0, 86400.0));
+  app.add_option("--keepalive-timeout-s", args.keepalive_timeout_s,
+                 "Close a connection whose ping is unanswered for this many seconds")
+      ->capture_default_str()
+      ->check(CLI::Range(0.1, 3600.0));
+  app.add_option("--idle-timeout-s", args.idle_timeout_s,
+                 "Close a connection without any call for this many seconds")
+      ->capture_default_str()
+      ->check(CLI::Range(0.1, 86400.0));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -192,6 +239,9 @@ int main(int argc, char** argv) {
   args.server.limits.max_upload_bytes = args.max_upload_mb << 20;
   args.server.max_message_bytes = args.max_message_mb << 20;
   args.server.limits.tenant_max_memory_bytes = args.tenant_max_memory_mb << 20;
+  args.server.connections.keepalive_time_ms = static_cast<int>(args.keepalive_s * 1000);
+  args.server.connections.keepalive_timeout_ms = static_cast<int>(args.keepalive_timeout_s * 1000);
+  args.server.connections.max_connection_idle_ms = static_cast<int>(args.idle_timeout_s * 1000);
 
   DeformServer server(args.server);
   if (!args.token_file.empty()) {
@@ -227,6 +277,5 @@ int main(int argc, char** argv) {
     }
   }
   spdlog::info("received {}, shutting down", signal_number == SIGTERM ? "SIGTERM" : "SIGINT");
-  server.Shutdown(std::chrono::milliseconds(static_cast<long>(args.shutdown_grace_s * 1000)));
-  return 0;
+  ExitWithinGrace(&server, args.shutdown_grace_s);
 }

@@ -5,6 +5,7 @@
 #include <grpcpp/health_check_service_interface.h>
 #include <spdlog/spdlog.h>
 
+#include "health.pb.h"
 #include "service/annotated_mutex.h"
 #include "service/deform_service.h"
 #include "service/load_request.h"
@@ -15,6 +16,22 @@
 #include "service/transport_security.h"
 
 namespace deform::service {
+namespace {
+
+// One server per address (gRPC turns SO_REUSEPORT on by default: a second server would start and
+// take half the connections), keepalive pings and an idle limit.
+void ApplyConnectionOptions(const ConnectionOptions& options, grpc::ServerBuilder* builder) {
+  builder->AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
+  builder->AddChannelArgument(GRPC_ARG_KEEPALIVE_TIME_MS, options.keepalive_time_ms);
+  builder->AddChannelArgument(GRPC_ARG_KEEPALIVE_TIMEOUT_MS, options.keepalive_timeout_ms);
+  builder->AddChannelArgument(GRPC_ARG_KEEPALIVE_PERMIT_WITHOUT_CALLS, 1);
+  builder->AddChannelArgument(GRPC_ARG_HTTP2_MAX_PINGS_WITHOUT_DATA, 0);
+  builder->AddChannelArgument(GRPC_ARG_MAX_CONNECTION_IDLE_MS, options.max_connection_idle_ms);
+  builder->AddChannelArgument(GRPC_ARG_HTTP2_MIN_RECV_PING_INTERVAL_WITHOUT_DATA_MS,
+                              options.min_client_ping_interval_ms);
+}
+
+}  // namespace
 
 struct DeformServer::Impl {
   explicit Impl(const ServerOptions& server_options)
@@ -36,6 +53,9 @@ DeformServer::~DeformServer() { Shutdown(); }
 Status DeformServer::Start() {
   if (impl_->server != nullptr) return Status::FailedPrecondition("the server is already started");
   grpc::EnableDefaultHealthCheckService(true);
+  // Reflection describes only services whose descriptors are linked in (grpc/grpc#36665): touching
+  // the health proto's descriptor keeps it, so reflection lists grpc.health.v1.Health.
+  (void)grpc::health::v1::HealthCheckRequest::descriptor();
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
   std::string transport;
   DEFORM_ASSIGN_OR_RETURN(
@@ -46,6 +66,7 @@ Status DeformServer::Start() {
   builder.RegisterService(&impl_->service);
   builder.SetMaxReceiveMessageSize(impl_->options.max_message_bytes);
   builder.SetMaxSendMessageSize(impl_->options.max_message_bytes);
+  ApplyConnectionOptions(impl_->options.connections, &builder);
   impl_->server = builder.BuildAndStart();
   if (impl_->server == nullptr || impl_->port == 0) {
     impl_->server.reset();

@@ -8,6 +8,7 @@
 #include "service/load_mesh_reactor.h"
 #include "service/proto_conversion.h"
 #include "service/rejected_call.h"
+#include "service/request_limits.h"
 #include "service/status_mapping.h"
 
 namespace deform::service {
@@ -47,6 +48,11 @@ grpc::ServerUnaryReactor* DeformServiceImpl::GetMeshInfo(grpc::CallbackServerCon
                                                          const v1::GetMeshInfoRequest* request,
                                                          v1::GetMeshInfoResponse* response) {
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  const Status id_length = CheckLength(request->mesh_id(), kMaxMeshIdBytes, "mesh_id");
+  if (!id_length.ok()) {
+    reactor->Finish(ToGrpcStatus(id_length));
+    return reactor;
+  }
   const char* action = request->include_geometry() ? "download" : "get_mesh_info";
   StatusOr<Identity> caller = Caller(*core_, context, action, request->mesh_id());
   if (!caller.ok()) {
@@ -88,6 +94,11 @@ grpc::ServerUnaryReactor* DeformServiceImpl::UnloadMesh(grpc::CallbackServerCont
                                                         const v1::UnloadMeshRequest* request,
                                                         v1::UnloadMeshResponse* /*response*/) {
   grpc::ServerUnaryReactor* reactor = context->DefaultReactor();
+  const Status id_length = CheckLength(request->mesh_id(), kMaxMeshIdBytes, "mesh_id");
+  if (!id_length.ok()) {
+    reactor->Finish(ToGrpcStatus(id_length));
+    return reactor;
+  }
   StatusOr<Identity> caller = Caller(*core_, context, "unload", request->mesh_id());
   if (!caller.ok()) {
     reactor->Finish(ToGrpcStatus(caller.status()));

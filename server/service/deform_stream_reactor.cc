@@ -20,6 +20,7 @@
 #include "service/pending_pose_slot.h"
 #include "service/pose_input.h"
 #include "service/proto_conversion.h"
+#include "service/request_limits.h"
 #include "service/shared_reactor.h"
 #include "service/status_mapping.h"
 #include "service/stiffness_switch.h"
@@ -47,6 +48,7 @@ class DeformStreamReactor final
   DeformStreamReactor(ServiceCore* core, Identity caller)
       : core_(core), caller_(std::move(caller)), stream_id_(core->next_stream_id.fetch_add(1)) {
     log_context_ = "stream=" + std::to_string(stream_id_) + " tenant=" + EscapeForLog(caller_.tenant);
+    outbox_.set_backlog_gauge(&core->notice_backlog_bytes);
     StartRead(&request_);
   }
 
@@ -62,6 +64,9 @@ class DeformStreamReactor final
   void HandleStiffness() DEFORM_EXCLUDES(mutex_);
   void Fail(grpc::StatusCode code, const std::string& message) DEFORM_EXCLUDES(mutex_);
   void FailLocked(grpc::StatusCode code, const std::string& message) DEFORM_REQUIRES(mutex_);
+  // Reads the next request, or stops reading while the notice backlog is full (a client that
+  // sends without reading); WriteCompleted resumes once it has drained.
+  void ReadNextLocked() DEFORM_REQUIRES(mutex_);
 
   // UrgentTask: one solve on a worker.
   void RunUrgent() DEFORM_EXCLUDES(mutex_) override;
@@ -111,6 +116,7 @@ class DeformStreamReactor final
       this, &sink_, FinishRule::kErrorOverridesGraceful};
   std::uint64_t frames_written_ DEFORM_GUARDED_BY(mutex_) = 0;
   std::uint64_t poses_rejected_ DEFORM_GUARDED_BY(mutex_) = 0;
+  bool reading_paused_ DEFORM_GUARDED_BY(mutex_) = false;
 };
 
 void DeformStreamReactor::OnReadDone(bool ok) {
@@ -144,7 +150,7 @@ void DeformStreamReactor::Fail(grpc::StatusCode code, const std::string& message
 
 void DeformStreamReactor::FailLocked(grpc::StatusCode code, const std::string& message) {
   spdlog::warn("{} ending: {}", log_context_, message);
-  pump_.RequestFinish(grpc::Status(code, message));
+  pump_.RequestFinish(grpc::Status(code, BoundStatusMessage(message)));
   pump_.Pump();
 }
 
@@ -153,7 +159,12 @@ void DeformStreamReactor::HandleStart() {
     Fail(grpc::StatusCode::INVALID_ARGUMENT, "`start` sent twice on one stream");
     return;
   }
-  const std::string mesh_id = request_.start().mesh_id();
+  const std::string& mesh_id = request_.start().mesh_id();
+  const Status id_length = CheckLength(mesh_id, kMaxMeshIdBytes, "start.mesh_id");
+  if (!id_length.ok()) {
+    Fail(grpc::StatusCode::INVALID_ARGUMENT, id_length.message());
+    return;
+  }
   auto entry = core_->registry.Find(mesh_id, caller_);
   if (!entry.ok()) {
     Audit(caller_.tenant, "deform", mesh_id, entry.status().ToString());
@@ -215,7 +226,7 @@ void DeformStreamReactor::HandlePose() {
     } else {
       post = poses_.Offer(&staging_);
     }
-    StartRead(&request_);
+    ReadNextLocked();
   }
   if (post) core_->pool.PostUrgent(SharedFromThis());
 }
@@ -247,6 +258,14 @@ void DeformStreamReactor::HandleStiffness() {
     StartRefactorLocked({std::move(*stiffness), version});
   }
   pump_.Pump();
+  ReadNextLocked();
+}
+
+void DeformStreamReactor::ReadNextLocked() {
+  if (outbox_.notice_backlog_full()) {
+    reading_paused_ = true;
+    return;
+  }
   StartRead(&request_);
 }
 
@@ -340,6 +359,10 @@ const v1::DeformResponse* DeformStreamReactor::TakeNextWrite() {
 void DeformStreamReactor::WriteCompleted(bool ok) {
   mutex_.AssertHeld();
   if (ok && outbox_.frame_in_flight()) ++frames_written_;
+  if (ok && reading_paused_ && outbox_.notice_backlog_drained() && !pump_.finish_requested()) {
+    reading_paused_ = false;
+    StartRead(&request_);
+  }
 }
 
 bool DeformStreamReactor::ReadyToFinish() {
@@ -371,9 +394,9 @@ void DeformStreamReactor::OnDone() {
   {
     MutexLock lock(&mutex_);
     const grpc::Status& status = pump_.finish_status();
-    spdlog::info("{} closed ({}): {} frames written, {} poses rejected", log_context_,
-                 status.ok() ? std::string("OK") : status.error_message(), frames_written_,
-                 poses_rejected_);
+    spdlog::info("{} closed ({}): {} frames written, {} poses rejected, {} notices dropped",
+                 log_context_, status.ok() ? std::string("OK") : status.error_message(),
+                 frames_written_, poses_rejected_, outbox_.notices_dropped());
   }
   ReleaseTransportReference();  // last: may free the reactor
 }

@@ -13,6 +13,7 @@
 #include "service/annotated_mutex.h"
 #include "service/audit_log.h"
 #include "service/grpc_stream_sink.h"
+#include "service/load_header.h"
 #include "service/load_request.h"
 #include "service/log_text.h"
 #include "service/mesh_id.h"
@@ -31,29 +32,6 @@ using Clock = std::chrono::steady_clock;
 
 // Bytes reserved up front for an upload; larger uploads grow as their chunks arrive.
 constexpr std::size_t kMaxInitialReserve = std::size_t{64} << 20;
-
-// The header checks of an upload's skeleton and weights: a glTF rig carries both, so neither may
-// be given beside it; other formats need a skeleton, and weights only with their format.
-Status CheckUploadParts(const v1::UploadSource& upload) {
-  if (upload.format() == v1::MESH_FORMAT_GLTF) {
-    if (!upload.skeleton().empty() || !upload.weights().empty()) {
-      return Status::InvalidArgument(
-          "a glTF upload carries its own skeleton and weights: upload.skeleton and "
-          "upload.weights must be empty");
-    }
-    return Status::Ok();
-  }
-  DEFORM_RETURN_IF_ERROR(CoreMeshFormat(upload.format()).status());
-  if (upload.skeleton().empty()) return Status::InvalidArgument("upload.skeleton is empty");
-  if (upload.skeleton_format() != v1::SKELETON_FORMAT_TGF &&
-      upload.skeleton_format() != v1::SKELETON_FORMAT_JSON) {
-    return Status::InvalidArgument("upload.skeleton_format is unspecified or unknown");
-  }
-  if (!upload.weights().empty()) {
-    DEFORM_RETURN_IF_ERROR(CoreWeightsFormat(upload.weights_format()).status());
-  }
-  return Status::Ok();
-}
 
 double MillisecondsSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
@@ -142,49 +120,16 @@ Status LoadMeshReactor::HandleHeader() {
   start_ = Clock::now();
   header_.Swap(request_.mutable_header());
   has_header_ = true;
-  const ServiceLimits& limits = core_->limits;
-  switch (header_.source_case()) {
-    case v1::LoadMeshHeader::kPhantom: {
-      const int vertices = header_.phantom().vertices();
-      if (vertices < 0) {
-        return Status::InvalidArgument("phantom.vertices must not be negative, got " +
-                                       std::to_string(vertices));
-      }
-      const int effective = vertices == 0 ? kDefaultPhantomVertices : vertices;
-      if (static_cast<std::size_t>(effective) > limits.max_vertices) {
-        return Status::ResourceExhausted(
-            "a phantom of " + std::to_string(effective) + " vertices exceeds the limit of " +
-            std::to_string(limits.max_vertices) + " vertices per mesh");
-      }
-      spdlog::info("{} phantom of {} vertices requested, name='{}'", log_context_, effective,
-                   EscapeForLog(header_.name()));
-      break;
-    }
-    case v1::LoadMeshHeader::kUpload: {
-      const v1::UploadSource& upload = header_.upload();
-      DEFORM_RETURN_IF_ERROR(CheckUploadParts(upload));
-      if (upload.mesh_size_bytes() == 0) {
-        return Status::InvalidArgument(
-            "upload.mesh_size_bytes is 0: the mesh file size is required");
-      }
-      // Compared part by part first, so that the sum cannot overflow.
-      const std::uint64_t total =
-          upload.mesh_size_bytes() + upload.skeleton().size() + upload.weights().size();
-      if (upload.mesh_size_bytes() > limits.max_upload_bytes ||
-          upload.skeleton().size() + upload.weights().size() > limits.max_upload_bytes ||
-          total > limits.max_upload_bytes) {
-        return Status::ResourceExhausted("upload of " + std::to_string(total) +
-                                         " bytes exceeds the limit of " +
-                                         std::to_string(limits.max_upload_bytes) + " bytes");
-      }
-      expected_bytes_ = upload.mesh_size_bytes();
-      mesh_bytes_.reserve(std::min<std::size_t>(expected_bytes_, kMaxInitialReserve));
-      spdlog::info("{} upload of {} mesh bytes announced, name='{}'", log_context_, expected_bytes_,
-                   EscapeForLog(header_.name()));
-      break;
-    }
-    case v1::LoadMeshHeader::SOURCE_NOT_SET:
-      return Status::InvalidArgument("the header names no source (phantom or upload)");
+  DEFORM_RETURN_IF_ERROR(CheckLoadHeader(header_, core_->limits));
+  if (header_.has_phantom()) {
+    const int vertices = header_.phantom().vertices();
+    spdlog::info("{} phantom of {} vertices requested, name='{}'", log_context_,
+                 vertices == 0 ? kDefaultPhantomVertices : vertices, EscapeForLog(header_.name()));
+  } else {
+    expected_bytes_ = header_.upload().mesh_size_bytes();
+    mesh_bytes_.reserve(std::min<std::size_t>(expected_bytes_, kMaxInitialReserve));
+    spdlog::info("{} upload of {} mesh bytes announced, name='{}'", log_context_, expected_bytes_,
+                 EscapeForLog(header_.name()));
   }
   DEFORM_ASSIGN_OR_RETURN(reservation_, core_->registry.Reserve(caller_.tenant));
   return Status::Ok();

@@ -6,6 +6,7 @@
 #include "core/io/phantom.h"
 #include "core/io/rig_import.h"
 #include "core/io/skeleton_io.h"
+#include "service/load_header.h"
 #include "service/proto_conversion.h"
 
 namespace deform::service {
@@ -59,34 +60,6 @@ Status ParseUpload(const v1::UploadSource& upload, std::string* mesh_bytes,
 }
 
 }  // namespace
-
-StatusOr<MeshFormat> CoreMeshFormat(v1::MeshFormat format) {
-  switch (format) {
-    case v1::MESH_FORMAT_OBJ:
-      return MeshFormat::kObj;
-    case v1::MESH_FORMAT_PLY:
-      return MeshFormat::kPly;
-    case v1::MESH_FORMAT_STL:
-      return MeshFormat::kStl;
-    case v1::MESH_FORMAT_OFF:
-      return MeshFormat::kOff;
-    default:
-      return Status::InvalidArgument("upload.format is unspecified or unknown (" +
-                                     std::to_string(static_cast<int>(format)) + ")");
-  }
-}
-
-StatusOr<SkinWeightsFormat> CoreWeightsFormat(v1::SkinWeightsFormat format) {
-  switch (format) {
-    case v1::SKIN_WEIGHTS_FORMAT_DMAT:
-      return SkinWeightsFormat::kDmat;
-    case v1::SKIN_WEIGHTS_FORMAT_CSV:
-      return SkinWeightsFormat::kCsv;
-    default:
-      return Status::InvalidArgument("upload.weights_format is unspecified or unknown (" +
-                                     std::to_string(static_cast<int>(format)) + ")");
-  }
-}
 
 StatusOr<LoadJob> LoadJobFromRequest(const v1::LoadMeshHeader& header, std::string* mesh_bytes,
                                      const ServiceLimits& limits) {

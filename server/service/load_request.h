@@ -21,8 +21,4 @@ namespace deform::service {
 StatusOr<LoadJob> LoadJobFromRequest(const v1::LoadMeshHeader& header, std::string* mesh_bytes,
                                      const ServiceLimits& limits);
 
-// The core's format of an upload's mesh (not glTF) and weights; INVALID_ARGUMENT when unknown.
-StatusOr<MeshFormat> CoreMeshFormat(v1::MeshFormat format);
-StatusOr<SkinWeightsFormat> CoreWeightsFormat(v1::SkinWeightsFormat format);
-
 }  // namespace deform::service

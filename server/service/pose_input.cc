@@ -1,7 +1,10 @@
 #include "service/pose_input.h"
 
 #include <cmath>
+#include <cstdio>
 #include <string>
+
+#include "service/request_limits.h"
 
 namespace deform::service {
 namespace {
@@ -10,8 +13,10 @@ namespace {
 // every digit of a limb's shape).
 constexpr double kMaxRootTranslation = 1e9;
 
-// The unit quaternion of (w, x, y, z), scaled before normalising so that huge finite components
-// (1e155) are not squared into infinity. INVALID_ARGUMENT for NaN, infinite or all-zero input.
+// The unit quaternion of (w, x, y, z): normalised when its norm is within
+// kQuaternionNormTolerance of 1. INVALID_ARGUMENT for NaN, infinite or all-zero input and for
+// norms further from 1 (1e155 components are a client's bug, not a rotation). The norm is computed
+// on the scaled vector, so huge finite components are not squared into infinity.
 StatusOr<Eigen::Quaterniond> UnitQuaternion(double w, double x, double y, double z,
                                             const std::string& what) {
   const Eigen::Vector4d q(w, x, y, z);
@@ -20,7 +25,16 @@ StatusOr<Eigen::Quaterniond> UnitQuaternion(double w, double x, double y, double
   }
   const double largest = q.cwiseAbs().maxCoeff();
   if (!(largest > 0)) return Status::InvalidArgument(what + " is the zero quaternion");
-  const Eigen::Vector4d unit = (q / largest).normalized();
+  const Eigen::Vector4d scaled = q / largest;
+  const double norm = scaled.norm() * largest;
+  if (!(std::abs(norm - 1) <= kQuaternionNormTolerance)) {
+    char text[64];
+    std::snprintf(text, sizeof text, "%.6g", norm);
+    return Status::InvalidArgument(what + " has norm " + text + ", not within " +
+                                   std::to_string(kQuaternionNormTolerance).substr(0, 3) +
+                                   " of 1 (a unit quaternion is expected)");
+  }
+  const Eigen::Vector4d unit = scaled.normalized();
   return Eigen::Quaterniond(unit[0], unit[1], unit[2], unit[3]);
 }
 
@@ -50,21 +64,29 @@ Status PoseInputFromProto(const v1::PoseUpdate& update, const Skeleton& skeleton
   input->client_timestamp_ns = update.client_timestamp_ns();
   input->angles.clear();
   input->rotations.clear();
+  DEFORM_RETURN_IF_ERROR(CheckPoseStrings(update));
   for (const v1::JointRotation& rotation : update.rotations()) {
     auto joint = skeleton.FindJoint(rotation.joint());
     if (!joint.ok()) return Status::InvalidArgument("rotation: " + joint.status().message());
     DEFORM_ASSIGN_OR_RETURN(const Eigen::Quaterniond q,
                             UnitQuaternion(rotation.w(), rotation.x(), rotation.y(), rotation.z(),
-                                           "rotation of joint '" + rotation.joint() + "'"));
+                                           "rotation of joint '" + EchoForClient(rotation.joint()) + "'"));
     input->rotations.emplace_back(*joint, q);
   }
   for (const v1::JointAngle& angle : update.angles()) {
     auto joint = skeleton.FindJoint(angle.joint());
     if (!joint.ok()) return Status::InvalidArgument("angle: " + joint.status().message());
     if (!std::isfinite(angle.degrees())) {
-      return Status::InvalidArgument("angle of joint '" + angle.joint() + "' axis '" +
-                                     angle.axis() + "' is " + std::to_string(angle.degrees()) +
-                                     ", not a finite number");
+      return Status::InvalidArgument("angle of joint '" + EchoForClient(angle.joint()) +
+                                     "' axis '" + EchoForClient(angle.axis()) + "' is " +
+                                     std::to_string(angle.degrees()) + ", not a finite number");
+    }
+    if (std::abs(angle.degrees()) > kMaxAngleDegrees) {
+      char text[64];
+      std::snprintf(text, sizeof text, "%.6g", angle.degrees());
+      return Status::InvalidArgument("angle of joint '" + EchoForClient(angle.joint()) +
+                                     "' axis '" + EchoForClient(angle.axis()) + "' is " + text +
+                                     " degrees, beyond the limit of +-36000 degrees");
     }
     PoseTerm term;
     term.joint = *joint;

@@ -28,10 +28,11 @@ struct PoseInput {
 };
 
 // Fills `input` from `update` (sequence, timestamp, resolved angles and rotations; `arrival` is
-// left to the caller). INVALID_ARGUMENT naming the problem for an unknown joint or axis, an angle
-// or quaternion component that is NaN or infinite, a zero quaternion (huge finite components are
-// scaled, never squared into infinity), or a root translation that is not finite or beyond 1e9
-// model units.
+// left to the caller). INVALID_ARGUMENT naming the problem for a joint or axis string over its
+// length limit (request_limits.h), an unknown joint or axis, an angle or quaternion component that
+// is NaN or infinite, an angle beyond kMaxAngleDegrees, a quaternion whose norm is not within
+// kQuaternionNormTolerance of 1 (within it, it is normalised; huge components are scaled, never
+// squared into infinity), or a root translation that is not finite or beyond 1e9 model units.
 Status PoseInputFromProto(const v1::PoseUpdate& update, const Skeleton& skeleton, PoseInput* input);
 
 // The core pose of `input`: per joint, its rotations (composed in order), then its angles

@@ -7,6 +7,8 @@
 #include <limits>
 #include <string>
 
+#include "service/request_limits.h"
+
 namespace deform::service {
 namespace {
 
@@ -50,6 +52,7 @@ StatusOr<int> RegionJointOf(const DeformationModel& model, const std::string& na
 
 StatusOr<ModelOptions> ModelOptionsFromProto(const v1::MethodOptions& proto,
                                              const Skeleton& skeleton) {
+  DEFORM_RETURN_IF_ERROR(CheckMethodOptionStrings(proto));
   ModelOptions options = ModelOptions::Paper();
   if (proto.region_radius_factor() != 0) {
     if (!std::isfinite(proto.region_radius_factor()) || proto.region_radius_factor() < 0) {
@@ -95,6 +98,7 @@ StatusOr<ModelOptions> ModelOptionsFromProto(const v1::MethodOptions& proto,
 StatusOr<Stiffness> StiffnessFromProto(const v1::StiffnessUpdate& proto,
                                        const DeformationModel& model,
                                        const std::vector<int>& client_order) {
+  DEFORM_RETURN_IF_ERROR(CheckStiffnessStrings(proto));
   Stiffness stiffness;
   for (const v1::JointMaterialUpdate& update : proto.joint_materials()) {
     DEFORM_ASSIGN_OR_RETURN(const int joint,

@@ -85,6 +85,8 @@ struct ServiceCore {
   std::unique_ptr<MeshStore> store;
   std::atomic<std::uint64_t> next_stream_id{1};
   std::atomic<std::uint64_t> next_load_id{1};
+  // Serialised bytes of the notices waiting unwritten in every Deform stream (DeformOutbox).
+  std::atomic<std::int64_t> notice_backlog_bytes{0};
 };
 
 }  // namespace deform::service

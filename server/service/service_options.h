@@ -37,6 +37,22 @@ struct TransportSecurity {
   bool allow_plaintext = false;
 };
 
+// How the server treats connections (gRPC channel arguments; deformd's flags set them).
+struct ConnectionOptions {
+  // The server pings a connection after this long without activity, so a vanished or frozen peer
+  // is found. Default: 30 s (GRPC_ARG_KEEPALIVE_TIME_MS).
+  int keepalive_time_ms = 30'000;
+  // A ping unanswered this long closes the connection and cancels its calls. Default: 10 s
+  // (GRPC_ARG_KEEPALIVE_TIMEOUT_MS).
+  int keepalive_timeout_ms = 10'000;
+  // A connection without any call for this long is closed (the client reconnects on its next
+  // call). Default: 5 min (GRPC_ARG_MAX_CONNECTION_IDLE_MS).
+  int max_connection_idle_ms = 300'000;
+  // Clients may ping at most this often (their keepalives); more often is answered with GOAWAY.
+  // Default: 10 s (GRPC_ARG_HTTP2_MIN_RECV_PING_INTERVAL_WITHOUT_DATA_MS).
+  int min_client_ping_interval_ms = 10'000;
+};
+
 struct ServerOptions {
   // "host:port"; port 0 picks a free port (DeformServer::port() tells which). Default: loopback.
   std::string listen_address = "127.0.0.1:50051";
@@ -44,6 +60,7 @@ struct ServerOptions {
   int workers = 0;
   // Largest gRPC message received or sent. Default: 64 MiB.
   int max_message_bytes = 64 << 20;
+  ConnectionOptions connections;
   ServiceLimits limits;
   TransportSecurity security;
 };

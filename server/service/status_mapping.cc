@@ -1,5 +1,7 @@
 #include "service/status_mapping.h"
 
+#include "service/request_limits.h"
+
 namespace deform::service {
 
 grpc::StatusCode ToGrpcCode(StatusCode code) {
@@ -26,7 +28,8 @@ grpc::StatusCode ToGrpcCode(StatusCode code) {
 
 grpc::Status ToGrpcStatus(const Status& status) {
   if (status.ok()) return grpc::Status::OK;
-  return grpc::Status(ToGrpcCode(status.code()), status.message());
+  // Cut: a message repeating client strings must never overflow gRPC's metadata limit.
+  return grpc::Status(ToGrpcCode(status.code()), BoundStatusMessage(status.message()));
 }
 
 }  // namespace deform::service

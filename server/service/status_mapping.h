@@ -1,7 +1,7 @@
 // The one place where the core's error values become gRPC statuses.
 //
 // deform::StatusCode mirrors the canonical gRPC codes one to one, so the mapping keeps the code
-// and the message unchanged. Thread-safe (pure functions).
+// and the message (cut to kMaxStatusMessageBytes, request_limits.h). Thread-safe (pure functions).
 #pragma once
 
 #include <grpcpp/support/status.h>

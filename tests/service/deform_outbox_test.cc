@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -80,6 +81,35 @@ TEST(DeformOutboxTest, TheBacklogIsFullAtItsLimit) {
   EXPECT_TRUE(outbox.notice_backlog_full());
   outbox.TakeNextWrite();
   EXPECT_FALSE(outbox.notice_backlog_full());
+}
+
+TEST(DeformOutboxTest, TheBacklogIsBoundedInBytesForEveryKind) {
+  DeformOutbox outbox;
+  std::atomic<std::int64_t> gauge{0};
+  outbox.set_backlog_gauge(&gauge);
+  const std::string long_message(100'000, 'm');  // cut to kMaxNoticeMessageBytes
+  int added = 0;
+  for (int k = 0; k < 10'000; ++k) {
+    const auto kind = k % 2 == 0 ? v1::Notice::KIND_POSE_REJECTED
+                                 : v1::Notice::KIND_STIFFNESS_REJECTED;
+    if (outbox.AddNotice(kind, 0, 1, long_message)) ++added;
+  }
+  EXPECT_TRUE(outbox.notice_backlog_full());
+  EXPECT_LT(added, 300);
+  EXPECT_EQ(outbox.notices_dropped(), static_cast<std::uint64_t>(10'000 - added));
+  EXPECT_LE(outbox.notice_backlog_bytes(),
+            DeformOutbox::kMaxNoticeBacklogBytes + 2 * DeformOutbox::kMaxNoticeMessageBytes);
+  EXPECT_EQ(static_cast<std::size_t>(gauge.load()), outbox.notice_backlog_bytes());
+  // An applied-stiffness notice is never dropped (it separates two versions' frames).
+  EXPECT_TRUE(outbox.AddNotice(v1::Notice::KIND_STIFFNESS_APPLIED, 0, 2, "applied"));
+  const v1::DeformResponse* first = outbox.TakeNextWrite();
+  ASSERT_NE(first, nullptr);
+  EXPECT_EQ(first->notice().message().size(), DeformOutbox::kMaxNoticeMessageBytes);
+  while (!outbox.notice_backlog_drained()) outbox.TakeNextWrite();
+  EXPECT_FALSE(outbox.notice_backlog_full());
+  while (outbox.TakeNextWrite() != nullptr) {
+  }
+  EXPECT_EQ(gauge.load(), 0);
 }
 
 TEST(DeformOutboxTest, NoticesCarryTheirFields) {
