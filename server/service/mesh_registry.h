@@ -4,10 +4,13 @@
 // Streams hold a shared_ptr to their entry, which keeps the model alive after UnloadMesh.
 //
 // Limits: the number of meshes loaded or being loaded (a Reservation is taken before the
-// expensive work, so a client learns early that no slot is free) and a memory budget checked
-// against DeformationModel::EstimatedBytes() when the mesh is registered; both server-wide and
-// per tenant (ServiceLimits::tenant_*). Memory is released from the budget at unload, even while
-// open streams still use the model until they end.
+// expensive work, so a client learns early that no slot is free) and a memory budget; both
+// server-wide and per tenant (ServiceLimits::tenant_*). A load in progress holds memory in its
+// reservation (ReserveMemory: an upload's declared bytes while they arrive, then the model's
+// estimate before anything is built, DeformationModel::EstimateBytesBeforeBuild), so what does not
+// fit is refused before it is allocated and two loads cannot both take the last of the budget; a
+// registered mesh counts DeformationModel::EstimatedBytes() instead. Memory is released from the
+// budget at unload, even while open streams still use the model until they end.
 //
 // Tenancy: every mesh belongs to the tenant that loaded it. The lookups that take a caller
 // (Identity) answer another tenant's id exactly as an unknown id (NOT_FOUND, same message), so a
@@ -77,6 +80,8 @@ class MeshRegistry {
     ~Reservation();
     bool valid() const { return registry_ != nullptr; }
     const std::string& tenant() const { return tenant_; }
+    // The memory it holds against the budgets (MeshRegistry::ReserveMemory).
+    std::size_t memory_bytes() const { return memory_bytes_; }
     void Release();
 
    private:
@@ -85,6 +90,7 @@ class MeshRegistry {
         : registry_(registry), tenant_(std::move(tenant)) {}
     MeshRegistry* registry_ = nullptr;
     std::string tenant_;
+    std::size_t memory_bytes_ = 0;
   };
 
   explicit MeshRegistry(const ServiceLimits& limits);
@@ -96,10 +102,12 @@ class MeshRegistry {
   // A slot for a mesh `tenant` loads. RESOURCE_EXHAUSTED (naming the limit) when max_meshes are
   // loaded or being loaded, or tenant_max_meshes of `tenant`'s. The registry must outlive it.
   StatusOr<Reservation> Reserve(const std::string& tenant = Identity::Implicit().tenant);
-  // RESOURCE_EXHAUSTED when `bytes` more would not fit in the memory budget now, the server's or
-  // `tenant`'s (an early check before the expensive precomputation; Register checks again).
-  Status CheckMemoryAvailable(std::size_t bytes,
-                              const std::string& tenant = Identity::Implicit().tenant) const;
+  // Makes `reservation` (valid) hold `bytes` of the memory budgets, the server's and its tenant's,
+  // in place of what it held: what the load will need next, known before it is allocated.
+  // RESOURCE_EXHAUSTED naming `what`, the estimate, the budget and what is in use (by loaded
+  // meshes and by other loads in progress) when it does not fit; the reservation then keeps what
+  // it held.
+  Status ReserveMemory(Reservation* reservation, std::size_t bytes, const std::string& what);
 
   // Registers a built model using `reservation`'s slot, owned by the reservation's tenant, under `id` if given (a mesh restored from
   // a store keeps its id; an id already loaded is INVALID_ARGUMENT), else under a new NewMeshId().
@@ -122,19 +130,27 @@ class MeshRegistry {
   std::vector<std::shared_ptr<const MeshEntry>> List() const;
   Status Unload(const std::string& mesh_id);
 
+  // Of the budget: loaded meshes' memory, and memory held by loads in progress.
   std::size_t memory_bytes_used() const;
+  std::size_t memory_bytes_reserved() const;
   int mesh_count() const;
+  int loads_in_progress() const;
+  // Meshes registered since the registry was made (unloaded ones included).
+  int registrations() const;
 
  private:
   // Per-tenant counts: slots held by loads in progress, loaded meshes, their memory.
   struct TenantUsage {
     int reserved = 0;
     int loaded = 0;
-    std::size_t memory_bytes = 0;
+    std::size_t memory_bytes = 0;           // of loaded meshes
+    std::size_t reserved_memory_bytes = 0;  // held by loads in progress
   };
-  void ReleaseSlot(const std::string& tenant);
-  Status CheckMemoryLocked(std::size_t bytes, const std::string& tenant) const
-      DEFORM_REQUIRES(mutex_);
+  void ReleaseSlot(const std::string& tenant, std::size_t memory_bytes);
+  // OK when `bytes` fit in the budgets besides what is in use, not counting `held` (what the
+  // caller's own reservation holds already).
+  Status CheckMemoryLocked(std::size_t bytes, std::size_t held, const std::string& tenant,
+                           const std::string& what) const DEFORM_REQUIRES(mutex_);
 
   const ServiceLimits limits_;
   mutable Mutex mutex_;
@@ -143,7 +159,8 @@ class MeshRegistry {
   std::unordered_map<std::string, std::uint64_t> order_of_id_ DEFORM_GUARDED_BY(mutex_);
   int reserved_ DEFORM_GUARDED_BY(mutex_) = 0;             // slots held by loads in progress
   std::size_t memory_used_ DEFORM_GUARDED_BY(mutex_) = 0;  // sum of memory_bytes of loaded meshes
-  std::uint64_t next_order_ DEFORM_GUARDED_BY(mutex_) = 1;
+  std::size_t memory_reserved_ DEFORM_GUARDED_BY(mutex_) = 0;  // held by reservations
+  std::uint64_t next_order_ DEFORM_GUARDED_BY(mutex_) = 1;  // also counts registrations
   std::map<std::string, TenantUsage> tenants_ DEFORM_GUARDED_BY(mutex_);
 };
 

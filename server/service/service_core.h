@@ -7,18 +7,21 @@
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <map>
 #include <memory>
 #include <string>
 #include <unordered_set>
 
+#include "core/base/cancel_token.h"
 #include "service/annotated_mutex.h"
 #include "service/identity.h"
 #include "service/mesh_registry.h"
 #include "service/mesh_store.h"
 #include "service/service_options.h"
 #include "service/thread_annotations.h"
+#include "service/upload_watchdog.h"
 #include "service/worker_pool.h"
 
 namespace deform::service {
@@ -72,6 +75,8 @@ struct ServiceCore {
       : limits(options.limits),
         registry(options.limits),
         pool(options.workers),
+        uploads(std::chrono::milliseconds(options.limits.upload_idle_timeout_ms),
+                std::chrono::milliseconds(options.limits.upload_time_limit_ms)),
         tenant_streams(options.limits.tenant_max_streams) {}
 
   const ServiceLimits limits;
@@ -79,10 +84,13 @@ struct ServiceCore {
   Authenticator auth;
   MeshRegistry registry;
   WorkerPool pool;
+  UploadWatchdog uploads;
   ActiveStreams streams;
   TenantStreamQuota tenant_streams;
   // Where loaded meshes are kept across restarts (--store); null: nowhere. Set before serving.
   std::unique_ptr<MeshStore> store;
+  // Cancelled when the server shuts down: the parent of every build's token (cancel_token.h).
+  CancelToken shutting_down;
   std::atomic<std::uint64_t> next_stream_id{1};
   std::atomic<std::uint64_t> next_load_id{1};
 };
