@@ -134,11 +134,17 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 2047));
   app.add_option("--max-upload-mb", args.max_upload_mb, "Largest LoadMesh upload, MiB")
       ->capture_default_str();
+  app.add_option("--max-streams", args.server.limits.max_streams,
+                 "Open Deform streams on the server, all tenants; 0 = no limit")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1 << 20));
   app.add_option("--upload-idle-timeout-s", args.upload_idle_timeout_s,
                  "End an upload that sends no data for this long (DEADLINE_EXCEEDED); 0 = never")
+      ->capture_default_str()
       ->check(CLI::Range(0.0, 86400.0));
   app.add_option("--upload-time-limit-s", args.upload_time_limit_s,
                  "End an upload not complete after this long (DEADLINE_EXCEEDED); 0 = never")
+      ->capture_default_str()
       ->check(CLI::Range(0.0, 86400.0));
   app.add_option("--log-level", args.log_level, "trace, debug, info, warn, error or off")
       ->capture_default_str()

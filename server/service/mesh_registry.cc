@@ -84,7 +84,9 @@ Status MeshRegistry::CheckMemoryLocked(std::size_t bytes, std::size_t held,
     return Status::ResourceExhausted(
         "memory budget exceeded (--max-memory-mb): " + what + " needs about " + MebiBytes(bytes) +
         ", " + MebiBytes(in_use) + " of the " + MebiBytes(limits_.max_memory_bytes) +
-        " budget are in use (" + MebiBytes(memory_used_) + " by loaded meshes)");
+        " budget are in use (" + MebiBytes(memory_used_ - memory_retained_) +
+        " by loaded meshes, " + MebiBytes(memory_retained_) +
+        " by unloaded meshes that streams still use)");
   }
   if (limits_.tenant_max_memory_bytes > 0) {
     const auto it = tenants_.find(tenant);
@@ -182,13 +184,35 @@ Status MeshRegistry::Unload(const std::string& mesh_id, const Identity& caller) 
   MeshEntry& entry = *it->second;
   if (!caller.CanAccess(entry.tenant)) return NotLoaded(mesh_id);
   entry.unloaded.store(true);
-  memory_used_ -= entry.memory_bytes;
-  TenantUsage& usage = tenants_[entry.tenant];
-  --usage.loaded;
-  usage.memory_bytes -= entry.memory_bytes;
+  --tenants_[entry.tenant].loaded;
+  if (entry.open_streams.load() == 0) {
+    ReleaseMemoryLocked(entry);
+  } else {
+    memory_retained_ += entry.memory_bytes;  // until its last stream detaches
+  }
   order_of_id_.erase(order);
   meshes_.erase(it);
   return Status::Ok();
+}
+
+void MeshRegistry::ReleaseMemoryLocked(const MeshEntry& entry) {
+  memory_used_ -= entry.memory_bytes;
+  tenants_[entry.tenant].memory_bytes -= entry.memory_bytes;
+}
+
+Status MeshRegistry::AttachStream(const MeshEntry& entry) {
+  MutexLock lock(&mutex_);
+  if (entry.unloaded.load()) return NotLoaded(entry.id);
+  entry.open_streams.fetch_add(1);
+  return Status::Ok();
+}
+
+void MeshRegistry::DetachStream(const MeshEntry& entry) {
+  MutexLock lock(&mutex_);
+  if (entry.open_streams.fetch_sub(1) == 1 && entry.unloaded.load()) {
+    memory_retained_ -= entry.memory_bytes;
+    ReleaseMemoryLocked(entry);
+  }
 }
 
 StatusOr<std::shared_ptr<const MeshEntry>> MeshRegistry::Find(const std::string& mesh_id) const {

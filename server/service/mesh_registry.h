@@ -1,6 +1,7 @@
 // The loaded meshes: ids, their deformation models, and the limits on what may be loaded.
 //
-// A MeshEntry is immutable once registered except for two atomics (unloaded, open_streams).
+// A MeshEntry is immutable once registered except for two atomics (unloaded, open_streams), which
+// change only under the registry's lock (readers may read them without).
 // Streams hold a shared_ptr to their entry, which keeps the model alive after UnloadMesh.
 //
 // Limits: the number of meshes loaded or being loaded (a Reservation is taken before the
@@ -9,8 +10,9 @@
 // reservation (ReserveMemory: an upload's declared bytes while they arrive, then the model's
 // estimate before anything is built, DeformationModel::EstimateBytesBeforeBuild), so what does not
 // fit is refused before it is allocated and two loads cannot both take the last of the budget; a
-// registered mesh counts DeformationModel::EstimatedBytes() instead. Memory is released from the
-// budget at unload, even while open streams still use the model until they end.
+// registered mesh counts DeformationModel::EstimatedBytes() instead, until it is unloaded and the
+// last stream using it has ended (AttachStream / DetachStream): a model kept alive by streams
+// after UnloadMesh still counts.
 //
 // Tenancy: every mesh belongs to the tenant that loaded it. The lookups that take a caller
 // (Identity) answer another tenant's id exactly as an unknown id (NOT_FOUND, same message), so a
@@ -123,14 +125,21 @@ class MeshRegistry {
                                                   const Identity& caller) const;
   // The meshes `caller` may access, in the order they were loaded.
   std::vector<std::shared_ptr<const MeshEntry>> List(const Identity& caller) const;
-  // Removes the mesh and marks it unloaded; NOT_FOUND as Find.
+  // Removes the mesh and marks it unloaded; NOT_FOUND as Find. Its memory stays counted until its
+  // last stream detaches.
   Status Unload(const std::string& mesh_id, const Identity& caller);
+  // A stream starts using `entry` (from Find): counted in entry.open_streams. NOT_FOUND (as Find)
+  // when it has been unloaded since. Call DetachStream once for every successful AttachStream.
+  Status AttachStream(const MeshEntry& entry);
+  // The stream has ended; the last one of an unloaded mesh releases its memory from the budget.
+  void DetachStream(const MeshEntry& entry);
   // Unscoped (the server's own use: preloads, a load whose client went away, tests).
   StatusOr<std::shared_ptr<const MeshEntry>> Find(const std::string& mesh_id) const;
   std::vector<std::shared_ptr<const MeshEntry>> List() const;
   Status Unload(const std::string& mesh_id);
 
-  // Of the budget: loaded meshes' memory, and memory held by loads in progress.
+  // Of the budget: the memory of loaded meshes and of unloaded ones streams still use, and memory
+  // held by loads in progress.
   std::size_t memory_bytes_used() const;
   std::size_t memory_bytes_reserved() const;
   int mesh_count() const;
@@ -143,10 +152,11 @@ class MeshRegistry {
   struct TenantUsage {
     int reserved = 0;
     int loaded = 0;
-    std::size_t memory_bytes = 0;           // of loaded meshes
+    std::size_t memory_bytes = 0;           // of loaded meshes and unloaded ones still streamed
     std::size_t reserved_memory_bytes = 0;  // held by loads in progress
   };
   void ReleaseSlot(const std::string& tenant, std::size_t memory_bytes);
+  void ReleaseMemoryLocked(const MeshEntry& entry) DEFORM_REQUIRES(mutex_);
   // OK when `bytes` fit in the budgets besides what is in use, not counting `held` (what the
   // caller's own reservation holds already).
   Status CheckMemoryLocked(std::size_t bytes, std::size_t held, const std::string& tenant,
@@ -158,7 +168,9 @@ class MeshRegistry {
   std::map<std::uint64_t, std::shared_ptr<MeshEntry>> meshes_ DEFORM_GUARDED_BY(mutex_);
   std::unordered_map<std::string, std::uint64_t> order_of_id_ DEFORM_GUARDED_BY(mutex_);
   int reserved_ DEFORM_GUARDED_BY(mutex_) = 0;             // slots held by loads in progress
-  std::size_t memory_used_ DEFORM_GUARDED_BY(mutex_) = 0;  // sum of memory_bytes of loaded meshes
+  // memory_bytes of loaded meshes, and of unloaded meshes whose streams have not all ended
+  std::size_t memory_used_ DEFORM_GUARDED_BY(mutex_) = 0;
+  std::size_t memory_retained_ DEFORM_GUARDED_BY(mutex_) = 0;  // of the latter alone
   std::size_t memory_reserved_ DEFORM_GUARDED_BY(mutex_) = 0;  // held by reservations
   std::uint64_t next_order_ DEFORM_GUARDED_BY(mutex_) = 1;  // also counts registrations
   std::map<std::string, TenantUsage> tenants_ DEFORM_GUARDED_BY(mutex_);

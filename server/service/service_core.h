@@ -54,20 +54,24 @@ class ActiveStreams {
   bool draining_ DEFORM_GUARDED_BY(mutex_) = false;
 };
 
-// Open Deform streams per tenant, against ServiceLimits::tenant_max_streams. Thread-safe.
+// Open Deform streams per tenant and in all, against ServiceLimits::tenant_max_streams and
+// max_streams. Thread-safe.
 class TenantStreamQuota {
  public:
-  // `max_per_tenant` <= 0: no limit (streams are still counted).
-  explicit TenantStreamQuota(int max_per_tenant) : max_per_tenant_(max_per_tenant) {}
-  // Counts one more stream of `tenant`; RESOURCE_EXHAUSTED naming the limit when it has
-  // max_per_tenant open already. Release() once for every successful Acquire().
+  // A limit <= 0: none (streams are still counted).
+  TenantStreamQuota(int max_per_tenant, int max_total)
+      : max_per_tenant_(max_per_tenant), max_total_(max_total) {}
+  // Counts one more stream of `tenant`; RESOURCE_EXHAUSTED naming the limit when max_total are
+  // open already, or max_per_tenant of `tenant`'s. Release() once for every successful Acquire().
   Status Acquire(const std::string& tenant) DEFORM_EXCLUDES(mutex_);
   void Release(const std::string& tenant) DEFORM_EXCLUDES(mutex_);
 
  private:
   const int max_per_tenant_;
+  const int max_total_;
   Mutex mutex_;
   std::map<std::string, int> open_ DEFORM_GUARDED_BY(mutex_);
+  int total_ DEFORM_GUARDED_BY(mutex_) = 0;
 };
 
 struct ServiceCore {
@@ -77,7 +81,7 @@ struct ServiceCore {
         pool(options.workers),
         uploads(std::chrono::milliseconds(options.limits.upload_idle_timeout_ms),
                 std::chrono::milliseconds(options.limits.upload_time_limit_ms)),
-        tenant_streams(options.limits.tenant_max_streams) {}
+        tenant_streams(options.limits.tenant_max_streams, options.limits.max_streams) {}
 
   const ServiceLimits limits;
   // Who may call (token file, or the single implicit tenant).
