@@ -103,7 +103,7 @@ struct BuildHooks {
   // Laplacian system, symbolic analysis, numeric factorisation, linear response): once it is
   // cancelled, Build frees what it made and returns FAILED_PRECONDITION "cancelled during
   // <phase>" at the end of the phase in progress. A phase itself is not interrupted (the longest
-  // are the numeric factorisation and the through-the-body binding: README, "Limits"). Null:
+  // are the symbolic analysis and the numeric factorisation: README, "Limits"). Null:
   // never cancelled. Must outlive the Build call.
   const CancelToken* cancel = nullptr;
 };
