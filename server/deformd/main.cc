@@ -49,6 +49,8 @@ struct Args {
   std::size_t max_memory_mb = 4096;
   int max_message_mb = 64;
   std::size_t max_upload_mb = 256;
+  double upload_idle_timeout_s = 30;
+  double upload_time_limit_s = 300;
   std::string log_level = "info";
   std::vector<std::string> preload;
   std::vector<int> preload_phantom;
@@ -167,6 +169,18 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 2047));
   app.add_option("--max-upload-mb", args.max_upload_mb, "Largest LoadMesh upload, MiB")
       ->capture_default_str();
+  app.add_option("--max-streams", args.server.limits.max_streams,
+                 "Open Deform streams on the server, all tenants; 0 = no limit")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1 << 20));
+  app.add_option("--upload-idle-timeout-s", args.upload_idle_timeout_s,
+                 "End an upload that sends no data for this long (DEADLINE_EXCEEDED); 0 = never")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 86400.0));
+  app.add_option("--upload-time-limit-s", args.upload_time_limit_s,
+                 "End an upload not complete after this long (DEADLINE_EXCEEDED); 0 = never")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 86400.0));
   app.add_option("--log-level", args.log_level, "trace, debug, info, warn, error or off")
       ->capture_default_str()
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "critical", "off"}));
@@ -237,6 +251,10 @@ int main(int argc, char** argv) {
   spdlog::set_pattern("[%Y-%m-%d %H:%M:%S.%e] [%^%l%$] %v");
   args.server.limits.max_memory_bytes = args.max_memory_mb << 20;
   args.server.limits.max_upload_bytes = args.max_upload_mb << 20;
+  args.server.limits.upload_idle_timeout_ms =
+      static_cast<long long>(args.upload_idle_timeout_s * 1000);
+  args.server.limits.upload_time_limit_ms =
+      static_cast<long long>(args.upload_time_limit_s * 1000);
   args.server.max_message_bytes = args.max_message_mb << 20;
   args.server.limits.tenant_max_memory_bytes = args.tenant_max_memory_mb << 20;
   args.server.connections.keepalive_time_ms = static_cast<int>(args.keepalive_s * 1000);

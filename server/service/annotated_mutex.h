@@ -9,6 +9,7 @@
 // Thread safety: as std::mutex / std::condition_variable. Not recursive.
 #pragma once
 
+#include <chrono>
 #include <condition_variable>
 #include <mutex>
 
@@ -66,6 +67,13 @@ class CondVar {
     std::unique_lock<std::mutex> lock(mutex->mutex_, std::adopt_lock);
     cv_.wait(lock);
     lock.release();  // still held: the caller's scope owns it
+  }
+  // As Wait(), returning after `timeout` at the latest.
+  template <class Rep, class Period>
+  void WaitFor(Mutex* mutex, std::chrono::duration<Rep, Period> timeout) DEFORM_REQUIRES(mutex) {
+    std::unique_lock<std::mutex> lock(mutex->mutex_, std::adopt_lock);
+    cv_.wait_for(lock, timeout);
+    lock.release();
   }
   void NotifyOne() { cv_.notify_one(); }
   void NotifyAll() { cv_.notify_all(); }

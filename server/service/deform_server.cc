@@ -165,6 +165,7 @@ void DeformServer::Shutdown(std::chrono::milliseconds grace) {
       health->SetServingStatus(false);
     }
     impl_->core.streams.DrainAll();
+    impl_->core.shutting_down.Cancel();  // builds in progress stop at the end of their phase
     impl_->server->Shutdown(std::chrono::system_clock::now() + grace);
     impl_->server->Wait();
   }

@@ -171,6 +171,13 @@ void DeformStreamReactor::HandleStart() {
     Fail(ToGrpcCode(entry.status().code()), entry.status().message());
     return;
   }
+  const Status attached = core_->registry.AttachStream(**entry);  // unloaded since: NOT_FOUND
+  if (!attached.ok()) {
+    Audit(caller_.tenant, "deform", mesh_id, attached.ToString());
+    Fail(ToGrpcCode(attached.code()), attached.message());
+    return;
+  }
+  entry_ = std::move(*entry);  // attached: DetachStream in OnDone
   const Status quota = core_->tenant_streams.Acquire(caller_.tenant);
   Audit(caller_.tenant, "deform", mesh_id, quota.ok() ? "OK" : quota.ToString());
   if (!quota.ok()) {
@@ -183,8 +190,6 @@ void DeformStreamReactor::HandleStart() {
     return;
   }
   registered_ = true;
-  entry_ = std::move(*entry);
-  entry_->open_streams.fetch_add(1);
   model_ = entry_->model.get();
   log_context_ += " mesh=" + entry_->id;
   auto encoder = MakeFrameEncoder(request_.start(), *entry_);
@@ -390,7 +395,7 @@ void DeformStreamReactor::Drain() {
 void DeformStreamReactor::OnDone() {
   if (registered_) core_->streams.Remove(this);
   if (counted_) core_->tenant_streams.Release(caller_.tenant);
-  if (entry_ != nullptr) entry_->open_streams.fetch_sub(1);
+  if (entry_ != nullptr) core_->registry.DetachStream(*entry_);
   {
     MutexLock lock(&mutex_);
     const grpc::Status& status = pump_.finish_status();

@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "core/io/phantom.h"
+#include "core/model/deformation_model.h"
 #include "service/annotated_mutex.h"
 #include "service/audit_log.h"
 #include "service/grpc_stream_sink.h"
@@ -33,6 +34,28 @@ using Clock = std::chrono::steady_clock;
 // Bytes reserved up front for an upload; larger uploads grow as their chunks arrive.
 constexpr std::size_t kMaxInitialReserve = std::size_t{64} << 20;
 
+// What a load's header lets the server know of the memory it will need: a phantom's model
+// (DeformationModel::EstimateBytesBeforeBuild, the phantom's triangles about twice its vertices);
+// an upload's bytes as announced (mesh, skeleton and weights), held while they arrive.
+std::size_t AdmissionBytes(const v1::LoadMeshHeader& header) {
+  if (header.has_phantom()) {
+    const int vertices =
+        header.phantom().vertices() == 0 ? kDefaultPhantomVertices : header.phantom().vertices();
+    return DeformationModel::EstimateBytesBeforeBuild(vertices, 2 * vertices);
+  }
+  const v1::UploadSource& upload = header.upload();
+  return upload.mesh_size_bytes() + upload.skeleton().size() + upload.weights().size();
+}
+
+std::string AdmissionSubject(const v1::LoadMeshHeader& header) {
+  if (header.has_phantom()) {
+    const int vertices =
+        header.phantom().vertices() == 0 ? kDefaultPhantomVertices : header.phantom().vertices();
+    return "a phantom of " + std::to_string(vertices) + " vertices";
+  }
+  return "an upload of " + std::to_string(AdmissionBytes(header)) + " bytes";
+}
+
 double MillisecondsSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
@@ -40,6 +63,7 @@ double MillisecondsSince(Clock::time_point start) {
 class LoadMeshReactor final
     : public grpc::ServerBidiReactor<v1::LoadMeshRequest, v1::LoadMeshResponse>,
       public SharedReactor<LoadMeshReactor>,
+      public ExpiringUpload,
       private StreamWriteSource<v1::LoadMeshResponse> {
  public:
   LoadMeshReactor(ServiceCore* core, Identity caller)
@@ -54,6 +78,8 @@ class LoadMeshReactor final
   void OnWriteDone(bool ok) DEFORM_EXCLUDES(mutex_) override;
   void OnCancel() DEFORM_EXCLUDES(mutex_) override;
   void OnDone() override;
+  // The upload stalled or took too long (upload_watchdog.h): DEADLINE_EXCEEDED.
+  void ExpireUpload(const std::string& why) DEFORM_EXCLUDES(mutex_) override;
 
  private:
   Status HandleHeader();
@@ -76,6 +102,8 @@ class LoadMeshReactor final
   const Identity caller_;
   std::string log_context_;
   Clock::time_point start_;
+  // The build's: cancelled by the client's cancel or a failed write, and at server shutdown.
+  CancelToken cancel_{&core_->shutting_down};
 
   // Reader-owned until the build is posted, then worker-owned.
   v1::LoadMeshRequest request_;
@@ -84,6 +112,7 @@ class LoadMeshReactor final
   std::string mesh_bytes_;
   std::uint64_t expected_bytes_ = 0;
   MeshRegistry::Reservation reservation_;
+  std::uint64_t upload_watch_ = 0;  // core_->uploads' id while an upload arrives; 0: none
 
   GrpcStreamSink<v1::LoadMeshRequest, v1::LoadMeshResponse> sink_{this};
   Mutex mutex_;
@@ -127,12 +156,19 @@ Status LoadMeshReactor::HandleHeader() {
                  vertices == 0 ? kDefaultPhantomVertices : vertices, EscapeForLog(header_.name()));
   } else {
     expected_bytes_ = header_.upload().mesh_size_bytes();
+    upload_watch_ = core_->uploads.Watch(std::weak_ptr<LoadMeshReactor>(SharedFromThis()));
     mesh_bytes_.reserve(std::min<std::size_t>(expected_bytes_, kMaxInitialReserve));
     spdlog::info("{} upload of {} mesh bytes announced, name='{}'", log_context_, expected_bytes_,
                  EscapeForLog(header_.name()));
   }
   DEFORM_ASSIGN_OR_RETURN(reservation_, core_->registry.Reserve(caller_.tenant));
-  return Status::Ok();
+  // Admission: the memory the load will need, as far as the header tells, is taken from the
+  // budget before anything is allocated (BuildAndRegister replaces it by the model's estimate
+  // once the upload is parsed).
+  const Status admitted = core_->registry.ReserveMemory(&reservation_, AdmissionBytes(header_),
+                                                        AdmissionSubject(header_));
+  if (!admitted.ok()) reservation_.Release();
+  return admitted;
 }
 
 Status LoadMeshReactor::HandleChunk() {
@@ -145,10 +181,12 @@ Status LoadMeshReactor::HandleChunk() {
                                    " mesh bytes announced in the header");
   }
   mesh_bytes_.append(chunk);
+  core_->uploads.Touch(upload_watch_);
   return Status::Ok();
 }
 
 Status LoadMeshReactor::HandleEndOfInput() {
+  if (upload_watch_ != 0) core_->uploads.Forget(std::exchange(upload_watch_, 0));
   {
     MutexLock lock(&mutex_);
     if (pump_.finish_requested()) return Status::Ok();  // cancelled or already failed
@@ -187,6 +225,14 @@ void LoadMeshReactor::Build() {
       AddProgressLocked(v1::LoadMeshResponse::STAGE_READY, MillisecondsSince(start_), entry->get());
       pump_.RequestFinish(grpc::Status::OK);
     }
+  } else if (!skip && cancel_.cancelled()) {
+    // Stopped between two phases of the build; its memory and slot are released already.
+    spdlog::info("{} build stopped: {}", log_context_, entry.status().message());
+    Audit(caller_.tenant, "load", "", "CANCELLED");
+    pump_.RequestFinish(core_->shutting_down.cancelled()
+                            ? grpc::Status(grpc::StatusCode::UNAVAILABLE,
+                                           "the server is shutting down: the load was stopped")
+                            : grpc::Status(grpc::StatusCode::CANCELLED, "cancelled"));
   } else if (!skip) {
     spdlog::warn("{} failed: {}", log_context_, entry.status().ToString());
     Audit(caller_.tenant, "load", "", entry.status().ToString());
@@ -211,6 +257,7 @@ StatusOr<std::shared_ptr<const MeshEntry>> LoadMeshReactor::ParseAndBuild() {
   LoadJob job = std::move(*parsed);
   job.start = start_;
   job.id = pending_id;
+  job.cancel = &cancel_;
 
   const auto progress = [this](LoadStage stage, double elapsed_ms) {
     MutexLock lock(&mutex_);
@@ -240,6 +287,7 @@ StatusOr<std::shared_ptr<const MeshEntry>> LoadMeshReactor::ParseAndBuild() {
 }
 
 void LoadMeshReactor::Fail(const Status& status) {
+  if (upload_watch_ != 0) core_->uploads.Forget(std::exchange(upload_watch_, 0));
   spdlog::warn("{} refused: {}", log_context_, status.ToString());
   Audit(caller_.tenant, "load", "", status.ToString());
   MutexLock lock(&mutex_);
@@ -265,7 +313,10 @@ const v1::LoadMeshResponse* LoadMeshReactor::TakeNextWrite() {
 
 void LoadMeshReactor::WriteCompleted(bool ok) {
   mutex_.AssertHeld();
-  if (!ok) cancelled_ = true;
+  if (!ok) {
+    cancelled_ = true;
+    cancel_.Cancel();
+  }
 }
 
 void LoadMeshReactor::OnWriteDone(bool ok) {
@@ -274,9 +325,22 @@ void LoadMeshReactor::OnWriteDone(bool ok) {
 }
 
 void LoadMeshReactor::OnCancel() {
+  cancel_.Cancel();  // a build in progress stops at the end of its phase
   MutexLock lock(&mutex_);
   cancelled_ = true;
   pump_.RequestFinish(grpc::Status(grpc::StatusCode::CANCELLED, "cancelled by the client"));
+  pump_.Pump();
+}
+
+void LoadMeshReactor::ExpireUpload(const std::string& why) {
+  {
+    MutexLock lock(&mutex_);
+    if (pump_.finish_requested()) return;  // ended already (failed or cancelled)
+  }
+  spdlog::warn("{} upload ended: {}", log_context_, why);
+  Audit(caller_.tenant, "load", "", "DEADLINE_EXCEEDED");
+  MutexLock lock(&mutex_);
+  pump_.RequestFinish(grpc::Status(grpc::StatusCode::DEADLINE_EXCEEDED, why));
   pump_.Pump();
 }
 

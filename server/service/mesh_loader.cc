@@ -24,13 +24,15 @@ StatusOr<std::shared_ptr<const MeshEntry>> BuildAndRegister(MeshRegistry* regist
   const std::size_t bytes_before_build =
       DeformationModel::EstimateBytesBeforeBuild(job.mesh.num_vertices(), job.mesh.num_triangles());
   const int vertices = job.mesh.num_vertices();
-  const std::string tenant = reservation.tenant();
   BuildHooks hooks;
   hooks.validated = [&] {
-    DEFORM_RETURN_IF_ERROR(registry->CheckMemoryAvailable(bytes_before_build, tenant));
+    DEFORM_RETURN_IF_ERROR(registry->ReserveMemory(
+        &reservation, bytes_before_build,
+        "a mesh of " + std::to_string(vertices) + " vertices"));
     if (progress) progress(LoadStage::kValidated, MillisecondsSince(job.start));
     return Status::Ok();
   };
+  hooks.cancel = job.cancel;
   hooks.precomputed = [&] {
     if (progress) progress(LoadStage::kWeights, MillisecondsSince(job.start));
   };

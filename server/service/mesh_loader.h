@@ -11,6 +11,7 @@
 #include <optional>
 #include <string>
 
+#include "core/base/cancel_token.h"
 #include "core/base/status.h"
 #include "core/geometry/mesh.h"
 #include "core/geometry/skeleton.h"
@@ -39,12 +40,16 @@ struct LoadJob {
   std::optional<SkinWeights> weights;  // a rig's own weights: binding from them (Build)
   MeshPresentation presentation;       // from a glTF rig: the file's vertex order, units, up axis
   std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
+  // Stops the build between its phases once cancelled (BuildHooks::cancel); null: never. Must
+  // outlive BuildAndRegister.
+  const CancelToken* cancel = nullptr;
 };
 
 // Builds the model and registers it with `reservation`. Checks nothing the core checks: the mesh
 // readers validated an uploaded mesh, and DeformationModel::Build validates mesh and options again
-// (with the registry's vertex limit in options.limits); once it has, the memory budget is checked
-// for the mesh's size (DeformationModel::EstimateBytesBeforeBuild) and kValidated reported.
+// (with the registry's vertex limit in options.limits); once it has, `reservation` is made to hold
+// the model's estimate from the mesh's size (DeformationModel::EstimateBytesBeforeBuild,
+// MeshRegistry::ReserveMemory) before anything of the model is allocated, and kValidated reported.
 // Errors: INVALID_ARGUMENT for a bad mesh or options (naming the problem), RESOURCE_EXHAUSTED for
 // limits.
 StatusOr<std::shared_ptr<const MeshEntry>> BuildAndRegister(MeshRegistry* registry,

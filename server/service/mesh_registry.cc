@@ -23,13 +23,16 @@ const Identity& Unscoped() {
 }  // namespace
 
 MeshRegistry::Reservation::Reservation(Reservation&& other) noexcept
-    : registry_(std::exchange(other.registry_, nullptr)), tenant_(std::move(other.tenant_)) {}
+    : registry_(std::exchange(other.registry_, nullptr)),
+      tenant_(std::move(other.tenant_)),
+      memory_bytes_(std::exchange(other.memory_bytes_, 0)) {}
 
 MeshRegistry::Reservation& MeshRegistry::Reservation::operator=(Reservation&& other) noexcept {
   if (this != &other) {
     Release();
     registry_ = std::exchange(other.registry_, nullptr);
     tenant_ = std::move(other.tenant_);
+    memory_bytes_ = std::exchange(other.memory_bytes_, 0);
   }
   return *this;
 }
@@ -37,7 +40,9 @@ MeshRegistry::Reservation& MeshRegistry::Reservation::operator=(Reservation&& ot
 MeshRegistry::Reservation::~Reservation() { Release(); }
 
 void MeshRegistry::Reservation::Release() {
-  if (registry_ != nullptr) std::exchange(registry_, nullptr)->ReleaseSlot(tenant_);
+  if (registry_ != nullptr) {
+    std::exchange(registry_, nullptr)->ReleaseSlot(tenant_, std::exchange(memory_bytes_, 0));
+  }
 }
 
 MeshRegistry::MeshRegistry(const ServiceLimits& limits) : limits_(limits) {}
@@ -63,25 +68,35 @@ StatusOr<MeshRegistry::Reservation> MeshRegistry::Reserve(const std::string& ten
   return Reservation(this, tenant);
 }
 
-void MeshRegistry::ReleaseSlot(const std::string& tenant) {
+void MeshRegistry::ReleaseSlot(const std::string& tenant, std::size_t memory_bytes) {
   MutexLock lock(&mutex_);
+  TenantUsage& usage = tenants_[tenant];
   --reserved_;
-  --tenants_[tenant].reserved;
+  --usage.reserved;
+  memory_reserved_ -= memory_bytes;
+  usage.reserved_memory_bytes -= memory_bytes;
 }
 
-Status MeshRegistry::CheckMemoryLocked(std::size_t bytes, const std::string& tenant) const {
-  if (memory_used_ + bytes > limits_.max_memory_bytes) {
-    return Status::ResourceExhausted("memory budget exceeded: the mesh needs about " +
-                                     MebiBytes(bytes) + ", " + MebiBytes(memory_used_) +
-                                     " of the " + MebiBytes(limits_.max_memory_bytes) +
-                                     " budget are in use");
+Status MeshRegistry::CheckMemoryLocked(std::size_t bytes, std::size_t held,
+                                       const std::string& tenant, const std::string& what) const {
+  const std::size_t in_use = memory_used_ + memory_reserved_ - held;
+  if (bytes > limits_.max_memory_bytes || in_use > limits_.max_memory_bytes - bytes) {
+    return Status::ResourceExhausted(
+        "memory budget exceeded (--max-memory-mb): " + what + " needs about " + MebiBytes(bytes) +
+        ", " + MebiBytes(in_use) + " of the " + MebiBytes(limits_.max_memory_bytes) +
+        " budget are in use (" + MebiBytes(memory_used_ - memory_retained_) +
+        " by loaded meshes, " + MebiBytes(memory_retained_) +
+        " by unloaded meshes that streams still use)");
   }
   if (limits_.tenant_max_memory_bytes > 0) {
     const auto it = tenants_.find(tenant);
-    const std::size_t used = it == tenants_.end() ? 0 : it->second.memory_bytes;
-    if (used + bytes > limits_.tenant_max_memory_bytes) {
+    const std::size_t used =
+        it == tenants_.end() ? 0
+                             : it->second.memory_bytes + it->second.reserved_memory_bytes - held;
+    if (bytes > limits_.tenant_max_memory_bytes ||
+        used > limits_.tenant_max_memory_bytes - bytes) {
       return Status::ResourceExhausted(
-          "tenant memory budget exceeded (--tenant-max-memory-mb): the mesh needs about " +
+          "tenant memory budget exceeded (--tenant-max-memory-mb): " + what + " needs about " +
           MebiBytes(bytes) + ", " + MebiBytes(used) + " of the tenant's " +
           MebiBytes(limits_.tenant_max_memory_bytes) + " are in use");
     }
@@ -89,9 +104,16 @@ Status MeshRegistry::CheckMemoryLocked(std::size_t bytes, const std::string& ten
   return Status::Ok();
 }
 
-Status MeshRegistry::CheckMemoryAvailable(std::size_t bytes, const std::string& tenant) const {
+Status MeshRegistry::ReserveMemory(Reservation* reservation, std::size_t bytes,
+                                   const std::string& what) {
   MutexLock lock(&mutex_);
-  return CheckMemoryLocked(bytes, tenant);
+  const std::size_t held = reservation->memory_bytes_;
+  DEFORM_RETURN_IF_ERROR(CheckMemoryLocked(bytes, held, reservation->tenant_, what));
+  TenantUsage& usage = tenants_[reservation->tenant_];
+  memory_reserved_ = memory_reserved_ - held + bytes;
+  usage.reserved_memory_bytes = usage.reserved_memory_bytes - held + bytes;
+  reservation->memory_bytes_ = bytes;
+  return Status::Ok();
 }
 
 StatusOr<std::shared_ptr<const MeshEntry>> MeshRegistry::Register(
@@ -110,10 +132,13 @@ StatusOr<std::shared_ptr<const MeshEntry>> MeshRegistry::Register(
   MutexLock lock(&mutex_);
   // From here the reservation's slot is released here (failure) or becomes the mesh's.
   reservation.registry_ = nullptr;
+  const std::size_t held = std::exchange(reservation.memory_bytes_, 0);
   TenantUsage& usage = tenants_[entry->tenant];
   --reserved_;
   --usage.reserved;
-  DEFORM_RETURN_IF_ERROR(CheckMemoryLocked(entry->memory_bytes, entry->tenant));
+  memory_reserved_ -= held;
+  usage.reserved_memory_bytes -= held;
+  DEFORM_RETURN_IF_ERROR(CheckMemoryLocked(entry->memory_bytes, 0, entry->tenant, "the mesh"));
   if (!id.empty() && order_of_id_.count(id) != 0) {
     return Status::InvalidArgument("mesh id '" + id + "' is already loaded");
   }
@@ -159,13 +184,35 @@ Status MeshRegistry::Unload(const std::string& mesh_id, const Identity& caller) 
   MeshEntry& entry = *it->second;
   if (!caller.CanAccess(entry.tenant)) return NotLoaded(mesh_id);
   entry.unloaded.store(true);
-  memory_used_ -= entry.memory_bytes;
-  TenantUsage& usage = tenants_[entry.tenant];
-  --usage.loaded;
-  usage.memory_bytes -= entry.memory_bytes;
+  --tenants_[entry.tenant].loaded;
+  if (entry.open_streams.load() == 0) {
+    ReleaseMemoryLocked(entry);
+  } else {
+    memory_retained_ += entry.memory_bytes;  // until its last stream detaches
+  }
   order_of_id_.erase(order);
   meshes_.erase(it);
   return Status::Ok();
+}
+
+void MeshRegistry::ReleaseMemoryLocked(const MeshEntry& entry) {
+  memory_used_ -= entry.memory_bytes;
+  tenants_[entry.tenant].memory_bytes -= entry.memory_bytes;
+}
+
+Status MeshRegistry::AttachStream(const MeshEntry& entry) {
+  MutexLock lock(&mutex_);
+  if (entry.unloaded.load()) return NotLoaded(entry.id);
+  entry.open_streams.fetch_add(1);
+  return Status::Ok();
+}
+
+void MeshRegistry::DetachStream(const MeshEntry& entry) {
+  MutexLock lock(&mutex_);
+  if (entry.open_streams.fetch_sub(1) == 1 && entry.unloaded.load()) {
+    memory_retained_ -= entry.memory_bytes;
+    ReleaseMemoryLocked(entry);
+  }
 }
 
 StatusOr<std::shared_ptr<const MeshEntry>> MeshRegistry::Find(const std::string& mesh_id) const {
@@ -181,6 +228,21 @@ Status MeshRegistry::Unload(const std::string& mesh_id) { return Unload(mesh_id,
 std::size_t MeshRegistry::memory_bytes_used() const {
   MutexLock lock(&mutex_);
   return memory_used_;
+}
+
+std::size_t MeshRegistry::memory_bytes_reserved() const {
+  MutexLock lock(&mutex_);
+  return memory_reserved_;
+}
+
+int MeshRegistry::loads_in_progress() const {
+  MutexLock lock(&mutex_);
+  return reserved_;
+}
+
+int MeshRegistry::registrations() const {
+  MutexLock lock(&mutex_);
+  return static_cast<int>(next_order_ - 1);
 }
 
 int MeshRegistry::mesh_count() const {

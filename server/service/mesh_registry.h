@@ -1,13 +1,18 @@
 // The loaded meshes: ids, their deformation models, and the limits on what may be loaded.
 //
-// A MeshEntry is immutable once registered except for two atomics (unloaded, open_streams).
+// A MeshEntry is immutable once registered except for two atomics (unloaded, open_streams), which
+// change only under the registry's lock (readers may read them without).
 // Streams hold a shared_ptr to their entry, which keeps the model alive after UnloadMesh.
 //
 // Limits: the number of meshes loaded or being loaded (a Reservation is taken before the
-// expensive work, so a client learns early that no slot is free) and a memory budget checked
-// against DeformationModel::EstimatedBytes() when the mesh is registered; both server-wide and
-// per tenant (ServiceLimits::tenant_*). Memory is released from the budget at unload, even while
-// open streams still use the model until they end.
+// expensive work, so a client learns early that no slot is free) and a memory budget; both
+// server-wide and per tenant (ServiceLimits::tenant_*). A load in progress holds memory in its
+// reservation (ReserveMemory: an upload's declared bytes while they arrive, then the model's
+// estimate before anything is built, DeformationModel::EstimateBytesBeforeBuild), so what does not
+// fit is refused before it is allocated and two loads cannot both take the last of the budget; a
+// registered mesh counts DeformationModel::EstimatedBytes() instead, until it is unloaded and the
+// last stream using it has ended (AttachStream / DetachStream): a model kept alive by streams
+// after UnloadMesh still counts.
 //
 // Tenancy: every mesh belongs to the tenant that loaded it. The lookups that take a caller
 // (Identity) answer another tenant's id exactly as an unknown id (NOT_FOUND, same message), so a
@@ -77,6 +82,8 @@ class MeshRegistry {
     ~Reservation();
     bool valid() const { return registry_ != nullptr; }
     const std::string& tenant() const { return tenant_; }
+    // The memory it holds against the budgets (MeshRegistry::ReserveMemory).
+    std::size_t memory_bytes() const { return memory_bytes_; }
     void Release();
 
    private:
@@ -85,6 +92,7 @@ class MeshRegistry {
         : registry_(registry), tenant_(std::move(tenant)) {}
     MeshRegistry* registry_ = nullptr;
     std::string tenant_;
+    std::size_t memory_bytes_ = 0;
   };
 
   explicit MeshRegistry(const ServiceLimits& limits);
@@ -96,10 +104,12 @@ class MeshRegistry {
   // A slot for a mesh `tenant` loads. RESOURCE_EXHAUSTED (naming the limit) when max_meshes are
   // loaded or being loaded, or tenant_max_meshes of `tenant`'s. The registry must outlive it.
   StatusOr<Reservation> Reserve(const std::string& tenant = Identity::Implicit().tenant);
-  // RESOURCE_EXHAUSTED when `bytes` more would not fit in the memory budget now, the server's or
-  // `tenant`'s (an early check before the expensive precomputation; Register checks again).
-  Status CheckMemoryAvailable(std::size_t bytes,
-                              const std::string& tenant = Identity::Implicit().tenant) const;
+  // Makes `reservation` (valid) hold `bytes` of the memory budgets, the server's and its tenant's,
+  // in place of what it held: what the load will need next, known before it is allocated.
+  // RESOURCE_EXHAUSTED naming `what`, the estimate, the budget and what is in use (by loaded
+  // meshes and by other loads in progress) when it does not fit; the reservation then keeps what
+  // it held.
+  Status ReserveMemory(Reservation* reservation, std::size_t bytes, const std::string& what);
 
   // Registers a built model using `reservation`'s slot, owned by the reservation's tenant, under `id` if given (a mesh restored from
   // a store keeps its id; an id already loaded is INVALID_ARGUMENT), else under a new NewMeshId().
@@ -115,26 +125,42 @@ class MeshRegistry {
                                                   const Identity& caller) const;
   // The meshes `caller` may access, in the order they were loaded.
   std::vector<std::shared_ptr<const MeshEntry>> List(const Identity& caller) const;
-  // Removes the mesh and marks it unloaded; NOT_FOUND as Find.
+  // Removes the mesh and marks it unloaded; NOT_FOUND as Find. Its memory stays counted until its
+  // last stream detaches.
   Status Unload(const std::string& mesh_id, const Identity& caller);
+  // A stream starts using `entry` (from Find): counted in entry.open_streams. NOT_FOUND (as Find)
+  // when it has been unloaded since. Call DetachStream once for every successful AttachStream.
+  Status AttachStream(const MeshEntry& entry);
+  // The stream has ended; the last one of an unloaded mesh releases its memory from the budget.
+  void DetachStream(const MeshEntry& entry);
   // Unscoped (the server's own use: preloads, a load whose client went away, tests).
   StatusOr<std::shared_ptr<const MeshEntry>> Find(const std::string& mesh_id) const;
   std::vector<std::shared_ptr<const MeshEntry>> List() const;
   Status Unload(const std::string& mesh_id);
 
+  // Of the budget: the memory of loaded meshes and of unloaded ones streams still use, and memory
+  // held by loads in progress.
   std::size_t memory_bytes_used() const;
+  std::size_t memory_bytes_reserved() const;
   int mesh_count() const;
+  int loads_in_progress() const;
+  // Meshes registered since the registry was made (unloaded ones included).
+  int registrations() const;
 
  private:
   // Per-tenant counts: slots held by loads in progress, loaded meshes, their memory.
   struct TenantUsage {
     int reserved = 0;
     int loaded = 0;
-    std::size_t memory_bytes = 0;
+    std::size_t memory_bytes = 0;           // of loaded meshes and unloaded ones still streamed
+    std::size_t reserved_memory_bytes = 0;  // held by loads in progress
   };
-  void ReleaseSlot(const std::string& tenant);
-  Status CheckMemoryLocked(std::size_t bytes, const std::string& tenant) const
-      DEFORM_REQUIRES(mutex_);
+  void ReleaseSlot(const std::string& tenant, std::size_t memory_bytes);
+  void ReleaseMemoryLocked(const MeshEntry& entry) DEFORM_REQUIRES(mutex_);
+  // OK when `bytes` fit in the budgets besides what is in use, not counting `held` (what the
+  // caller's own reservation holds already).
+  Status CheckMemoryLocked(std::size_t bytes, std::size_t held, const std::string& tenant,
+                           const std::string& what) const DEFORM_REQUIRES(mutex_);
 
   const ServiceLimits limits_;
   mutable Mutex mutex_;
@@ -142,8 +168,11 @@ class MeshRegistry {
   std::map<std::uint64_t, std::shared_ptr<MeshEntry>> meshes_ DEFORM_GUARDED_BY(mutex_);
   std::unordered_map<std::string, std::uint64_t> order_of_id_ DEFORM_GUARDED_BY(mutex_);
   int reserved_ DEFORM_GUARDED_BY(mutex_) = 0;             // slots held by loads in progress
-  std::size_t memory_used_ DEFORM_GUARDED_BY(mutex_) = 0;  // sum of memory_bytes of loaded meshes
-  std::uint64_t next_order_ DEFORM_GUARDED_BY(mutex_) = 1;
+  // memory_bytes of loaded meshes, and of unloaded meshes whose streams have not all ended
+  std::size_t memory_used_ DEFORM_GUARDED_BY(mutex_) = 0;
+  std::size_t memory_retained_ DEFORM_GUARDED_BY(mutex_) = 0;  // of the latter alone
+  std::size_t memory_reserved_ DEFORM_GUARDED_BY(mutex_) = 0;  // held by reservations
+  std::uint64_t next_order_ DEFORM_GUARDED_BY(mutex_) = 1;  // also counts registrations
   std::map<std::string, TenantUsage> tenants_ DEFORM_GUARDED_BY(mutex_);
 };
 

@@ -27,6 +27,11 @@ int ActiveStreams::count() const {
 
 Status TenantStreamQuota::Acquire(const std::string& tenant) {
   MutexLock lock(&mutex_);
+  if (max_total_ > 0 && total_ >= max_total_) {
+    return Status::ResourceExhausted("server stream limit reached (--max-streams): " +
+                                     std::to_string(total_) + " streams open, of at most " +
+                                     std::to_string(max_total_));
+  }
   int& open = open_[tenant];
   if (max_per_tenant_ > 0 && open >= max_per_tenant_) {
     return Status::ResourceExhausted("tenant stream limit reached (--tenant-max-streams): " +
@@ -34,13 +39,16 @@ Status TenantStreamQuota::Acquire(const std::string& tenant) {
                                      std::to_string(max_per_tenant_) + " per tenant");
   }
   ++open;
+  ++total_;
   return Status::Ok();
 }
 
 void TenantStreamQuota::Release(const std::string& tenant) {
   MutexLock lock(&mutex_);
   const auto it = open_.find(tenant);
-  if (it != open_.end() && --it->second == 0) open_.erase(it);
+  if (it == open_.end()) return;
+  --total_;
+  if (--it->second == 0) open_.erase(it);
 }
 
 }  // namespace deform::service

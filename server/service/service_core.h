@@ -7,18 +7,21 @@
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <map>
 #include <memory>
 #include <string>
 #include <unordered_set>
 
+#include "core/base/cancel_token.h"
 #include "service/annotated_mutex.h"
 #include "service/identity.h"
 #include "service/mesh_registry.h"
 #include "service/mesh_store.h"
 #include "service/service_options.h"
 #include "service/thread_annotations.h"
+#include "service/upload_watchdog.h"
 #include "service/worker_pool.h"
 
 namespace deform::service {
@@ -51,20 +54,24 @@ class ActiveStreams {
   bool draining_ DEFORM_GUARDED_BY(mutex_) = false;
 };
 
-// Open Deform streams per tenant, against ServiceLimits::tenant_max_streams. Thread-safe.
+// Open Deform streams per tenant and in all, against ServiceLimits::tenant_max_streams and
+// max_streams. Thread-safe.
 class TenantStreamQuota {
  public:
-  // `max_per_tenant` <= 0: no limit (streams are still counted).
-  explicit TenantStreamQuota(int max_per_tenant) : max_per_tenant_(max_per_tenant) {}
-  // Counts one more stream of `tenant`; RESOURCE_EXHAUSTED naming the limit when it has
-  // max_per_tenant open already. Release() once for every successful Acquire().
+  // A limit <= 0: none (streams are still counted).
+  TenantStreamQuota(int max_per_tenant, int max_total)
+      : max_per_tenant_(max_per_tenant), max_total_(max_total) {}
+  // Counts one more stream of `tenant`; RESOURCE_EXHAUSTED naming the limit when max_total are
+  // open already, or max_per_tenant of `tenant`'s. Release() once for every successful Acquire().
   Status Acquire(const std::string& tenant) DEFORM_EXCLUDES(mutex_);
   void Release(const std::string& tenant) DEFORM_EXCLUDES(mutex_);
 
  private:
   const int max_per_tenant_;
+  const int max_total_;
   Mutex mutex_;
   std::map<std::string, int> open_ DEFORM_GUARDED_BY(mutex_);
+  int total_ DEFORM_GUARDED_BY(mutex_) = 0;
 };
 
 struct ServiceCore {
@@ -72,17 +79,22 @@ struct ServiceCore {
       : limits(options.limits),
         registry(options.limits),
         pool(options.workers),
-        tenant_streams(options.limits.tenant_max_streams) {}
+        uploads(std::chrono::milliseconds(options.limits.upload_idle_timeout_ms),
+                std::chrono::milliseconds(options.limits.upload_time_limit_ms)),
+        tenant_streams(options.limits.tenant_max_streams, options.limits.max_streams) {}
 
   const ServiceLimits limits;
   // Who may call (token file, or the single implicit tenant).
   Authenticator auth;
   MeshRegistry registry;
   WorkerPool pool;
+  UploadWatchdog uploads;
   ActiveStreams streams;
   TenantStreamQuota tenant_streams;
   // Where loaded meshes are kept across restarts (--store); null: nowhere. Set before serving.
   std::unique_ptr<MeshStore> store;
+  // Cancelled when the server shuts down: the parent of every build's token (cancel_token.h).
+  CancelToken shutting_down;
   std::atomic<std::uint64_t> next_stream_id{1};
   std::atomic<std::uint64_t> next_load_id{1};
   // Serialised bytes of the notices waiting unwritten in every Deform stream (DeformOutbox).

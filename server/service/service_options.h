@@ -16,6 +16,14 @@ struct ServiceLimits {
   std::size_t max_memory_bytes = std::size_t{4} << 30;
   // Largest upload (mesh file plus skeleton file) accepted by LoadMesh. Default: 256 MiB.
   std::size_t max_upload_bytes = std::size_t{256} << 20;
+  // Open Deform streams on the server, all tenants together (each holds a scratch and frame slots
+  // of its mesh's size); 0 means no limit. Default: 256.
+  int max_streams = 256;
+  // An upload ends with DEADLINE_EXCEEDED (its slot and bytes released) when no data has arrived
+  // for upload_idle_timeout_ms, or when it has lasted upload_time_limit_ms from its header to its
+  // last byte (upload_watchdog.h); 0 disables either. Defaults: 30 s and 300 s.
+  long long upload_idle_timeout_ms = 30'000;
+  long long upload_time_limit_ms = 300'000;
   // Per tenant (identity.h), on top of the server-wide limits above; 0 means no per-tenant limit.
   // Meshes loaded or being loaded by one tenant. Default: 0.
   int tenant_max_meshes = 0;

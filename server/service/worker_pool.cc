@@ -66,7 +66,10 @@ void WorkerPool::WorkerLoop() {
   MutexLock lock(&mutex_);
   while (true) {
     const bool can_run_background = !background_.empty() && running_background_ < max_background_;
-    if (urgent_head_ != nullptr) {
+    // The background queue's guaranteed worker (header comment).
+    const bool background_owed =
+        can_run_background && running_background_ == 0 && thread_count_ > 1;
+    if (urgent_head_ != nullptr && !background_owed) {
       std::shared_ptr<UrgentTask> task = std::move(urgent_head_);
       urgent_head_ = std::move(task->next_urgent_);
       if (urgent_head_ == nullptr) urgent_tail_ = nullptr;

@@ -1,9 +1,12 @@
 // A fixed pool of worker threads for everything that must not run on gRPC's threads: per-frame
 // solves (urgent) and mesh precomputation or refactorisation (background).
 //
-// Scheduling: urgent tasks always go first, in FIFO order. Background tasks run in FIFO order on
-// at most max(1, threads - 1) workers at once, so with two or more workers one of them is always
-// free for frames while meshes are being built.
+// Scheduling: two queues, each in FIFO order. Background tasks run on at most max(1, threads - 1)
+// workers at once, so with two or more workers one of them is always free for frames while
+// meshes are being built. Urgent tasks go first, except that with two or more workers a queued
+// background task is owed a worker whenever none is running one: a worker that becomes free takes
+// it before the next urgent task, so builds and refactorisations progress however busy the frames
+// keep the pool (a guaranteed share of one worker). With one worker urgent tasks always go first.
 //
 // Ownership: the pool holds a reference to every task it has been given (the urgent task's
 // shared_ptr, the background task's function and its captures) until the task has run, and drops

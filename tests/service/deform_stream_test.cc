@@ -389,6 +389,36 @@ TEST_F(DeformStreamTest, UnloadedMeshKeepsItsStreamsButRefusesNewOnes) {
   ExpectBackgroundStreamAlive();
 }
 
+TEST_F(DeformStreamTest, AnUnloadedMeshKeptAliveByAStreamStillCountsAgainstTheBudget) {
+  service::ServerOptions options = TestServerOptions();
+  options.limits.max_memory_bytes = std::size_t{16} << 20;  // one 5000-vertex phantom, not two
+  StartServer(options);
+  const std::string mesh_id = LoadPhantom(5000);
+  StreamRecorder recorder;
+  auto stream = client_->OpenStream(mesh_id, recorder.Callbacks());
+  ASSERT_TRUE(stream->SendPose(KneePose(1, 10)));
+  ASSERT_TRUE(recorder.WaitForFrameWithSequence(1));
+  ASSERT_TRUE(client_->UnloadMesh(mesh_id).ok());
+
+  // The stream keeps the model in memory: the budget still counts it.
+  v1::MeshSummary summary;
+  const grpc::Status refused = client_->LoadPhantom(5000, {}, &summary);
+  EXPECT_EQ(refused.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_THAT(refused.error_message(), HasSubstr("by unloaded meshes that streams still use"));
+
+  stream->Close();
+  EXPECT_TRUE(stream->Wait().ok());
+  // Its last stream has ended: the memory is released.
+  grpc::Status loaded;
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    loaded = client_->LoadPhantom(5000, {}, &summary);
+    if (loaded.ok()) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  EXPECT_TRUE(loaded.ok()) << loaded.error_message();
+  ExpectBackgroundStreamAlive();
+}
+
 TEST_F(DeformStreamTest, HalfCloseAnswersTheLastPoseThenEndsOk) {
   StartServer();
   const std::string mesh_id = LoadPhantom(500);

@@ -4,16 +4,19 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "core/geometry/skeleton.h"
 #include "core/io/mesh_io.h"
 #include "core/io/phantom.h"
 #include "core/io/skeleton_io.h"
+#include "service/service_core.h"
 #include "tests/service/service_fixture.h"
 #include "tests/shared_data.h"
 
@@ -323,6 +326,178 @@ TEST_F(LoadMeshTest, MemoryBudgetIsResourceExhausted) {
   const grpc::Status status = client_->LoadPhantom(3000, {}, &summary);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
   EXPECT_THAT(status.error_message(), HasSubstr("memory budget"));
+  ExpectBackgroundStreamAlive();
+}
+
+TEST_F(LoadMeshTest, APhantomThatCannotFitIsRefusedBeforeAnythingIsBuilt) {
+  // A request of a few bytes for a model far larger than the budget: refused at the header, before
+  // the phantom is made (no stage reported), naming the estimate and the budget.
+  service::ServerOptions options = TestServerOptions();
+  options.limits.max_memory_bytes = std::size_t{256} << 20;
+  StartServer(options);
+  std::vector<v1::LoadMeshResponse::Stage> stages;
+  v1::MeshSummary summary;
+  const grpc::Status status = client_->LoadPhantom(
+      200'000, {}, &summary,
+      [&](const v1::LoadMeshResponse& progress) { stages.push_back(progress.stage()); });
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_THAT(status.error_message(), HasSubstr("a phantom of 200000 vertices needs about"));
+  EXPECT_THAT(status.error_message(), HasSubstr("of the 256 MiB budget"));
+  EXPECT_TRUE(stages.empty()) << stages.size() << " stages were reported before the refusal";
+  EXPECT_EQ(server_->server().core().registry.loads_in_progress(), 0);
+  EXPECT_EQ(server_->server().core().registry.memory_bytes_reserved(), 0u);
+  ExpectBackgroundStreamAlive();
+}
+
+TEST_F(LoadMeshTest, AnUploadInFlightHoldsItsBytesOfTheBudgetUntilItEnds) {
+  service::ServerOptions options = TestServerOptions();
+  options.limits.max_memory_bytes = std::size_t{64} << 20;
+  StartServer(options);
+  service::MeshRegistry& registry = server_->server().core().registry;
+  // An upload that announces 56 MiB and sends nothing more.
+  auto context = std::make_unique<grpc::ClientContext>();
+  auto stream = client_->stub()->LoadMesh(context.get());
+  v1::LoadMeshRequest request;
+  v1::UploadSource* upload = request.mutable_header()->mutable_upload();
+  upload->set_format(v1::MESH_FORMAT_OBJ);
+  upload->set_mesh_size_bytes(std::uint64_t{56} << 20);
+  upload->set_skeleton_format(v1::SKELETON_FORMAT_TGF);
+  upload->set_skeleton("1 0 0 0\n2 0 1 0\n#\n1 2\n#\n");
+  ASSERT_TRUE(stream->Write(request));
+  for (int i = 0; i < 600 && registry.memory_bytes_reserved() == 0; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ASSERT_GE(registry.memory_bytes_reserved(), std::size_t{56} << 20);
+
+  // A phantom that would fit in the budget alone does not fit beside the upload's bytes.
+  v1::MeshSummary summary;
+  const grpc::Status refused = client_->LoadPhantom(20'000, {}, &summary);
+  EXPECT_EQ(refused.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_THAT(refused.error_message(), HasSubstr("a phantom of 20000 vertices needs about"));
+
+  // The upload ends (its client cancels): its bytes and its slot are released.
+  context->TryCancel();
+  (void)stream->Finish();
+  for (int i = 0; i < 600 && registry.loads_in_progress() != 0; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  EXPECT_EQ(registry.loads_in_progress(), 0);
+  EXPECT_EQ(registry.memory_bytes_reserved(), 0u);
+  EXPECT_TRUE(client_->LoadPhantom(20'000, {}, &summary).ok());
+  ExpectBackgroundStreamAlive();
+}
+
+// Starts a LoadMesh of a large phantom on `stream` and reads its progress until the build has
+// begun (STAGE_VALIDATED: admitted, the phantom made, the model's precomputation under way).
+void StartLargePhantomBuild(
+    grpc::ClientReaderWriter<v1::LoadMeshRequest, v1::LoadMeshResponse>* stream) {
+  v1::LoadMeshRequest request;
+  request.mutable_header()->mutable_phantom()->set_vertices(100'000);
+  ASSERT_TRUE(stream->Write(request));
+  ASSERT_TRUE(stream->WritesDone());
+  v1::LoadMeshResponse progress;
+  while (stream->Read(&progress)) {
+    if (progress.stage() == v1::LoadMeshResponse::STAGE_VALIDATED) return;
+  }
+  FAIL() << "the load ended before its build began";
+}
+
+TEST_F(LoadMeshTest, AClientsCancelStopsItsBuildAndFreesTheSlot) {
+  StartServer();
+  const service::MeshRegistry& registry = server_->server().core().registry;
+  const int registered_before = registry.registrations();
+  grpc::ClientContext context;
+  auto stream = client_->stub()->LoadMesh(&context);
+  StartLargePhantomBuild(stream.get());
+  context.TryCancel();
+  EXPECT_EQ(stream->Finish().error_code(), grpc::StatusCode::CANCELLED);
+  for (int i = 0; i < 1200 && registry.loads_in_progress() != 0; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  EXPECT_EQ(registry.loads_in_progress(), 0);
+  EXPECT_EQ(registry.memory_bytes_reserved(), 0u);
+  // The build stopped between two phases: its model was never made, let alone registered.
+  EXPECT_EQ(registry.registrations(), registered_before);
+  ExpectBackgroundStreamAlive();
+}
+
+TEST_F(LoadMeshTest, ShutdownStopsABuildInProgress) {
+  StartServer();
+  const service::MeshRegistry& registry = server_->server().core().registry;
+  const int registered_before = registry.registrations();
+  grpc::ClientContext context;
+  auto stream = client_->stub()->LoadMesh(&context);
+  StartLargePhantomBuild(stream.get());
+  expect_background_ok_at_end_ = false;  // drained by the shutdown
+  server_->server().Shutdown(std::chrono::milliseconds(100));
+  // Shutdown returns once the workers have stopped: the build ended without a model.
+  EXPECT_EQ(registry.loads_in_progress(), 0);
+  EXPECT_EQ(registry.registrations(), registered_before);
+  const grpc::Status status = stream->Finish();
+  EXPECT_TRUE(status.error_code() == grpc::StatusCode::UNAVAILABLE ||
+              status.error_code() == grpc::StatusCode::CANCELLED)
+      << status.error_code() << " " << status.error_message();
+}
+
+// An upload's header announcing 1000 mesh bytes, and its first 100.
+void StartUpload(grpc::ClientReaderWriter<v1::LoadMeshRequest, v1::LoadMeshResponse>* stream) {
+  v1::LoadMeshRequest request;
+  v1::UploadSource* upload = request.mutable_header()->mutable_upload();
+  upload->set_format(v1::MESH_FORMAT_OBJ);
+  upload->set_mesh_size_bytes(1000);
+  upload->set_skeleton_format(v1::SKELETON_FORMAT_TGF);
+  upload->set_skeleton("1 0 0 0\n2 0 1 0\n#\n1 2\n#\n");
+  ASSERT_TRUE(stream->Write(request));
+  request.set_chunk(std::string(100, ' '));
+  ASSERT_TRUE(stream->Write(request));
+}
+
+TEST_F(LoadMeshTest, AStalledUploadEndsAfterTheIdleTimeoutAndFreesItsSlot) {
+  service::ServerOptions options = TestServerOptions();
+  options.limits.upload_idle_timeout_ms = 300;
+  options.limits.max_meshes = 2;  // the background mesh and the upload
+  StartServer(options);
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(120));
+  auto stream = client_->stub()->LoadMesh(&context);
+  StartUpload(stream.get());
+  v1::LoadMeshResponse progress;
+  while (stream->Read(&progress)) {
+  }
+  const grpc::Status status = stream->Finish();
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::DEADLINE_EXCEEDED);
+  EXPECT_THAT(status.error_message(),
+              HasSubstr("no upload data for 0.3 s (--upload-idle-timeout-s)"));
+  const service::MeshRegistry& registry = server_->server().core().registry;
+  for (int i = 0; i < 1200 && registry.loads_in_progress() != 0; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  EXPECT_EQ(registry.loads_in_progress(), 0);
+  v1::MeshSummary summary;
+  EXPECT_TRUE(client_->LoadPhantom(300, {}, &summary).ok());  // the slot is free again
+  ExpectBackgroundStreamAlive();
+}
+
+TEST_F(LoadMeshTest, AnUploadThatNeverEndsStopsAtTheTimeLimit) {
+  service::ServerOptions options = TestServerOptions();
+  options.limits.upload_idle_timeout_ms = 0;
+  options.limits.upload_time_limit_ms = 500;
+  StartServer(options);
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(120));
+  auto stream = client_->stub()->LoadMesh(&context);
+  StartUpload(stream.get());
+  // A byte now and then: never idle, never complete.
+  v1::LoadMeshRequest trickle;
+  trickle.set_chunk(" ");
+  while (stream->Write(trickle)) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  v1::LoadMeshResponse progress;
+  while (stream->Read(&progress)) {
+  }
+  const grpc::Status status = stream->Finish();
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::DEADLINE_EXCEEDED);
+  EXPECT_THAT(status.error_message(),
+              HasSubstr("the upload took longer than 0.5 s (--upload-time-limit-s)"));
   ExpectBackgroundStreamAlive();
 }
 

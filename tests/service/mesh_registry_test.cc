@@ -86,6 +86,36 @@ TEST(MeshRegistryTest, MemoryBudgetRefusesAModelThatDoesNotFit) {
   EXPECT_FALSE(registry.Reserve().ok());
 }
 
+TEST(MeshRegistryTest, LoadsInProgressHoldTheirMemoryUntilRegisteredOrReleased) {
+  const auto model = SmallModel();
+  ServiceLimits limits;
+  limits.max_memory_bytes = std::size_t{10} << 20;
+  limits.tenant_max_memory_bytes = std::size_t{8} << 20;
+  MeshRegistry registry(limits);
+  auto first = registry.Reserve("a").value();
+  auto second = registry.Reserve("b").value();
+  ASSERT_TRUE(registry.ReserveMemory(&first, std::size_t{6} << 20, "the first").ok());
+  // The last of the budget cannot be taken twice.
+  const Status refused = registry.ReserveMemory(&second, std::size_t{6} << 20, "the second");
+  EXPECT_EQ(refused.code(), StatusCode::kResourceExhausted);
+  EXPECT_THAT(refused.message(), HasSubstr("the second needs about 6 MiB, 6 MiB of the 10 MiB"));
+  EXPECT_EQ(second.memory_bytes(), 0u);
+  // A reservation may shrink or grow within what is left; the tenant's budget counts it too.
+  ASSERT_TRUE(registry.ReserveMemory(&first, std::size_t{1} << 20, "the first").ok());
+  EXPECT_EQ(registry.memory_bytes_reserved(), std::size_t{1} << 20);
+  const Status tenant = registry.ReserveMemory(&second, std::size_t{9} << 20, "the second");
+  EXPECT_THAT(tenant.message(), HasSubstr("tenant memory budget"));
+  ASSERT_TRUE(registry.ReserveMemory(&second, std::size_t{6} << 20, "the second").ok());
+  EXPECT_EQ(registry.loads_in_progress(), 2);
+  // Registering swaps the reservation's memory for the model's; releasing frees it.
+  ASSERT_TRUE(registry.Register(std::move(first), "first", model).ok());
+  EXPECT_EQ(registry.memory_bytes_reserved(), std::size_t{6} << 20);
+  EXPECT_EQ(registry.memory_bytes_used(), model->EstimatedBytes());
+  second.Release();
+  EXPECT_EQ(registry.memory_bytes_reserved(), 0u);
+  EXPECT_EQ(registry.loads_in_progress(), 0);
+}
+
 TEST(StatusMappingTest, KeepsCodeAndMessage) {
   EXPECT_TRUE(ToGrpcStatus(Status::Ok()).ok());
   const grpc::Status status = ToGrpcStatus(Status::ResourceExhausted("too big"));

@@ -180,6 +180,33 @@ TEST_F(TenancyTest, PerTenantMeshAndStreamLimits) {
   EXPECT_TRUE(again.ok()) << again.error_message();
 }
 
+TEST_F(TenancyTest, TheServerStreamLimitCountsEveryTenantsStreams) {
+  service::ServerOptions options = TestServerOptions();
+  options.limits.max_streams = 1;
+  Start(options);
+  const std::string a_mesh = LoadPhantom(*ward_a_);
+  const std::string b_mesh = LoadPhantom(*ward_b_);
+  StreamRecorder first;
+  auto open = ward_a_->OpenStream(a_mesh, first.Callbacks());
+  v1::PoseUpdate pose;
+  pose.set_sequence(1);
+  ASSERT_TRUE(open->SendPose(pose));
+  ASSERT_TRUE(first.WaitForFrames(1));
+  // Another tenant, with no per-tenant limit, is refused too: the server's streams are all taken.
+  const grpc::Status refused = StreamStatus(*ward_b_, b_mesh);
+  EXPECT_EQ(refused.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
+  EXPECT_THAT(refused.error_message(), HasSubstr("--max-streams"));
+  open->Close();
+  EXPECT_TRUE(open->Wait().ok());
+  grpc::Status again;
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    again = StreamStatus(*ward_b_, b_mesh);
+    if (again.ok()) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  EXPECT_TRUE(again.ok()) << again.error_message();
+}
+
 TEST_F(TenancyTest, PerTenantMemoryBudget) {
   service::ServerOptions options = TestServerOptions();
   options.limits.tenant_max_memory_bytes = 1;  // less than any mesh

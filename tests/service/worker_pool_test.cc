@@ -9,6 +9,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace deform::service {
@@ -102,6 +103,33 @@ TEST(WorkerPoolTest, BackgroundWorkLeavesOneWorkerForUrgentTasks) {
   release_first.Open();
   pool.Shutdown();
   EXPECT_EQ(log.events(), (std::vector<std::string>{"urgent", "first", "second"}));
+}
+
+// Urgent work that never lets up: runs, then posts itself again until stopped.
+class EndlessUrgentTask final : public UrgentTask,
+                                public std::enable_shared_from_this<EndlessUrgentTask> {
+ public:
+  EndlessUrgentTask(WorkerPool* pool, std::atomic<bool>* stop) : pool_(pool), stop_(stop) {}
+  void RunUrgent() override {
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
+    if (!stop_->load()) pool_->PostUrgent(shared_from_this());
+  }
+
+ private:
+  WorkerPool* const pool_;
+  std::atomic<bool>* const stop_;
+};
+
+TEST(WorkerPoolTest, BackgroundWorkRunsHoweverBusyUrgentWorkKeepsThePool) {
+  WorkerPool pool(2);
+  std::atomic<bool> stop{false};
+  // More urgent work than workers, queued at every moment.
+  for (int i = 0; i < 4; ++i) pool.PostUrgent(std::make_shared<EndlessUrgentTask>(&pool, &stop));
+  Gate background_ran;
+  pool.PostBackground([&] { background_ran.Open(); });
+  EXPECT_TRUE(background_ran.Wait()) << "the background task was starved";
+  stop.store(true);
+  pool.Shutdown();
 }
 
 TEST(WorkerPoolTest, ShutdownRunsEverythingQueuedIncludingWorkPostedByTasks) {

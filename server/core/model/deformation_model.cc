@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cassert>
 #include <chrono>
+#include <cmath>
 #include <string>
 #include <utility>
 
@@ -78,32 +79,37 @@ StatusOr<std::shared_ptr<const DeformationModel>> DeformationModel::Build(
   DEFORM_RETURN_IF_ERROR(ValidateMesh(mesh, options.limits));
   DEFORM_RETURN_IF_ERROR(ValidateModelOptions(options));
   if (hooks.validated) DEFORM_RETURN_IF_ERROR(hooks.validated());
+  DEFORM_RETURN_IF_ERROR(CheckCancelled(hooks.cancel, "validation"));
   std::shared_ptr<DeformationModel> model(new DeformationModel());
   model->id_ = NextModelId();
   model->mesh_ = std::move(mesh);
   model->skeleton_ = std::move(skeleton);
   model->options_ = options;
-  DEFORM_RETURN_IF_ERROR(model->Precompute(weights));
+  DEFORM_RETURN_IF_ERROR(model->Precompute(weights, hooks.cancel));
   model->precompute_seconds_ = SecondsSince(start);
   if (hooks.precomputed) hooks.precomputed();
-  DEFORM_ASSIGN_OR_RETURN(model->default_factorization_, model->Factorize(Stiffness{}));
+  DEFORM_ASSIGN_OR_RETURN(model->default_factorization_,
+                          model->FactorizeCancellable(Stiffness{}, hooks.cancel));
   spdlog::debug("model built: {} vertices, {} joint nodes, {} anchors, factor {} non-zeros",
                 model->mesh_.num_vertices(), model->system_.num_nodes,
                 model->system_.anchors.size(), model->default_factorization_->factor().nonzeros());
   return std::shared_ptr<const DeformationModel>(std::move(model));
 }
 
-Status DeformationModel::Precompute(const SkinWeights* weights) {
+Status DeformationModel::Precompute(const SkinWeights* weights, const CancelToken* cancel) {
   diagonal_ = BoundingBoxDiagonal(mesh_.vertices);
   const VertexAdjacency adjacency = BuildVertexAdjacency(mesh_.triangles, mesh_.num_vertices());
   const TriangleBvh bvh(mesh_);
   DEFORM_RETURN_IF_ERROR(CheckSkeletonAgainstMesh(mesh_, skeleton_, bvh));
+  DEFORM_RETURN_IF_ERROR(CheckCancelled(cancel, "the mesh's adjacency"));
   if (weights != nullptr) {
     DEFORM_RETURN_IF_ERROR(BindToWeights(*weights, adjacency));
   } else {
-    DEFORM_RETURN_IF_ERROR(BindAutomatically(adjacency, bvh));
+    DEFORM_RETURN_IF_ERROR(BindAutomatically(adjacency, bvh, cancel));
   }
+  DEFORM_RETURN_IF_ERROR(CheckCancelled(cancel, "the harmonic weights"));
   system_ = BuildLaplacianSystem(mesh_, adjacency, regions_, rigid_bones_, bone_weights_, options_);
+  DEFORM_RETURN_IF_ERROR(CheckCancelled(cancel, "the Laplacian system"));
   if (options_.rotation_blend == RotationBlend::kLinear) {
     linear_blend_plan_ = std::make_shared<const LinearBlendPlan>(LinearBlendPlan::Build(
         bone_weights_, skeleton_.num_bones(), options_.linear_blend_segments));
@@ -115,13 +121,14 @@ Status DeformationModel::Precompute(const SkinWeights* weights) {
   report.reached_along_surface = binding_report_.reached_along_surface;
   report.straight_line = binding_report_.straight_line;
   binding_report_ = std::move(report);
+  DEFORM_RETURN_IF_ERROR(CheckCancelled(cancel, "the binding report"));
   DEFORM_ASSIGN_OR_RETURN(
       symbolic_, SymbolicCholesky::Analyze(NormalMatrixPattern(system_), options_.ordering));
-  return Status::Ok();
+  return CheckCancelled(cancel, "the symbolic analysis");
 }
 
 Status DeformationModel::BindAutomatically(const VertexAdjacency& adjacency,
-                                           const TriangleBvh& bvh) {
+                                           const TriangleBvh& bvh, const CancelToken* cancel) {
   std::vector<NearestBone> bound;
   if (options_.binding == BindingMethod::kThroughBody) {
     BodyBinding binding = BindThroughBody(mesh_, skeleton_, adjacency, bvh);
@@ -135,11 +142,13 @@ Status DeformationModel::BindAutomatically(const VertexAdjacency& adjacency,
     binding_report_.source = "straight line";
     binding_report_.straight_line = mesh_.num_vertices();
   }
+  DEFORM_RETURN_IF_ERROR(CheckCancelled(cancel, "the binding"));
   DEFORM_ASSIGN_OR_RETURN(
       JointRegions regions,
       ComputeJointRegions(mesh_, skeleton_, adjacency, bound, options_.regions));
   regions_ = KeepRigidCores(mesh_, adjacency, bound, std::move(regions), kMinRigidFraction);
   rigid_bones_ = RigidZones(regions_, bound);
+  DEFORM_RETURN_IF_ERROR(CheckCancelled(cancel, "the joint regions"));
   DEFORM_ASSIGN_OR_RETURN(bone_weights_,
                           HarmonicBoneWeights(adjacency, rigid_bones_, skeleton_.num_bones(),
                                               RegionBonesPerVertex(regions_, skeleton_, bound)));
@@ -167,6 +176,11 @@ Status DeformationModel::BindToWeights(const SkinWeights& weights,
 
 StatusOr<std::shared_ptr<const MaterialFactorization>> DeformationModel::Factorize(
     const Stiffness& stiffness) const {
+  return FactorizeCancellable(stiffness, nullptr);
+}
+
+StatusOr<std::shared_ptr<const MaterialFactorization>> DeformationModel::FactorizeCancellable(
+    const Stiffness& stiffness, const CancelToken* cancel) const {
   const auto start = Clock::now();
   auto result = std::make_shared<MaterialFactorization>();
   result->model_id_ = id_;
@@ -175,6 +189,7 @@ StatusOr<std::shared_ptr<const MaterialFactorization>> DeformationModel::Factori
   DEFORM_ASSIGN_OR_RETURN(
       result->factor_, CholeskyFactor::Factorize(
                            symbolic_, deform::NormalMatrix(system_, result->row_weights_squared_)));
+  DEFORM_RETURN_IF_ERROR(CheckCancelled(cancel, "the numeric factorisation"));
   if (options_.rotation_blend == RotationBlend::kLinear) {
     result->linear_response_ = BuildLinearPoseResponse(
         system_, skeleton_, linear_blend_plan_, result->row_weights_squared_, result->factor_);
@@ -200,17 +215,27 @@ Eigen::SparseMatrix<double> DeformationModel::NormalMatrix(
   return deform::NormalMatrix(system_, factorization.row_weights_squared_);
 }
 
+namespace {
+
+// Without the factor: per vertex and per triangle (EstimatedBytes).
+std::size_t GeometryBytes(int num_vertices, int num_triangles) {
+  return static_cast<std::size_t>(std::max(num_vertices, 0)) * DeformationModel::kBytesPerVertex +
+         static_cast<std::size_t>(std::max(num_triangles, 0)) * DeformationModel::kBytesPerTriangle;
+}
+
+}  // namespace
+
 std::size_t DeformationModel::EstimateBytesBeforeBuild(int num_vertices, int num_triangles) {
-  constexpr std::size_t kBytesPerVertex = 400;
-  constexpr std::size_t kBytesPerTriangle = 12;
-  return static_cast<std::size_t>(num_vertices) * kBytesPerVertex +
-         static_cast<std::size_t>(num_triangles) * kBytesPerTriangle;
+  const double n = std::max(num_vertices, 2);
+  const auto factor =
+      static_cast<std::size_t>(static_cast<double>(kFactorBytesPerVertexLog2) * n * std::log2(n));
+  return GeometryBytes(num_vertices, num_triangles) + factor;
 }
 
 std::size_t DeformationModel::EstimatedBytes() const {
   const LinearPoseResponse* response = default_factorization_->linear_response();
   return default_factorization_->factor().bytes() + (response ? response->bytes() : 0) +
-         EstimateBytesBeforeBuild(mesh_.num_vertices(), mesh_.num_triangles());
+         GeometryBytes(mesh_.num_vertices(), mesh_.num_triangles());
 }
 
 DeformScratch DeformationModel::MakeScratch() const {

@@ -26,6 +26,7 @@
 #include <optional>
 #include <vector>
 
+#include "core/base/cancel_token.h"
 #include "core/base/status.h"
 #include "core/geometry/mesh.h"
 #include "core/geometry/pose.h"
@@ -98,6 +99,13 @@ struct BuildHooks {
   // Once the weights, regions and symbolic analysis are done, before the first numeric
   // factorisation (for progress reports).
   std::function<void()> precomputed;
+  // Polled between the build's phases (validation, binding, joint regions, harmonic weights, the
+  // Laplacian system, symbolic analysis, numeric factorisation, linear response): once it is
+  // cancelled, Build frees what it made and returns FAILED_PRECONDITION "cancelled during
+  // <phase>" at the end of the phase in progress. A phase itself is not interrupted (the longest
+  // are the symbolic analysis and the numeric factorisation: README, "Limits"). Null:
+  // never cancelled. Must outlive the Build call.
+  const CancelToken* cancel = nullptr;
 };
 
 class DeformationModel {
@@ -192,11 +200,20 @@ class DeformationModel {
   // Seconds spent in Build() before the first numeric factorisation.
   double precompute_seconds() const { return precompute_seconds_; }
 
-  // The memory a model holds, estimated; the one formula behind every memory budget. Before the
-  // build, from the mesh's size alone: per vertex its rest and differential coordinates, Laplacian
-  // rows (both orientations), bone weights and region data (about 400 bytes in all), plus 12 bytes
-  // per triangle; a lower bound of EstimatedBytes(), which adds the default factorisation's factor
-  // and linear response once they are known.
+  // The memory a model holds, estimated; the one formula behind every memory budget, calibrated
+  // against the growth of a server's resident memory when it loads the model (the 133k-vertex
+  // arm: 266 MiB measured; README, "Limits").
+  // EstimatedBytes(), once built: the default factorisation's factor and linear response as they
+  // are, plus kBytesPerVertex per vertex (rest and differential coordinates, Laplacian rows in both
+  // orientations, bone weights, region data, the normal matrix's pattern the symbolic analysis
+  // keeps) and kBytesPerTriangle per triangle.
+  // EstimateBytesBeforeBuild(), from the mesh's size alone (admission: what a load is refused on
+  // before anything is allocated): the same, with the factor predicted as
+  // kFactorBytesPerVertexLog2 * n * log2(n) (the nested-dissection fill of a surface mesh; above
+  // the measured factor on the phantoms and the arm, so it errs towards refusing).
+  static constexpr std::size_t kBytesPerVertex = 1400;
+  static constexpr std::size_t kBytesPerTriangle = 12;
+  static constexpr std::size_t kFactorBytesPerVertexLog2 = 80;
   static std::size_t EstimateBytesBeforeBuild(int num_vertices, int num_triangles);
   std::size_t EstimatedBytes() const;
 
@@ -209,9 +226,14 @@ class DeformationModel {
   void AssembleOwnedRightHandSide(const MaterialFactorization& factorization, const Pose& pose,
                                   DeformScratch* scratch) const;
   void SolveOwnedInPlace(const MaterialFactorization& factorization, DeformScratch* scratch) const;
-  Status Precompute(const SkinWeights* weights);
+  Status Precompute(const SkinWeights* weights, const CancelToken* cancel);
   // The binding steps of Precompute: set regions_, bone_weights_, rigid_bones_, bound_bones_.
-  Status BindAutomatically(const VertexAdjacency& adjacency, const TriangleBvh& bvh);
+  Status BindAutomatically(const VertexAdjacency& adjacency, const TriangleBvh& bvh,
+                           const CancelToken* cancel);
+  // Factorize, stopping between the numeric factorisation and the linear response when `cancel`
+  // (may be null) is cancelled.
+  StatusOr<std::shared_ptr<const MaterialFactorization>> FactorizeCancellable(
+      const Stiffness& stiffness, const CancelToken* cancel) const;
   Status BindToWeights(const SkinWeights& weights, const VertexAdjacency& adjacency);
   // The vertex rows' weights w_i for `stiffness` (all 1 with uniform_material).
   StatusOr<Eigen::VectorXd> RowWeights(const Stiffness& stiffness) const;

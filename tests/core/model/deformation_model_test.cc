@@ -289,12 +289,56 @@ TEST(DeformationModel, TheValidatedHookCanStopTheBuild) {
   EXPECT_FALSE(precomputed);
 }
 
-TEST(DeformationModel, EstimatedBytesAddTheFactorToTheEstimateBeforeTheBuild) {
+TEST(DeformationModel, ACancelledBuildStopsAtTheEndOfThePhaseInProgress) {
+  auto phantom = MakeKneePhantom(600);
+  CancelToken parent;
+  CancelToken token(&parent);
+  BuildHooks hooks;
+  hooks.cancel = &token;
+  // Cancelled (through its parent) while the binding is about to start: nothing more is built.
+  bool precomputed = false;
+  hooks.validated = [&] {
+    parent.Cancel();
+    return Status::Ok();
+  };
+  hooks.precomputed = [&] { precomputed = true; };
+  auto stopped = DeformationModel::Build(phantom->mesh, phantom->skeleton, {}, hooks);
+  EXPECT_EQ(stopped.status().ToString(), "FAILED_PRECONDITION: cancelled during validation");
+  EXPECT_FALSE(precomputed);
+
+  // Cancelled once the precomputation is done: the numeric factorisation is not interrupted, the
+  // build stops after it.
+  CancelToken late;
+  hooks.cancel = &late;
+  hooks.validated = {};
+  hooks.precomputed = [&] { late.Cancel(); };
+  auto after_factor = DeformationModel::Build(phantom->mesh, phantom->skeleton, {}, hooks);
+  EXPECT_EQ(after_factor.status().ToString(),
+            "FAILED_PRECONDITION: cancelled during the numeric factorisation");
+
+  CancelToken never;
+  hooks.cancel = &never;
+  hooks.precomputed = {};
+  EXPECT_TRUE(DeformationModel::Build(phantom->mesh, phantom->skeleton, {}, hooks).ok());
+}
+
+TEST(DeformationModel, EstimatedBytesAddTheFactorToTheGeometry) {
   auto model = BuildPhantomModel(600);
   const std::size_t before = DeformationModel::EstimateBytesBeforeBuild(
       model->mesh().num_vertices(), model->mesh().num_triangles());
-  EXPECT_EQ(before, 400u * model->mesh().num_vertices() + 12u * model->mesh().num_triangles());
-  EXPECT_EQ(model->EstimatedBytes(), before + model->default_factorization()->factor().bytes());
+  const std::size_t geometry =
+      DeformationModel::kBytesPerVertex * model->mesh().num_vertices() +
+      DeformationModel::kBytesPerTriangle * model->mesh().num_triangles();
+  EXPECT_EQ(model->EstimatedBytes(), geometry + model->default_factorization()->factor().bytes());
+  // Before the build the factor is predicted, from above: admission errs towards refusing.
+  EXPECT_GT(before, geometry + model->default_factorization()->factor().bytes());
+}
+
+TEST(DeformationModel, TheEstimateBeforeTheBuildGrowsFasterThanTheMesh) {
+  // A 2,000,000-vertex mesh needs more than 4 GiB (the default budget): refused before the build.
+  EXPECT_GT(DeformationModel::EstimateBytesBeforeBuild(2'000'000, 4'000'000), std::size_t{4} << 30);
+  EXPECT_GT(DeformationModel::EstimateBytesBeforeBuild(200'000, 400'000),
+            2 * DeformationModel::EstimateBytesBeforeBuild(100'000, 200'000));
 }
 
 TEST(DeformationModel, ExplicitRegionRadiusIsUsed) {
