@@ -222,7 +222,7 @@ inline GltfBuilder ChainRig(const std::vector<Eigen::Vector3d>& positions,
   nlohmann::json mesh = {{"primitives", nlohmann::json::array()}};
   for (const PrimitiveData& data : primitives)
     mesh["primitives"].push_back(AddPrimitive(&builder, data));
-  builder.doc()["meshes"] = {mesh};
+  builder.doc()["meshes"] = nlohmann::json::array({mesh});
   builder.AddNode({{"name", "mesh"}, {"mesh", 0}, {"skin", 0}});
   builder.doc()["scenes"] = {{{"nodes", {0, positions.size()}}}};
   return builder;
