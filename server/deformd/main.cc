@@ -6,7 +6,11 @@
 //           [--keepalive-s S] [--keepalive-timeout-s S] [--idle-timeout-s S]
 //           [--tls-cert PEM --tls-key PEM [--tls-client-ca PEM]] [--plaintext]
 //           [--token-file FILE] [--tenant-max-meshes N] [--tenant-max-streams N]
-//           [--tenant-max-memory-mb N] [--preload-tenant NAME] [--store DIR]
+//           [--tenant-max-memory-mb N] [--preload-tenant NAME] [--store DIR] [--metrics ADDR]
+//
+// --metrics ADDR serves GET /metrics in Prometheus' format on its own port: plain HTTP, on a
+// loopback address unless --plaintext, and with a token file for operators' tokens only
+// (service/metrics_endpoint.h).
 //
 // --store DIR keeps loaded meshes on disk and builds them again, under their ids and owners, when
 // the server starts (service/mesh_store.h); preloads are not kept (their flags bring them back).
@@ -218,6 +222,10 @@ int main(int argc, char** argv) {
   app.add_option("--tenant-max-memory-mb", args.tenant_max_memory_mb,
                  "Memory budget per tenant (same estimate as --max-memory-mb), MiB; 0 = none")
       ->capture_default_str();
+  app.add_option("--metrics", args.server.metrics_address,
+                 "Serve Prometheus metrics at http://ADDR/metrics (host:port; port 0 picks one; a "
+                 "non-loopback address needs --plaintext)")
+      ->envname("DEFORMD_METRICS");
   app.add_option("--store", args.store_dir,
                  "Keep loaded meshes in DIR (0700) and restore them at start-up")
       ->envname("DEFORMD_STORE");

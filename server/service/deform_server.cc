@@ -12,6 +12,8 @@
 #include "service/log_text.h"
 #include "service/mesh_loader.h"
 #include "service/mesh_store.h"
+#include "service/metrics_endpoint.h"
+#include "service/rpc_metrics_interceptor.h"
 #include "service/service_core.h"
 #include "service/transport_security.h"
 
@@ -31,6 +33,20 @@ void ApplyConnectionOptions(const ConnectionOptions& options, grpc::ServerBuilde
                               options.min_client_ping_interval_ms);
 }
 
+// The metrics page: the gauges from the service's state now, then everything serialised.
+std::string RenderMetrics(ServiceCore* core) {
+  ServiceMetrics::Gauges gauges;
+  gauges.streams_open = core->streams.count();
+  gauges.meshes_loaded = core->registry.mesh_count();
+  gauges.loads_in_progress = core->registry.loads_in_progress();
+  gauges.memory_used_bytes = core->registry.memory_bytes_used();
+  gauges.memory_reserved_bytes = core->registry.memory_bytes_reserved();
+  gauges.memory_budget_bytes = core->limits.max_memory_bytes;
+  gauges.notice_backlog_bytes = core->notice_backlog_bytes.load(std::memory_order_relaxed);
+  core->metrics.SetGauges(gauges);
+  return core->metrics.Serialize();
+}
+
 }  // namespace
 
 struct DeformServer::Impl {
@@ -41,6 +57,7 @@ struct DeformServer::Impl {
   ServiceCore core;
   DeformServiceImpl service;
   std::unique_ptr<grpc::Server> server;
+  std::unique_ptr<MetricsEndpoint> metrics;  // null without options.metrics_address
   int port = 0;
   Mutex shutdown_mutex;  // serialises Shutdown()
   bool shut_down DEFORM_GUARDED_BY(shutdown_mutex) = false;
@@ -67,9 +84,21 @@ Status DeformServer::Start() {
   builder.SetMaxReceiveMessageSize(impl_->options.max_message_bytes);
   builder.SetMaxSendMessageSize(impl_->options.max_message_bytes);
   ApplyConnectionOptions(impl_->options.connections, &builder);
+  std::vector<std::unique_ptr<grpc::experimental::ServerInterceptorFactoryInterface>> interceptors;
+  interceptors.push_back(std::make_unique<RpcMetricsInterceptorFactory>(&impl_->core.metrics));
+  builder.experimental().SetInterceptorCreators(std::move(interceptors));
+  if (!impl_->options.metrics_address.empty()) {
+    ServiceCore* core = &impl_->core;
+    DEFORM_ASSIGN_OR_RETURN(
+        impl_->metrics,
+        MetricsEndpoint::Start(impl_->options.metrics_address,
+                               impl_->options.security.allow_plaintext, &core->auth,
+                               [core] { return RenderMetrics(core); }));
+  }
   impl_->server = builder.BuildAndStart();
   if (impl_->server == nullptr || impl_->port == 0) {
     impl_->server.reset();
+    impl_->metrics.reset();
     return Status::FailedPrecondition("cannot listen on '" + impl_->options.listen_address + "'");
   }
   if (grpc::HealthCheckServiceInterface* health = impl_->server->GetHealthCheckService()) {
@@ -96,6 +125,7 @@ Status DeformServer::UseStore(const std::string& dir, int* restored) {
     if (job.ok()) {
       job->id = stored.id;
       job->start = start;
+      job->metrics = &core.metrics;
       auto reservation = core.registry.Reserve(stored.tenant);
       entry = reservation.ok() ? BuildAndRegister(&core.registry, std::move(*reservation),
                                                   std::move(*job))
@@ -135,6 +165,10 @@ Status DeformServer::ReloadTokens() {
 
 int DeformServer::port() const { return impl_->port; }
 
+int DeformServer::metrics_port() const {
+  return impl_->metrics != nullptr ? impl_->metrics->port() : 0;
+}
+
 std::string DeformServer::listening_address() const {
   const std::string& address = impl_->options.listen_address;
   const std::size_t colon = address.rfind(':');
@@ -152,6 +186,7 @@ StatusOr<std::shared_ptr<const MeshEntry>> DeformServer::Preload(ModelInput inpu
   job.mesh = std::move(input.mesh);
   job.skeleton = std::move(input.skeleton);
   job.options = ModelOptions::Paper();
+  job.metrics = &impl_->core.metrics;
   return BuildAndRegister(&impl_->core.registry, std::move(reservation), std::move(job));
 }
 
@@ -170,6 +205,7 @@ void DeformServer::Shutdown(std::chrono::milliseconds grace) {
     impl_->server->Wait();
   }
   impl_->core.pool.Shutdown();
+  impl_->metrics.reset();
   spdlog::info("stopped");
 }
 

@@ -32,6 +32,22 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// Counts a message whose write completed (what the client received) in `metrics`.
+void CountWritten(const v1::DeformResponse& message, ServiceMetrics* metrics) {
+  if (message.has_notice()) {
+    metrics->NoticeWritten(message.notice().kind());
+    return;
+  }
+  if (!message.has_frame()) return;
+  const v1::DeformFrame& frame = message.frame();
+  const v1::FrameTimings& t = frame.timings();
+  const double server_ms = t.queue_ms() + t.rhs_ms() + t.solve_ms() + t.encode_ms();
+  const int encoding =
+      frame.has_encoded() ? frame.encoded().encoding() : v1::FRAME_ENCODING_FLOAT32;
+  metrics->FrameWritten(encoding, message.ByteSizeLong(), server_ms * 1e-3,
+                        frame.skipped_poses());
+}
+
 // The reactor coordinates the stream's parts; each part states its own contract:
 //  PendingPoseSlot (latest wins, skipped poses, the solve task's state), StiffnessSwitch (the
 //  factorisation in use and the refactorisations), DeformOutbox (notices and frame slots, in
@@ -73,8 +89,13 @@ class DeformStreamReactor final
   // Drainable.
   void Drain() DEFORM_EXCLUDES(mutex_) override;
 
-  // Posts the background refactorisation of `update`.
+  // Posts the background refactorisation of `update`, once the memory budgets hold its
+  // factorisation (else KIND_STIFFNESS_REJECTED naming the budget).
   void StartRefactorLocked(StiffnessSwitch::Update update) DEFORM_REQUIRES(mutex_);
+  // Makes memory_ hold the buffers and one factorisation's bytes for each factorisation of the
+  // stream's own that may be alive: the current one unless it is the model's default, the next
+  // one waiting to be switched in, and `running` being built.
+  Status HoldFactorizationsLocked(int running, const std::string& what) DEFORM_REQUIRES(mutex_);
   // On a worker: the refactorisation, then its result handed to the stream.
   void Refactor(const StiffnessSwitch::Update& update) DEFORM_EXCLUDES(mutex_);
   // Switches the finished factorisation in, with its KIND_STIFFNESS_APPLIED notice. Only between
@@ -114,7 +135,13 @@ class DeformStreamReactor final
   DeformOutbox outbox_ DEFORM_GUARDED_BY(mutex_);
   StreamWritePump<v1::DeformResponse> pump_ DEFORM_GUARDED_BY(mutex_){
       this, &sink_, FinishRule::kErrorOverridesGraceful};
+  // The message being written (DeformOutbox keeps it untouched until the next TakeNextWrite).
+  const v1::DeformResponse* in_flight_ DEFORM_GUARDED_BY(mutex_) = nullptr;
   std::uint64_t frames_written_ DEFORM_GUARDED_BY(mutex_) = 0;
+  // The stream's memory beyond its mesh in the budgets: its buffers (buffer_bytes_, set by
+  // HandleStart before they are allocated) and its own factorisations (HoldFactorizationsLocked).
+  MeshRegistry::MemoryHold memory_ DEFORM_GUARDED_BY(mutex_);
+  std::size_t buffer_bytes_ DEFORM_GUARDED_BY(mutex_) = 0;
   std::uint64_t poses_rejected_ DEFORM_GUARDED_BY(mutex_) = 0;
   bool reading_paused_ DEFORM_GUARDED_BY(mutex_) = false;
 };
@@ -199,6 +226,23 @@ void DeformStreamReactor::HandleStart() {
   }
   const std::size_t encoded_bytes = *encoder ? (*encoder)->max_encoded_bytes() : 0;
   const int transform_floats = codec::kFloatsPerBoneTransform * model_->skeleton().num_bones();
+  {
+    // The buffers are counted in the memory budgets before they are allocated: the solve's
+    // scratch, the frames (FrameSlots: three) and a compact encoder's records and output.
+    const auto vertices = static_cast<std::size_t>(entry_->client_vertex_count());
+    const std::size_t frame_bytes = encoded_bytes > 0
+                                        ? encoded_bytes + sizeof(float) * transform_floats
+                                        : vertices * 3 * sizeof(float);
+    MutexLock lock(&mutex_);
+    buffer_bytes_ = model_->ScratchBytes() + 3 * frame_bytes +
+                    (encoded_bytes > 0 ? encoded_bytes + vertices * 8 : 0);
+    memory_ = core_->registry.HoldMemory(caller_.tenant);
+    const Status held = memory_.Resize(buffer_bytes_, "a Deform stream's buffers");
+    if (!held.ok()) {
+      FailLocked(ToGrpcCode(held.code()), held.message());
+      return;
+    }
+  }
   // Everything a solve needs, sized once; frames in the client's vertex order.
   solver_.emplace(*model_, entry_->presentation.file_vertex_to_mesh, std::move(*encoder));
   spdlog::info("{} opened", log_context_);
@@ -274,7 +318,24 @@ void DeformStreamReactor::ReadNextLocked() {
   StartRead(&request_);
 }
 
+Status DeformStreamReactor::HoldFactorizationsLocked(int running, const std::string& what) {
+  const bool own_current = stiffness_.current() != model_->default_factorization();
+  const std::size_t count =
+      (own_current ? 1 : 0) + (stiffness_.has_next() ? 1 : 0) + static_cast<std::size_t>(running);
+  return memory_.Resize(buffer_bytes_ + count * model_->FactorizationBytes(), what);
+}
+
 void DeformStreamReactor::StartRefactorLocked(StiffnessSwitch::Update update) {
+  const Status held = HoldFactorizationsLocked(
+      1, "the factorisation of stiffness version " + std::to_string(update.version));
+  if (!held.ok()) {
+    spdlog::info("{} stiffness version {} rejected: {}", log_context_, update.version,
+                 held.message());
+    outbox_.AddNotice(v1::Notice::KIND_STIFFNESS_REJECTED, 0, update.version,
+                      "stiffness version " + std::to_string(update.version) + ": " +
+                          held.message());
+    return;
+  }
   stiffness_.RefactorStarted();
   core_->pool.PostBackground(
       [self = SharedFromThis(), update = std::move(update)] { self->Refactor(update); });
@@ -286,10 +347,15 @@ void DeformStreamReactor::Refactor(const StiffnessSwitch::Update& update) {
     MutexLock lock(&mutex_);
     skip = pump_.failing();
   }
+  const auto started = std::chrono::steady_clock::now();
   StatusOr<std::shared_ptr<const MaterialFactorization>> result =
       skip ? StatusOr<std::shared_ptr<const MaterialFactorization>>(
                  Status::FailedPrecondition("stream ending"))
            : model_->Factorize(update.stiffness);
+  if (!skip) {
+    core_->metrics.RefactorisationFinished(
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
+  }
   const std::uint64_t version = update.version;
   MutexLock lock(&mutex_);
   stiffness_.RefactorEnded();
@@ -312,6 +378,7 @@ void DeformStreamReactor::Refactor(const StiffnessSwitch::Update& update) {
     }
     if (auto waiting = stiffness_.TakeWaiting()) StartRefactorLocked(std::move(*waiting));
   }
+  if (!stiffness_.refactor_running()) (void)HoldFactorizationsLocked(0, "");  // shrinks only
   pump_.Pump();
 }
 
@@ -322,6 +389,8 @@ void DeformStreamReactor::ApplyNextFactorizationLocked() {
                factor_ms);
   outbox_.AddNotice(v1::Notice::KIND_STIFFNESS_APPLIED, 0, version,
                     "stiffness version " + std::to_string(version) + " applied", factor_ms);
+  // The previous factorisation of the stream's own (if any) is released with this switch.
+  (void)HoldFactorizationsLocked(stiffness_.refactor_running() ? 1 : 0, "");  // shrinks only
 }
 
 void DeformStreamReactor::RunUrgent() {
@@ -358,11 +427,13 @@ void DeformStreamReactor::RunUrgent() {
 
 const v1::DeformResponse* DeformStreamReactor::TakeNextWrite() {
   mutex_.AssertHeld();
-  return outbox_.TakeNextWrite();
+  in_flight_ = outbox_.TakeNextWrite();
+  return in_flight_;
 }
 
 void DeformStreamReactor::WriteCompleted(bool ok) {
   mutex_.AssertHeld();
+  if (ok && in_flight_ != nullptr) CountWritten(*in_flight_, &core_->metrics);
   if (ok && outbox_.frame_in_flight()) ++frames_written_;
   if (ok && reading_paused_ && outbox_.notice_backlog_drained() && !pump_.finish_requested()) {
     reading_paused_ = false;

@@ -213,6 +213,9 @@ void LoadMeshReactor::Build() {
   StatusOr<std::shared_ptr<const MeshEntry>> entry =
       skip ? StatusOr<std::shared_ptr<const MeshEntry>>(Status::FailedPrecondition("cancelled"))
            : ParseAndBuild();
+  // A load refused before its build (declared size, parse) frees its slot and memory before the
+  // client hears of it (the reactor may outlive the call a little).
+  if (!entry.ok()) reservation_.Release();
   MutexLock lock(&mutex_);
   if (entry.ok()) {
     if (cancelled_) {
@@ -242,6 +245,15 @@ void LoadMeshReactor::Build() {
 }
 
 StatusOr<std::shared_ptr<const MeshEntry>> LoadMeshReactor::ParseAndBuild() {
+  // Admission before parsing: what the file declares (its header's counts) must fit.
+  std::string declared_subject;
+  DEFORM_ASSIGN_OR_RETURN(
+      const std::size_t declared,
+      DeclaredLoadBytes(header_, mesh_bytes_, core_->limits, &declared_subject));
+  if (declared > reservation_.memory_bytes()) {
+    DEFORM_RETURN_IF_ERROR(
+        core_->registry.ReserveMemory(&reservation_, declared, declared_subject));
+  }
   std::string pending_id;
   if (core_->store != nullptr) {
     // Kept on disk as uploaded (before parsing frees the bytes); committed once registered.
@@ -258,6 +270,7 @@ StatusOr<std::shared_ptr<const MeshEntry>> LoadMeshReactor::ParseAndBuild() {
   job.start = start_;
   job.id = pending_id;
   job.cancel = &cancel_;
+  job.metrics = &core_->metrics;
 
   const auto progress = [this](LoadStage stage, double elapsed_ms) {
     MutexLock lock(&mutex_);

@@ -2,7 +2,12 @@
 
 #include <utility>
 
+#include <algorithm>
+#include <climits>
+
 #include "core/geometry/skeleton.h"
+#include "core/io/declared_mesh_size.h"
+#include "core/model/deformation_model.h"
 #include "core/io/phantom.h"
 #include "core/io/rig_import.h"
 #include "core/io/skeleton_io.h"
@@ -80,6 +85,31 @@ StatusOr<LoadJob> LoadJobFromRequest(const v1::LoadMeshHeader& header, std::stri
   if (!options.ok()) return options.status().WithContext("options");
   job.options = std::move(*options);
   return job;
+}
+
+StatusOr<std::size_t> DeclaredLoadBytes(const v1::LoadMeshHeader& header,
+                                        const std::string& mesh_bytes, const ServiceLimits& limits,
+                                        std::string* subject) {
+  if (!header.has_upload() || header.upload().format() == v1::MESH_FORMAT_GLTF) return 0;
+  const StatusOr<MeshFormat> format = CoreMeshFormat(header.upload().format());
+  if (!format.ok()) return 0;  // the parse names it
+  const std::optional<DeclaredMeshSize> declared = ReadDeclaredMeshSize(mesh_bytes, *format);
+  if (!declared.has_value()) return 0;
+  *subject = "a mesh of " + std::to_string(declared->vertices) + " vertices and " +
+             std::to_string(declared->faces) + " faces (as its " + MeshFormatName(*format) +
+             " data declares)";
+  if (declared->vertices > limits.max_vertices) {
+    return Status::ResourceExhausted("the " + std::string(MeshFormatName(*format)) +
+                                     " data declares " + std::to_string(declared->vertices) +
+                                     " vertices, more than the limit of " +
+                                     std::to_string(limits.max_vertices) + " (--max-vertices)");
+  }
+  const auto clamp = [](std::size_t count) {
+    return static_cast<int>(std::min<std::size_t>(count, INT_MAX));
+  };
+  return mesh_bytes.size() +
+         DeformationModel::EstimateBytesBeforeBuild(clamp(declared->vertices),
+                                                    clamp(declared->faces));
 }
 
 }  // namespace deform::service

@@ -21,4 +21,15 @@ namespace deform::service {
 StatusOr<LoadJob> LoadJobFromRequest(const v1::LoadMeshHeader& header, std::string* mesh_bytes,
                                      const ServiceLimits& limits);
 
+// The memory a load of `header` with `mesh_bytes` needs, as far as the file declares before it is
+// parsed (declared_mesh_size.h: OFF and PLY headers, STL's count, OBJ's lines): the model's
+// estimate for the declared size (DeformationModel::EstimateBytesBeforeBuild) plus the bytes
+// themselves, held while they are parsed. RESOURCE_EXHAUSTED naming --max-vertices when the file
+// declares more vertices than `limits` allow; 0 for a phantom, a glTF rig or a file that declares
+// nothing readable (its parsed size is checked before the build instead). `subject` receives how
+// the refusal would name it.
+StatusOr<std::size_t> DeclaredLoadBytes(const v1::LoadMeshHeader& header,
+                                        const std::string& mesh_bytes, const ServiceLimits& limits,
+                                        std::string* subject);
+
 }  // namespace deform::service

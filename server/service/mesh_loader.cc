@@ -14,12 +14,9 @@ double MillisecondsSince(std::chrono::steady_clock::time_point start) {
       .count();
 }
 
-}  // namespace
-
-StatusOr<std::shared_ptr<const MeshEntry>> BuildAndRegister(MeshRegistry* registry,
-                                                            MeshRegistry::Reservation reservation,
-                                                            LoadJob job,
-                                                            const LoadProgress& progress) {
+StatusOr<std::shared_ptr<const MeshEntry>> Build(MeshRegistry* registry,
+                                                 MeshRegistry::Reservation reservation,
+                                                 LoadJob job, const LoadProgress& progress) {
   job.options.limits.max_vertices = registry->limits().max_vertices;
   const std::size_t bytes_before_build =
       DeformationModel::EstimateBytesBeforeBuild(job.mesh.num_vertices(), job.mesh.num_triangles());
@@ -51,6 +48,24 @@ StatusOr<std::shared_ptr<const MeshEntry>> BuildAndRegister(MeshRegistry* regist
       entry->memory_bytes >> 10);
   for (const std::string& warning : entry->model->binding_report().warnings) {
     spdlog::warn("mesh={} binding: {}", entry->id, EscapeForLog(warning));
+  }
+  return entry;
+}
+
+}  // namespace
+
+StatusOr<std::shared_ptr<const MeshEntry>> BuildAndRegister(MeshRegistry* registry,
+                                                            MeshRegistry::Reservation reservation,
+                                                            LoadJob job,
+                                                            const LoadProgress& progress) {
+  const auto started = std::chrono::steady_clock::now();
+  ServiceMetrics* metrics = job.metrics;
+  StatusOr<std::shared_ptr<const MeshEntry>> entry =
+      Build(registry, std::move(reservation), std::move(job), progress);
+  if (metrics != nullptr) {
+    metrics->BuildFinished(
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count(),
+        entry.ok());
   }
   return entry;
 }

@@ -18,6 +18,7 @@
 #include "core/geometry/skin_weights.h"
 #include "core/model/deformation_model.h"
 #include "service/mesh_registry.h"
+#include "service/service_metrics.h"
 
 namespace deform::service {
 
@@ -43,6 +44,9 @@ struct LoadJob {
   // Stops the build between its phases once cancelled (BuildHooks::cancel); null: never. Must
   // outlive BuildAndRegister.
   const CancelToken* cancel = nullptr;
+  // Where the build's duration is counted (ServiceMetrics::BuildFinished); null: nowhere. Must
+  // outlive BuildAndRegister.
+  ServiceMetrics* metrics = nullptr;
 };
 
 // Builds the model and registers it with `reservation`. Checks nothing the core checks: the mesh

@@ -45,7 +45,44 @@ void MeshRegistry::Reservation::Release() {
   }
 }
 
+MeshRegistry::MemoryHold::MemoryHold(MemoryHold&& other) noexcept
+    : registry_(std::exchange(other.registry_, nullptr)),
+      tenant_(std::move(other.tenant_)),
+      bytes_(std::exchange(other.bytes_, 0)) {}
+
+MeshRegistry::MemoryHold& MeshRegistry::MemoryHold::operator=(MemoryHold&& other) noexcept {
+  if (this != &other) {
+    if (registry_ != nullptr) (void)Resize(0, "");
+    registry_ = std::exchange(other.registry_, nullptr);
+    tenant_ = std::move(other.tenant_);
+    bytes_ = std::exchange(other.bytes_, 0);
+  }
+  return *this;
+}
+
+MeshRegistry::MemoryHold::~MemoryHold() {
+  if (registry_ != nullptr) (void)Resize(0, "");
+}
+
+Status MeshRegistry::MemoryHold::Resize(std::size_t bytes, const std::string& what) {
+  if (registry_ == nullptr) return Status::FailedPrecondition("an empty memory hold");
+  MeshRegistry& registry = *registry_;
+  MutexLock lock(&registry.mutex_);
+  if (bytes > bytes_) {
+    DEFORM_RETURN_IF_ERROR(registry.CheckMemoryLocked(bytes, bytes_, tenant_, what));
+  }
+  TenantUsage& usage = registry.tenants_[tenant_];
+  registry.memory_streams_ = registry.memory_streams_ - bytes_ + bytes;
+  usage.stream_memory_bytes = usage.stream_memory_bytes - bytes_ + bytes;
+  bytes_ = bytes;
+  return Status::Ok();
+}
+
 MeshRegistry::MeshRegistry(const ServiceLimits& limits) : limits_(limits) {}
+
+MeshRegistry::MemoryHold MeshRegistry::HoldMemory(const std::string& tenant) {
+  return MemoryHold(this, tenant);
+}
 
 StatusOr<MeshRegistry::Reservation> MeshRegistry::Reserve(const std::string& tenant) {
   MutexLock lock(&mutex_);
@@ -79,20 +116,22 @@ void MeshRegistry::ReleaseSlot(const std::string& tenant, std::size_t memory_byt
 
 Status MeshRegistry::CheckMemoryLocked(std::size_t bytes, std::size_t held,
                                        const std::string& tenant, const std::string& what) const {
-  const std::size_t in_use = memory_used_ + memory_reserved_ - held;
+  const std::size_t in_use = memory_used_ + memory_reserved_ + memory_streams_ - held;
   if (bytes > limits_.max_memory_bytes || in_use > limits_.max_memory_bytes - bytes) {
     return Status::ResourceExhausted(
         "memory budget exceeded (--max-memory-mb): " + what + " needs about " + MebiBytes(bytes) +
         ", " + MebiBytes(in_use) + " of the " + MebiBytes(limits_.max_memory_bytes) +
         " budget are in use (" + MebiBytes(memory_used_ - memory_retained_) +
         " by loaded meshes, " + MebiBytes(memory_retained_) +
-        " by unloaded meshes that streams still use)");
+        " by unloaded meshes that streams still use, " + MebiBytes(memory_streams_) +
+        " by streams' buffers and factorisations)");
   }
   if (limits_.tenant_max_memory_bytes > 0) {
     const auto it = tenants_.find(tenant);
     const std::size_t used =
         it == tenants_.end() ? 0
-                             : it->second.memory_bytes + it->second.reserved_memory_bytes - held;
+                             : it->second.memory_bytes + it->second.reserved_memory_bytes +
+                                   it->second.stream_memory_bytes - held;
     if (bytes > limits_.tenant_max_memory_bytes ||
         used > limits_.tenant_max_memory_bytes - bytes) {
       return Status::ResourceExhausted(
@@ -233,6 +272,11 @@ std::size_t MeshRegistry::memory_bytes_used() const {
 std::size_t MeshRegistry::memory_bytes_reserved() const {
   MutexLock lock(&mutex_);
   return memory_reserved_;
+}
+
+std::size_t MeshRegistry::memory_bytes_streams() const {
+  MutexLock lock(&mutex_);
+  return memory_streams_;
 }
 
 int MeshRegistry::loads_in_progress() const {

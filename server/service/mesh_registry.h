@@ -95,6 +95,30 @@ class MeshRegistry {
     std::size_t memory_bytes_ = 0;
   };
 
+  // Memory a Deform stream holds beyond its mesh's model (its solve buffers and frames, its own
+  // factorisations after stiffness updates), counted in the server's and its tenant's budgets
+  // until it is resized to 0 or destroyed. Movable; the registry must outlive it.
+  class MemoryHold {
+   public:
+    MemoryHold() = default;
+    MemoryHold(MemoryHold&& other) noexcept;
+    MemoryHold& operator=(MemoryHold&& other) noexcept;
+    ~MemoryHold();
+    // Makes the hold count `bytes` in place of what it counted. RESOURCE_EXHAUSTED naming `what`,
+    // the need, the budget and what is in use when the growth does not fit; the hold then keeps
+    // what it had. Shrinking always succeeds.
+    Status Resize(std::size_t bytes, const std::string& what);
+    std::size_t bytes() const { return bytes_; }
+
+   private:
+    friend class MeshRegistry;
+    MemoryHold(MeshRegistry* registry, std::string tenant)
+        : registry_(registry), tenant_(std::move(tenant)) {}
+    MeshRegistry* registry_ = nullptr;
+    std::string tenant_;
+    std::size_t bytes_ = 0;
+  };
+
   explicit MeshRegistry(const ServiceLimits& limits);
   MeshRegistry(const MeshRegistry&) = delete;
   MeshRegistry& operator=(const MeshRegistry&) = delete;
@@ -133,15 +157,18 @@ class MeshRegistry {
   Status AttachStream(const MeshEntry& entry);
   // The stream has ended; the last one of an unloaded mesh releases its memory from the budget.
   void DetachStream(const MeshEntry& entry);
+  // An empty hold of `tenant`'s (MemoryHold::Resize counts memory in it).
+  MemoryHold HoldMemory(const std::string& tenant);
   // Unscoped (the server's own use: preloads, a load whose client went away, tests).
   StatusOr<std::shared_ptr<const MeshEntry>> Find(const std::string& mesh_id) const;
   std::vector<std::shared_ptr<const MeshEntry>> List() const;
   Status Unload(const std::string& mesh_id);
 
-  // Of the budget: the memory of loaded meshes and of unloaded ones streams still use, and memory
-  // held by loads in progress.
+  // Of the budget: the memory of loaded meshes and of unloaded ones streams still use, memory
+  // held by loads in progress, and memory held by streams (MemoryHold).
   std::size_t memory_bytes_used() const;
   std::size_t memory_bytes_reserved() const;
+  std::size_t memory_bytes_streams() const;
   int mesh_count() const;
   int loads_in_progress() const;
   // Meshes registered since the registry was made (unloaded ones included).
@@ -154,6 +181,7 @@ class MeshRegistry {
     int loaded = 0;
     std::size_t memory_bytes = 0;           // of loaded meshes and unloaded ones still streamed
     std::size_t reserved_memory_bytes = 0;  // held by loads in progress
+    std::size_t stream_memory_bytes = 0;    // held by streams
   };
   void ReleaseSlot(const std::string& tenant, std::size_t memory_bytes);
   void ReleaseMemoryLocked(const MeshEntry& entry) DEFORM_REQUIRES(mutex_);
@@ -172,6 +200,7 @@ class MeshRegistry {
   std::size_t memory_used_ DEFORM_GUARDED_BY(mutex_) = 0;
   std::size_t memory_retained_ DEFORM_GUARDED_BY(mutex_) = 0;  // of the latter alone
   std::size_t memory_reserved_ DEFORM_GUARDED_BY(mutex_) = 0;  // held by reservations
+  std::size_t memory_streams_ DEFORM_GUARDED_BY(mutex_) = 0;   // held by MemoryHolds
   std::uint64_t next_order_ DEFORM_GUARDED_BY(mutex_) = 1;  // also counts registrations
   std::map<std::string, TenantUsage> tenants_ DEFORM_GUARDED_BY(mutex_);
 };

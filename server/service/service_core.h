@@ -19,6 +19,7 @@
 #include "service/identity.h"
 #include "service/mesh_registry.h"
 #include "service/mesh_store.h"
+#include "service/service_metrics.h"
 #include "service/service_options.h"
 #include "service/thread_annotations.h"
 #include "service/upload_watchdog.h"
@@ -99,6 +100,8 @@ struct ServiceCore {
   std::atomic<std::uint64_t> next_load_id{1};
   // Serialised bytes of the notices waiting unwritten in every Deform stream (DeformOutbox).
   std::atomic<std::int64_t> notice_backlog_bytes{0};
+  // Counters and histograms of frames, notices, RPCs, builds (service_metrics.h).
+  ServiceMetrics metrics;
 };
 
 }  // namespace deform::service

@@ -68,6 +68,9 @@ struct ServerOptions {
   int workers = 0;
   // Largest gRPC message received or sent. Default: 64 MiB.
   int max_message_bytes = 64 << 20;
+  // Where GET /metrics is served (metrics_endpoint.h), "host:port"; empty: not served. Default:
+  // empty.
+  std::string metrics_address;
   ConnectionOptions connections;
   ServiceLimits limits;
   TransportSecurity security;

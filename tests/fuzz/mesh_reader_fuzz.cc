@@ -1,11 +1,13 @@
-// libFuzzer target: ReadMesh on arbitrary bytes in one format (DEFORM_FUZZ_MESH_FORMAT, one
-// executable per format: OBJ, OFF, PLY, STL through OpenMesh as the service reads uploads). A
-// Status or a mesh, never a crash, a sanitizer report or an unbounded allocation. Limits are kept
+// libFuzzer target: ReadDeclaredMeshSize (the service's admission before parsing) and ReadMesh on
+// arbitrary bytes in one format (DEFORM_FUZZ_MESH_FORMAT, one executable per format: OBJ, OFF,
+// PLY, STL through OpenMesh as the service reads uploads). A Status or a mesh, never a crash, a
+// sanitizer report or an unbounded allocation. Limits are kept
 // small so that a declared count cannot make one input take seconds.
 #include <cstddef>
 #include <cstdint>
 #include <string_view>
 
+#include "core/io/declared_mesh_size.h"
 #include "core/io/mesh_io.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -13,6 +15,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   limits.max_vertices = 20'000;
   limits.max_triangles = 40'000;
   const std::string_view bytes(reinterpret_cast<const char*>(data), size);
+  const auto declared =
+      deform::ReadDeclaredMeshSize(bytes, deform::MeshFormat::DEFORM_FUZZ_MESH_FORMAT);
+  if (declared.has_value() && deform::MeshFormat::DEFORM_FUZZ_MESH_FORMAT ==
+                                  deform::MeshFormat::kObj && declared->vertices > size) {
+    __builtin_trap();  // OBJ's counts are lines of the input
+  }
   auto mesh = deform::ReadMesh(bytes, deform::MeshFormat::DEFORM_FUZZ_MESH_FORMAT, limits);
   if (mesh.ok() && mesh->num_vertices() > 20'000) __builtin_trap();
   return 0;

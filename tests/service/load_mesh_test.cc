@@ -349,6 +349,41 @@ TEST_F(LoadMeshTest, APhantomThatCannotFitIsRefusedBeforeAnythingIsBuilt) {
   ExpectBackgroundStreamAlive();
 }
 
+TEST_F(LoadMeshTest, AFileDeclaringAMeshThatCannotFitIsRefusedBeforeItIsParsed) {
+  // A few hundred bytes whose header declares a mesh far larger than the budget (or the vertex
+  // limit): refused from the declared counts, naming them, before the parser allocates anything;
+  // never a parse error about the missing data.
+  service::ServerOptions options = TestServerOptions();
+  options.limits.max_memory_bytes = std::size_t{256} << 20;
+  StartServer(options);
+  const UploadFiles files = WritePhantomFiles(300);
+  v1::MeshSummary summary;
+  const std::string off = "OFF\n1000000 2000000 0\n0 0 0\n1 0 0\n0 1 0\n";
+  const grpc::Status budget =
+      client_->LoadMeshBytes("declared", v1::MESH_FORMAT_OFF, off, v1::SKELETON_FORMAT_JSON,
+                             files.skeleton_bytes, {}, &summary);
+  EXPECT_EQ(budget.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << budget.error_message();
+  EXPECT_THAT(budget.error_message(),
+              HasSubstr("a mesh of 1000000 vertices and 2000000 faces (as its off data declares)"));
+  EXPECT_THAT(budget.error_message(), HasSubstr("of the 256 MiB budget"));
+  const std::string ply =
+      "ply\nformat ascii 1.0\nelement vertex 3000000\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  const grpc::Status limit =
+      client_->LoadMeshBytes("declared", v1::MESH_FORMAT_PLY, ply, v1::SKELETON_FORMAT_JSON,
+                             files.skeleton_bytes, {}, &summary);
+  EXPECT_EQ(limit.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << limit.error_message();
+  EXPECT_THAT(limit.error_message(), HasSubstr("declares 3000000 vertices"));
+  EXPECT_THAT(limit.error_message(), HasSubstr("--max-vertices"));
+  EXPECT_EQ(server_->server().core().registry.loads_in_progress(), 0);
+  EXPECT_EQ(server_->server().core().registry.memory_bytes_reserved(), 0u);
+  // A file that declares what it holds loads as before.
+  EXPECT_TRUE(client_->LoadMeshBytes("fits", v1::MESH_FORMAT_OBJ, files.mesh_bytes,
+                                     v1::SKELETON_FORMAT_JSON, files.skeleton_bytes, {}, &summary)
+                  .ok());
+  ExpectBackgroundStreamAlive();
+}
+
 TEST_F(LoadMeshTest, AnUploadInFlightHoldsItsBytesOfTheBudgetUntilItEnds) {
   service::ServerOptions options = TestServerOptions();
   options.limits.max_memory_bytes = std::size_t{64} << 20;

@@ -238,6 +238,22 @@ std::size_t DeformationModel::EstimatedBytes() const {
          GeometryBytes(mesh_.num_vertices(), mesh_.num_triangles());
 }
 
+std::size_t DeformationModel::FactorizationBytes() const {
+  const LinearPoseResponse* response = default_factorization_->linear_response();
+  return default_factorization_->factor().bytes() + (response ? response->bytes() : 0);
+}
+
+std::size_t DeformationModel::ScratchBytes() const {
+  const std::size_t vertices = static_cast<std::size_t>(mesh_.num_vertices());
+  const std::size_t bones = static_cast<std::size_t>(skeleton_.num_bones());
+  const std::size_t slots =
+      linear_blend_plan_ ? static_cast<std::size_t>(linear_blend_plan_->num_slots()) : bones;
+  const std::size_t unknowns = vertices + static_cast<std::size_t>(system_.num_nodes);
+  return bones * sizeof(RigidTransform) + slots * sizeof(Eigen::Matrix3d) +
+         (unknowns + vertices) * 3 * sizeof(double) +
+         default_factorization_->factor().WorkSize() * sizeof(double);
+}
+
 DeformScratch DeformationModel::MakeScratch() const {
   DeformScratch scratch;
   scratch.model_id_ = id_;

@@ -216,6 +216,11 @@ class DeformationModel {
   static constexpr std::size_t kFactorBytesPerVertexLog2 = 80;
   static std::size_t EstimateBytesBeforeBuild(int num_vertices, int num_triangles);
   std::size_t EstimatedBytes() const;
+  // The bytes one more factorisation for other stiffness (Factorize) holds: the default
+  // factorisation's factor and linear response (same sparsity, same sizes).
+  std::size_t FactorizationBytes() const;
+  // The bytes MakeScratch() allocates: one stream's solve buffers.
+  std::size_t ScratchBytes() const;
 
  private:
   DeformationModel() = default;

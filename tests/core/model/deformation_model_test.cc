@@ -334,6 +334,23 @@ TEST(DeformationModel, EstimatedBytesAddTheFactorToTheGeometry) {
   EXPECT_GT(before, geometry + model->default_factorization()->factor().bytes());
 }
 
+TEST(DeformationModel, ScratchAndFactorizationBytesAreWhatAStreamAllocates) {
+  auto model = BuildPhantomModel(600);
+  const DeformScratch scratch = model->MakeScratch();
+  const std::size_t allocated =
+      scratch.bone_transforms.size() * sizeof(scratch.bone_transforms[0]) +
+      scratch.slot_rotations.size() * sizeof(scratch.slot_rotations[0]) +
+      static_cast<std::size_t>(scratch.solution.size() + scratch.rotated_deltas.size()) *
+          sizeof(double) +
+      scratch.solve_work.size() * sizeof(double);
+  EXPECT_EQ(model->ScratchBytes(), allocated);
+  Stiffness stiffer;
+  stiffer.joint_materials.push_back({1, JointMaterial{9.0, 2.5, 6.0}});  // the knee
+  auto other = model->Factorize(stiffer);
+  ASSERT_TRUE(other.ok()) << other.status().ToString();
+  EXPECT_EQ(model->FactorizationBytes(), (*other)->factor().bytes());
+}
+
 TEST(DeformationModel, TheEstimateBeforeTheBuildGrowsFasterThanTheMesh) {
   // A 2,000,000-vertex mesh needs more than 4 GiB (the default budget): refused before the build.
   EXPECT_GT(DeformationModel::EstimateBytesBeforeBuild(2'000'000, 4'000'000), std::size_t{4} << 30);

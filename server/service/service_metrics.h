@@ -1,0 +1,106 @@
+// The service's Prometheus metrics (prometheus-cpp's registry; served by MetricsEndpoint).
+//
+// What is counted, and where (metric names as exposed):
+//  - deformd_frames_sent_total{encoding}, deformd_frame_bytes_sent_total{encoding}: Deform frames
+//    whose write completed (what clients received), and their serialised DeformResponse bytes;
+//    encoding is float32, quantized or predicted.
+//  - deformd_frame_server_seconds: histogram of a written frame's server time (queue, right-hand
+//    side, solve and encode: DeformFrame.timings).
+//  - deformd_poses_skipped_total: poses replaced by a newer one before they were solved (the sum
+//    of written frames' skipped_poses).
+//  - deformd_notices_sent_total{kind}: notices written (pose_rejected, stiffness_applied,
+//    stiffness_rejected).
+//  - deformd_rpcs_total{method,code}: finished RPCs by method (the five DeformService methods by
+//    name, every other method as "other") and status code name ("OK", "NOT_FOUND", ...).
+//  - deformd_build_seconds{result}: mesh builds (LoadMesh, --preload, --store), ok or error.
+//  - deformd_refactorisation_seconds: stiffness refactorisations of Deform streams.
+//  - Gauges set at each scrape (SetGauges): deformd_streams_open, deformd_meshes_loaded,
+//    deformd_loads_in_progress, deformd_memory_budget_used_bytes,
+//    deformd_memory_budget_reserved_bytes, deformd_memory_budget_bytes,
+//    deformd_notice_backlog_bytes.
+//
+// A client's errors as deform-loadtest counts them are the Deform RPCs that ended with a code
+// other than OK plus the notices pose_rejected and stiffness_rejected.
+//
+// Thread safety: every method may be called from any thread. The per-frame and per-RPC calls
+// (FrameWritten, NoticeWritten, RpcFinished) take no lock and allocate nothing: every labelled
+// series they touch is created in the constructor.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+
+namespace prometheus {
+class Counter;
+class Gauge;
+class Histogram;
+class Registry;
+}  // namespace prometheus
+
+namespace deform::service {
+
+class ServiceMetrics {
+ public:
+  // The encodings and notice kinds as the proto numbers them (FrameEncoding, Notice.Kind).
+  static constexpr int kEncodings = 4;     // index 0 (unspecified) counts as float32
+  static constexpr int kNoticeKinds = 4;   // index 0 (unspecified) is never written
+  static constexpr int kStatusCodes = 17;  // grpc::StatusCode 0..16
+  static constexpr int kMethods = 6;       // five DeformService methods and "other"
+
+  ServiceMetrics();
+  ~ServiceMetrics();
+  ServiceMetrics(const ServiceMetrics&) = delete;
+  ServiceMetrics& operator=(const ServiceMetrics&) = delete;
+
+  // A Deform frame's write completed: `encoding` as in FrameEncoding (out of range: float32),
+  // `bytes` its serialised size, `server_seconds` its server time, `skipped_poses` its count.
+  void FrameWritten(int encoding, std::size_t bytes, double server_seconds,
+                    std::uint64_t skipped_poses);
+  // A notice's write completed; `kind` as in Notice.Kind (out of range: ignored).
+  void NoticeWritten(int kind);
+  // An RPC finished: `method` is the full name ("/deform.v1.DeformService/Deform"), `code` the
+  // status code (out of range: UNKNOWN).
+  void RpcFinished(std::string_view method, int code);
+  void BuildFinished(double seconds, bool ok);
+  void RefactorisationFinished(double seconds);
+
+  // The gauges, from the caller's snapshot of the service (before each scrape).
+  struct Gauges {
+    int streams_open = 0;
+    int meshes_loaded = 0;
+    int loads_in_progress = 0;
+    std::size_t memory_used_bytes = 0;
+    std::size_t memory_reserved_bytes = 0;
+    std::size_t memory_budget_bytes = 0;
+    std::int64_t notice_backlog_bytes = 0;
+  };
+  void SetGauges(const Gauges& gauges);
+
+  // Everything in Prometheus' text exposition format (version 0.0.4).
+  std::string Serialize() const;
+
+ private:
+  std::shared_ptr<prometheus::Registry> registry_;
+  std::array<prometheus::Counter*, kEncodings> frames_sent_{};
+  std::array<prometheus::Counter*, kEncodings> frame_bytes_sent_{};
+  prometheus::Histogram* frame_server_seconds_ = nullptr;
+  prometheus::Counter* poses_skipped_ = nullptr;
+  std::array<prometheus::Counter*, kNoticeKinds> notices_sent_{};
+  std::array<std::array<prometheus::Counter*, kStatusCodes>, kMethods> rpcs_{};
+  prometheus::Histogram* build_ok_seconds_ = nullptr;
+  prometheus::Histogram* build_error_seconds_ = nullptr;
+  prometheus::Histogram* refactorisation_seconds_ = nullptr;
+  prometheus::Gauge* streams_open_ = nullptr;
+  prometheus::Gauge* meshes_loaded_ = nullptr;
+  prometheus::Gauge* loads_in_progress_ = nullptr;
+  prometheus::Gauge* memory_used_ = nullptr;
+  prometheus::Gauge* memory_reserved_ = nullptr;
+  prometheus::Gauge* memory_budget_ = nullptr;
+  prometheus::Gauge* notice_backlog_ = nullptr;
+};
+
+}  // namespace deform::service
