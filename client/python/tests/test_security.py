@@ -3,14 +3,18 @@ token UNAUTHENTICATED, with one the whole session works, tenants see only their 
 mutual TLS (scripts/make-test-certificates.sh; CA, client certificate and key, server name)."""
 
 import hashlib
+import os
 import pathlib
 import secrets
 import subprocess
+import sys
 import tempfile
 import unittest
 
 from deform_client import DeformClient, DeformError
 from deformd_process import REPOSITORY, DeformdProcess
+
+EXAMPLE = pathlib.Path(__file__).resolve().parents[1] / "examples" / "bend_knee.py"
 
 
 def token_line(token, tenant, role="tenant"):
@@ -86,6 +90,18 @@ class TlsTest(unittest.TestCase):
                                  (mesh.vertex_count, 3))
                 client.unload(mesh.mesh_id)
                 client.close()
+
+                # The example takes the same settings from the environment.
+                environment = dict(os.environ, DEFORM_TLS="1", DEFORM_TLS_CA=str(certs / "ca.pem"),
+                                   DEFORM_TLS_CERT=str(certs / "client.pem"),
+                                   DEFORM_TLS_KEY=str(certs / "client.key"),
+                                   DEFORM_TLS_SERVER_NAME="localhost", DEFORM_TOKEN=token)
+                done = subprocess.run(
+                    [sys.executable, str(EXAMPLE), "--target", server.target, "--vertices", "500",
+                     "--out", str(pathlib.Path(directory) / "bent.ply")],
+                    env=environment, capture_output=True, text=True, timeout=120)
+                self.assertEqual(done.returncode, 0, done.stderr)
+                self.assertIn("wrote", done.stdout)
 
                 # PEM contents work as well as paths.
                 pem = DeformClient(server.target, ca=(certs / "ca.pem").read_bytes(),
