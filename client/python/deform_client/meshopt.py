@@ -1,11 +1,12 @@
 """meshoptimizer's vertex decoder through ctypes, from Debian's shared library.
 
 Contract: decode_vertex_buffer(data, destination) fills `destination` (a writable, C-contiguous
-numpy array of vertex_count records of destination.itemsize * destination.shape[1] bytes) with what
-meshopt_encodeVertexBuffer encoded; ValueError when the bytes do not decode to that many vertices. The library is Debian's libmeshoptimizer2d (soname libmeshoptimizer.so.2d,
-meshoptimizer 0.18); DEFORM_MESHOPTIMIZER_LIB names another file. Loaded once, on first use;
-OSError naming what was tried when no library loads. Thread safety: the decoder keeps no state, so
-any number of threads may call it.
+numpy array of shape (vertex_count, k): one record of destination.itemsize * k bytes per vertex)
+with what meshopt_encodeVertexBuffer encoded; ValueError when the bytes do not decode to that many
+vertices. The library is Debian's libmeshoptimizer2d (soname libmeshoptimizer.so.2d, meshoptimizer
+0.18); DEFORM_MESHOPTIMIZER_LIB names another file. Loaded once, on first use; OSError naming what
+was tried when no library loads. Thread safety: the decoder keeps no state, so any number of
+threads may call it.
 """
 
 import ctypes

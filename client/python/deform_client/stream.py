@@ -87,14 +87,15 @@ class DeformStream:
 
     def send_pose(self, pose, sequence=None):
         """Sends a pose (poses.py: "knee:flexion:90", {"joint":..., "axis":..., "degrees":...},
-        a list of them, or a PoseUpdate). Returns its sequence number (increasing from 1 unless
-        given). RuntimeError once the stream is closed or ended; ValueError for a malformed pose."""
+        a list of them, or a PoseUpdate, whose own sequence is kept when set). Returns its sequence
+        number (one more than the largest sent so far unless given; the first is 1).
+        RuntimeError once the stream is closed or ended; ValueError for a malformed pose."""
         with self._lock:
             if sequence is None:
                 sequence = self._next_sequence
-            self._next_sequence = max(self._next_sequence, int(sequence) + 1)
             update = pose_update(pose, int(sequence), time.monotonic_ns())
             self._put_locked(pb.DeformRequest(pose=update))
+            self._next_sequence = max(self._next_sequence, update.sequence + 1)
             return update.sequence
 
     def send_stiffness(self, stiffness):
