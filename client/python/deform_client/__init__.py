@@ -1,0 +1,20 @@
+"""deformd's Python client: load meshes, stream poses, receive frames as numpy arrays.
+
+    from deform_client import DeformClient
+    client = DeformClient("127.0.0.1:50051")
+    mesh = client.load_phantom(2000, progress=lambda stage, ms: print(stage, ms))
+    with client.stream(mesh.mesh_id, encoding="predicted") as stream:
+        stream.send_pose("knee:flexion:90"); print(stream.next_frame().positions.shape)
+
+Modules: client (DeformClient, MeshInfo), stream (DeformStream, Frame), codec (the frame
+decoders), meshopt (meshoptimizer's decoder through ctypes), poses (pose forms), errors
+(DeformError), stubs (the generated deform.v1 code, `pb`: see stubs.py for where it is found).
+"""
+
+from .client import DeformClient, MeshInfo, client_from_environment
+from .errors import DeformError
+from .stream import DeformStream, Frame
+from .stubs import pb
+
+__all__ = ["DeformClient", "DeformError", "DeformStream", "Frame", "MeshInfo",
+           "client_from_environment", "pb"]

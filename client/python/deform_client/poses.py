@@ -1,0 +1,75 @@
+"""Poses for DeformStream.send_pose: deformctl's "JOINT:AXIS:DEGREES[,...]" text, a dict
+{"joint": ..., "axis": ..., "degrees": ...}, a (joint, axis, degrees) tuple, a list of those, or a
+PoseUpdate message as is. JOINT is a name or a 0-based index, AXIS x, y, z or a degree of freedom's
+name ("flexion"); the server resolves both. "" and "rest" are the rest pose. ValueError naming the
+offending term for malformed input (the same rules as core/base/pose_spec.h).
+"""
+
+import math
+
+from .stubs import pb
+
+
+def _term(joint, axis, degrees, text):
+    joint = str(joint).strip()
+    axis = str(axis).strip()
+    if not joint or not axis:
+        raise ValueError(f"pose term {text!r} is not JOINT:AXIS:DEGREES")
+    try:
+        value = float(degrees)
+    except (TypeError, ValueError):
+        raise ValueError(f"pose term {text!r}: {degrees!r} is not a finite number of degrees") \
+            from None
+    if not math.isfinite(value):
+        raise ValueError(f"pose term {text!r}: {degrees!r} is not a finite number of degrees")
+    return pb.JointAngle(joint=joint, axis=axis, degrees=value)
+
+
+def parse_pose_spec(spec):
+    """deformctl's syntax -> a list of JointAngle messages."""
+    spec = spec.strip()
+    if spec in ("", "rest"):
+        return []
+    angles = []
+    for text in spec.split(","):
+        fields = text.strip().split(":")
+        if len(fields) != 3:
+            raise ValueError(f"pose term {text.strip()!r} is not JOINT:AXIS:DEGREES")
+        angles.append(_term(fields[0], fields[1], fields[2].strip(), text.strip()))
+    return angles
+
+
+def angles_of(pose):
+    """Any accepted pose form except a PoseUpdate -> a list of JointAngle messages."""
+    if isinstance(pose, str):
+        return parse_pose_spec(pose)
+    if isinstance(pose, dict):
+        missing = [key for key in ("joint", "axis", "degrees") if key not in pose]
+        if missing:
+            raise ValueError(f"pose term {pose!r} lacks {', '.join(missing)}")
+        return [_term(pose["joint"], pose["axis"], pose["degrees"], pose)]
+    if isinstance(pose, tuple) and len(pose) == 3 and \
+            not any(isinstance(item, (tuple, list, dict)) for item in pose):
+        return [_term(pose[0], pose[1], pose[2], pose)]
+    if isinstance(pose, (list, tuple)):
+        angles = []
+        for item in pose:
+            angles.extend(angles_of(item))
+        return angles
+    raise ValueError(f"a pose is a 'JOINT:AXIS:DEGREES' string, a dict, a (joint, axis, degrees) "
+                     f"tuple or a list of them, not {type(pose).__name__}")
+
+
+def pose_update(pose, sequence, timestamp_ns):
+    """A PoseUpdate with `sequence` and `timestamp_ns` from any accepted form (a PoseUpdate is
+    copied, its sequence and timestamp kept when set)."""
+    if isinstance(pose, pb.PoseUpdate):
+        update = pb.PoseUpdate()
+        update.CopyFrom(pose)
+        if update.sequence == 0:
+            update.sequence = sequence
+        if update.client_timestamp_ns == 0:
+            update.client_timestamp_ns = timestamp_ns
+        return update
+    return pb.PoseUpdate(sequence=sequence, client_timestamp_ns=timestamp_ns,
+                         angles=angles_of(pose))

@@ -1,0 +1,216 @@
+"""DeformStream: one Deform call. Poses go in, frames come out as numpy arrays.
+
+Made by DeformClient.stream(). Requests are sent in order (the server answers the newest pose
+when poses come faster than it solves, and reports the others in Frame.skipped_poses). A
+background thread reads the responses into a queue; frames are decoded by whoever takes them
+(next_frame, iteration), so decoding costs the reader's thread, not gRPC's.
+
+Thread safety: send_pose / send_stiffness / close / cancel may be called from any thread; take
+frames (next_frame, next_event, iteration) from one thread at a time.
+
+Errors: the call's failure (NOT_FOUND for an unknown mesh id, INVALID_ARGUMENT for a bad start,
+UNAVAILABLE when the server shuts down, ...) is raised as DeformError by whatever takes the next
+event after it; a frame that does not decode cancels the call and raises DeformError(INTERNAL)
+naming the problem. A cancel() by the caller ends the stream quietly.
+"""
+
+import dataclasses
+import queue
+import threading
+import time
+
+import grpc
+import numpy as np
+
+from . import codec
+from .errors import DeformError
+from .poses import pose_update
+from .stubs import pb
+
+_END = object()
+
+
+@dataclasses.dataclass
+class Frame:
+    """One deformed frame. positions: (V, 3) float32, model units, the mesh's vertex order."""
+    sequence: int              # the pose answered
+    positions: np.ndarray = dataclasses.field(repr=False)
+    encoding: str              # how it travelled: float32, quantized or predicted
+    max_error: float           # the stated largest per-coordinate error (0 for float32)
+    wire_bytes: int            # bytes of positions as they travelled
+    decode_ms: float           # this client's decoding time
+    skipped_poses: int
+    clamped_angles: int
+    mesh_unloaded: bool
+    stiffness_version: int
+    client_timestamp_ns: int
+    message: object = dataclasses.field(repr=False)  # the DeformFrame as received
+
+
+def _frame_from(message, decoder):
+    started = time.perf_counter()
+    positions = decoder.decode(message)
+    decode_ms = (time.perf_counter() - started) * 1e3
+    if message.HasField("encoded"):
+        encoded = message.encoded
+        encoding, max_error, wire_bytes = (codec.ENCODING_NAMES.get(encoded.encoding, "unknown"),
+                                           encoded.max_error, len(encoded.data))
+    else:
+        encoding, max_error, wire_bytes = "float32", 0.0, len(message.positions)
+    return Frame(sequence=message.sequence, positions=positions, encoding=encoding,
+                 max_error=max_error, wire_bytes=wire_bytes, decode_ms=decode_ms,
+                 skipped_poses=message.skipped_poses, clamped_angles=message.clamped_angles,
+                 mesh_unloaded=message.mesh_unloaded, stiffness_version=message.stiffness_version,
+                 client_timestamp_ns=message.client_timestamp_ns, message=message)
+
+
+class DeformStream:
+    def __init__(self, stub, start, metadata, decoder):
+        """stub: a DeformServiceStub; start: the DeformStart message; metadata: call metadata;
+        decoder: a codec.FrameDecoder for the mesh."""
+        self._decoder = decoder
+        self._requests = queue.Queue()
+        self._events = queue.Queue()
+        self._lock = threading.Lock()
+        self._closing = False
+        self._cancelled = False
+        self._ended = False
+        self._next_sequence = 1
+        self.notices = []  # every Notice taken so far (pose or stiffness rejections, switches)
+        self._requests.put(pb.DeformRequest(start=start))
+        self._call = stub.Deform(self._request_iterator(), metadata=metadata)
+        self._reader = threading.Thread(target=self._read, name="deform-stream-reader",
+                                        daemon=True)
+        self._reader.start()
+
+    # Sending.
+
+    def send_pose(self, pose, sequence=None):
+        """Sends a pose (poses.py: "knee:flexion:90", {"joint":..., "axis":..., "degrees":...},
+        a list of them, or a PoseUpdate, whose own sequence is kept when set). Returns its sequence
+        number (one more than the largest sent so far unless given; the first is 1).
+        RuntimeError once the stream is closed or ended; ValueError for a malformed pose."""
+        with self._lock:
+            if sequence is None:
+                sequence = self._next_sequence
+            update = pose_update(pose, int(sequence), time.monotonic_ns())
+            self._put_locked(pb.DeformRequest(pose=update))
+            self._next_sequence = max(self._next_sequence, update.sequence + 1)
+            return update.sequence
+
+    def send_stiffness(self, stiffness):
+        """Sends a StiffnessUpdate message (replaces the stream's stiffness)."""
+        with self._lock:
+            self._put_locked(pb.DeformRequest(stiffness=stiffness))
+
+    def _put_locked(self, request):
+        if self._closing or self._cancelled or self._ended:
+            raise RuntimeError("the stream is closed")
+        self._requests.put(request)
+
+    def _request_iterator(self):
+        while True:
+            request = self._requests.get()
+            if request is None:
+                return
+            yield request
+
+    # Receiving.
+
+    def _read(self):
+        try:
+            for response in self._call:
+                self._events.put(response)
+            self._events.put(_END)
+        except grpc.RpcError as error:
+            if self._cancelled and error.code() == grpc.StatusCode.CANCELLED:
+                self._events.put(_END)
+            else:
+                self._events.put(DeformError.from_rpc_error(error))
+        finally:
+            self._requests.put(None)  # lets gRPC's request thread finish
+
+    def next_event(self, timeout=None):
+        """The next Frame or Notice, or None once the stream has ended well. Raises DeformError
+        when it failed, TimeoutError after `timeout` seconds without an event."""
+        if self._ended:
+            return None
+        try:
+            event = self._events.get(timeout=timeout)
+        except queue.Empty:
+            raise TimeoutError(f"no frame or notice within {timeout} s") from None
+        if event is _END:
+            self._ended = True
+            return None
+        if isinstance(event, DeformError):
+            self._ended = True
+            raise event
+        if event.HasField("notice"):
+            self.notices.append(event.notice)
+            return event.notice
+        try:
+            return _frame_from(event.frame, self._decoder)
+        except ValueError as error:
+            self._ended = True
+            self.cancel()
+            raise DeformError(grpc.StatusCode.INTERNAL, f"a frame did not decode: {error}") \
+                from None
+
+    def next_frame(self, timeout=None):
+        """The next Frame (notices in between go to self.notices), or None once the stream has
+        ended well. A rejected pose has no frame: watch self.notices or use events()."""
+        while True:
+            event = self.next_event(timeout)
+            if event is None or isinstance(event, Frame):
+                return event
+
+    def __iter__(self):
+        """Frames until the stream ends (after close(), or the server ends it)."""
+        while True:
+            frame = self.next_frame()
+            if frame is None:
+                return
+            yield frame
+
+    def events(self):
+        """Frames and Notices until the stream ends."""
+        while True:
+            event = self.next_event()
+            if event is None:
+                return
+            yield event
+
+    # Ending.
+
+    def close(self, timeout=30.0):
+        """Half-closes (no more sends), then waits up to `timeout` s for the server to end the
+        stream, dropping frames not taken yet. Raises DeformError if the stream failed,
+        TimeoutError (after cancelling the call) if it did not end in time."""
+        with self._lock:
+            if not self._closing:
+                self._closing = True
+                self._requests.put(None)
+        deadline = time.monotonic() + timeout
+        try:
+            while self.next_event(timeout=max(0.0, deadline - time.monotonic())) is not None:
+                pass
+        except TimeoutError:
+            self.cancel()
+            raise
+
+    def cancel(self):
+        """Cancels the call now; the stream ends quietly."""
+        with self._lock:
+            self._cancelled = True
+        self._call.cancel()
+        self._requests.put(None)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, exc_type, exc, traceback):
+        if exc_type is None:
+            self.close()
+        else:
+            self.cancel()
+        return False
