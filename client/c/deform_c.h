@@ -31,7 +31,7 @@
  *   into the caller: frames and notices are polled. Calls that contact the server block (loads for
  *   as long as the server precomputes: seconds for large meshes); keep them off a render thread.
  *   deform_stream_next_frame with timeout 0 and the deform_stream_send_* functions never wait for
- *   the network.
+ *   the network. A handle must not be freed while another thread is inside a call on it.
  *
  * Units and layouts
  *   Positions are float x, y, z per vertex (3 floats per vertex) in the mesh's own units and

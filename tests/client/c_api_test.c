@@ -1,10 +1,11 @@
 /* The C API (client/c/deform_c.h) from C11, against the real deformd executable (DEFORMD_PATH,
  * or $DEFORM_TEST_DEFORMD) started on 127.0.0.1 with a kernel-chosen port: connect, load the
- * phantom, read its joints and rest geometry, stream a 90-degree knee flexion in each encoding and
- * check the shape, root motion, notices, stiffness, the error paths (unknown mesh, too small
- * buffers, closed streams, malformed poses) and a server with a token file. Prints the pose-to-
- * frame latency of one stream measured through the C API. Exits 0 when everything passed, 1 with
- * the failed check, the last error and the server's log otherwise. Every wait is bounded. */
+ * phantom (and the shared leg from its files when ../shared/data is present), read its joints and
+ * rest geometry, stream a 90-degree knee flexion in each encoding and check the shape, root motion,
+ * notices, stiffness, the error paths (unknown mesh, too small buffers, closed streams, malformed
+ * poses) and a server with a token file. Prints the pose-to-frame latency of one stream measured
+ * through the C API. Exits 0 when everything passed, 1 with the failed check, the last error and
+ * the server's log otherwise. Every wait is bounded. */
 #define _POSIX_C_SOURCE 200809L
 
 #include <errno.h>
@@ -476,6 +477,61 @@ static void test_phantom_session(const char* target) {
   free(frame);
 }
 
+/* Uploads from files: missing and unknown files fail before the server is asked; the shared leg
+ * (when ../shared/data is present) loads with its TGF skeleton and bends at its knee. */
+static void test_files(const char* target) {
+  deform_client* client = connect_to(target, NULL);
+  deform_mesh* mesh = NULL;
+  CHECK(deform_load_files(client, "/nonexistent/leg.obj", "/nonexistent/leg.tgf", NULL, &mesh) ==
+        DEFORM_NOT_FOUND);
+  CHECK(strstr(deform_last_error(), "/nonexistent/leg.obj") != NULL && mesh == NULL);
+  CHECK(deform_load_files(client, "leg.xyz", "leg.tgf", NULL, &mesh) == DEFORM_INVALID_ARGUMENT);
+  CHECK(strstr(deform_last_error(), "leg.xyz") != NULL);
+
+  const char* data = getenv("DEFORM_SHARED_DATA");
+  if (data == NULL) data = DEFORM_SHARED_DATA_DIR;
+  char obj[512], tgf[512];
+  snprintf(obj, sizeof obj, "%s/leg/leg_1633.obj", data);
+  snprintf(tgf, sizeof tgf, "%s/leg/leg.tgf", data);
+  if (access(obj, R_OK) != 0 || access(tgf, R_OK) != 0) {
+    printf("c_api_test: shared data absent (%s); skipping the shared leg\n", obj);
+    deform_client_free(client);
+    return;
+  }
+  CHECK(deform_load_files(client, obj, tgf, NULL, &mesh) == DEFORM_OK);
+  const char* name = NULL;
+  const char* mesh_id = NULL;
+  uint32_t n = 0;
+  CHECK(deform_mesh_name(mesh, &name) == DEFORM_OK && strcmp(name, "leg_1633.obj") == 0);
+  CHECK(deform_mesh_id(mesh, &mesh_id) == DEFORM_OK);
+  CHECK(deform_mesh_vertex_count(mesh, &n) == DEFORM_OK && n == 1633);
+  const size_t floats = 3 * (size_t)n;
+  float* rest = malloc(sizeof(float) * floats);
+  float* frame = malloc(sizeof(float) * floats);
+  CHECK(rest != NULL && frame != NULL);
+  CHECK(deform_mesh_rest_geometry(mesh, rest, floats, NULL, 0) == DEFORM_OK);
+  deform_stream* stream = NULL;
+  CHECK(deform_stream_open(client, mesh_id, DEFORM_ENCODING_FLOAT32, 0, &stream) == DEFORM_OK);
+  uint64_t sequence = 0;
+  CHECK(deform_stream_send_pose_text(stream, "1:x:90", &sequence) == DEFORM_OK);
+  deform_frame_info info;
+  frame_for(stream, sequence, frame, floats, &info);
+  double moved = 0;
+  for (uint32_t i = 0; i < n; ++i) {
+    const double d = distance(frame + 3 * (size_t)i, rest + 3 * (size_t)i);
+    if (d > moved) moved = d;
+  }
+  printf("c_api_test: leg_1633 bent 90 degrees at its knee: largest displacement %.3f\n", moved);
+  CHECK(moved > 1.0);
+  CHECK(deform_stream_close(stream, 5000) == DEFORM_OK);
+  deform_stream_free(stream);
+  CHECK(deform_unload_mesh(client, mesh_id) == DEFORM_OK);
+  deform_mesh_free(mesh);
+  deform_client_free(client);
+  free(rest);
+  free(frame);
+}
+
 /* A server with a token file: no token UNAUTHENTICATED, the right one gets in. */
 static void test_token_server(void) {
   /* The token and its SHA-256 (printf '%s' TOKEN | sha256sum). */
@@ -534,6 +590,7 @@ int main(void) {
   g_servers[0] = &server;
   start_deformd(&server, NULL);
   test_phantom_session(server.target);
+  test_files(server.target);
   CHECK(stop_deformd(&server) == 0);
   test_token_server();
   printf("c_api_test: passed\n");
