@@ -21,6 +21,8 @@ deform_status FromGrpc(const grpc::Status& status, const std::string& context = 
 
 // Runs `body` (returning deform_status) and turns any exception into a status: bad_alloc into
 // RESOURCE_EXHAUSTED, anything else into INTERNAL naming what() where there is one.
+// `function` is the C function's name: take __func__ outside the lambda (inside, it names the
+// lambda's operator()).
 template <typename Body>
 deform_status Guarded(const char* function, Body&& body) noexcept {
   try {

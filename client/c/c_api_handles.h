@@ -1,5 +1,6 @@
-// The structs behind the C API's opaque handles. Each holds a shared_ptr to the C++ client it
-// came from, so handles may be freed in any order.
+// The structs behind the C API's client and mesh handles (deform_stream is in deform_c_stream.cc,
+// beside what its callbacks fill). Each holds a shared_ptr to the C++ client it came from, so
+// handles may be freed in any order.
 #pragma once
 
 #include <memory>

@@ -99,9 +99,10 @@ using deform::c_api::Succeed;
 extern "C" {
 
 deform_status deform_connect(const deform_connect_options* options, deform_client** out) {
-  return Guarded(__func__, [&] {
+  const char* const fn = __func__;
+  return Guarded(fn, [&] {
     deform_status status;
-    if (Missing(options, __func__, "options", &status) || Missing(out, __func__, "out", &status)) {
+    if (Missing(options, fn, "options", &status) || Missing(out, fn, "out", &status)) {
       return status;
     }
     if (options->target == nullptr || options->target[0] == '\0') {
@@ -128,9 +129,10 @@ void deform_client_free(deform_client* client) { delete client; }
 
 deform_status deform_load_phantom(deform_client* client, int vertices, const char* name,
                                   deform_mesh** out) {
-  return Guarded(__func__, [&] {
+  const char* const fn = __func__;
+  return Guarded(fn, [&] {
     deform_status status;
-    if (Missing(client, __func__, "client", &status) || Missing(out, __func__, "out", &status)) {
+    if (Missing(client, fn, "client", &status) || Missing(out, fn, "out", &status)) {
       return status;
     }
     if (vertices < 0) return Fail(DEFORM_INVALID_ARGUMENT, "deform_load_phantom: vertices < 0");
@@ -145,11 +147,11 @@ deform_status deform_load_phantom(deform_client* client, int vertices, const cha
 deform_status deform_load_files(deform_client* client, const char* mesh_path,
                                 const char* skeleton_path, const char* weights_path,
                                 deform_mesh** out) {
-  return Guarded(__func__, [&] {
+  const char* const fn = __func__;
+  return Guarded(fn, [&] {
     deform_status status;
-    if (Missing(client, __func__, "client", &status) ||
-        Missing(mesh_path, __func__, "mesh_path", &status) ||
-        Missing(out, __func__, "out", &status)) {
+    if (Missing(client, fn, "client", &status) || Missing(mesh_path, fn, "mesh_path", &status) ||
+        Missing(out, fn, "out", &status)) {
       return status;
     }
     deform::v1::MeshSummary summary;
@@ -162,10 +164,11 @@ deform_status deform_load_files(deform_client* client, const char* mesh_path,
 }
 
 deform_status deform_mesh_open(deform_client* client, const char* mesh_id, deform_mesh** out) {
-  return Guarded(__func__, [&] {
+  const char* const fn = __func__;
+  return Guarded(fn, [&] {
     deform_status status;
-    if (Missing(client, __func__, "client", &status) ||
-        Missing(mesh_id, __func__, "mesh_id", &status) || Missing(out, __func__, "out", &status)) {
+    if (Missing(client, fn, "client", &status) || Missing(mesh_id, fn, "mesh_id", &status) ||
+        Missing(out, fn, "out", &status)) {
       return status;
     }
     deform::v1::GetMeshInfoResponse info;
@@ -178,9 +181,10 @@ deform_status deform_mesh_open(deform_client* client, const char* mesh_id, defor
 void deform_mesh_free(deform_mesh* mesh) { delete mesh; }
 
 deform_status deform_mesh_id(const deform_mesh* mesh, const char** id) {
-  return Guarded(__func__, [&] {
+  const char* const fn = __func__;
+  return Guarded(fn, [&] {
     deform_status status;
-    if (Missing(mesh, __func__, "mesh", &status) || Missing(id, __func__, "id", &status)) {
+    if (Missing(mesh, fn, "mesh", &status) || Missing(id, fn, "id", &status)) {
       return status;
     }
     *id = mesh->summary.mesh_id().c_str();
@@ -189,9 +193,10 @@ deform_status deform_mesh_id(const deform_mesh* mesh, const char** id) {
 }
 
 deform_status deform_mesh_name(const deform_mesh* mesh, const char** name) {
-  return Guarded(__func__, [&] {
+  const char* const fn = __func__;
+  return Guarded(fn, [&] {
     deform_status status;
-    if (Missing(mesh, __func__, "mesh", &status) || Missing(name, __func__, "name", &status)) {
+    if (Missing(mesh, fn, "mesh", &status) || Missing(name, fn, "name", &status)) {
       return status;
     }
     *name = mesh->summary.name().c_str();
@@ -200,9 +205,10 @@ deform_status deform_mesh_name(const deform_mesh* mesh, const char** name) {
 }
 
 deform_status deform_mesh_vertex_count(const deform_mesh* mesh, uint32_t* count) {
-  return Guarded(__func__, [&] {
+  const char* const fn = __func__;
+  return Guarded(fn, [&] {
     deform_status status;
-    if (Missing(mesh, __func__, "mesh", &status) || Missing(count, __func__, "count", &status)) {
+    if (Missing(mesh, fn, "mesh", &status) || Missing(count, fn, "count", &status)) {
       return status;
     }
     *count = mesh->summary.vertex_count();
@@ -211,9 +217,10 @@ deform_status deform_mesh_vertex_count(const deform_mesh* mesh, uint32_t* count)
 }
 
 deform_status deform_mesh_triangle_count(const deform_mesh* mesh, uint32_t* count) {
-  return Guarded(__func__, [&] {
+  const char* const fn = __func__;
+  return Guarded(fn, [&] {
     deform_status status;
-    if (Missing(mesh, __func__, "mesh", &status) || Missing(count, __func__, "count", &status)) {
+    if (Missing(mesh, fn, "mesh", &status) || Missing(count, fn, "count", &status)) {
       return status;
     }
     *count = mesh->summary.triangle_count();
@@ -223,9 +230,10 @@ deform_status deform_mesh_triangle_count(const deform_mesh* mesh, uint32_t* coun
 
 deform_status deform_mesh_rest_geometry(deform_mesh* mesh, float* positions, size_t capacity_floats,
                                         uint32_t* triangles, size_t capacity_indices) {
-  return Guarded(__func__, [&] {
+  const char* const fn = __func__;
+  return Guarded(fn, [&] {
     deform_status status;
-    if (Missing(mesh, __func__, "mesh", &status)) return status;
+    if (Missing(mesh, fn, "mesh", &status)) return status;
     const std::size_t floats = 3 * static_cast<std::size_t>(mesh->summary.vertex_count());
     const std::size_t indices = 3 * static_cast<std::size_t>(mesh->summary.triangle_count());
     if (positions != nullptr && capacity_floats < floats) {
@@ -254,9 +262,10 @@ deform_status deform_mesh_rest_geometry(deform_mesh* mesh, float* positions, siz
 }
 
 deform_status deform_mesh_joint_count(const deform_mesh* mesh, uint32_t* count) {
-  return Guarded(__func__, [&] {
+  const char* const fn = __func__;
+  return Guarded(fn, [&] {
     deform_status status;
-    if (Missing(mesh, __func__, "mesh", &status) || Missing(count, __func__, "count", &status)) {
+    if (Missing(mesh, fn, "mesh", &status) || Missing(count, fn, "count", &status)) {
       return status;
     }
     *count = static_cast<uint32_t>(mesh->summary.joints_size());
@@ -265,12 +274,13 @@ deform_status deform_mesh_joint_count(const deform_mesh* mesh, uint32_t* count) 
 }
 
 deform_status deform_mesh_joint(const deform_mesh* mesh, uint32_t joint, deform_joint_info* info) {
-  return Guarded(__func__, [&] {
+  const char* const fn = __func__;
+  return Guarded(fn, [&] {
     deform_status status;
-    if (Missing(mesh, __func__, "mesh", &status) || Missing(info, __func__, "info", &status)) {
+    if (Missing(mesh, fn, "mesh", &status) || Missing(info, fn, "info", &status)) {
       return status;
     }
-    const deform::v1::JointInfo* found = deform::c_api::FindJoint(mesh, joint, __func__, &status);
+    const deform::v1::JointInfo* found = deform::c_api::FindJoint(mesh, joint, fn, &status);
     if (found == nullptr) return status;
     info->name = found->name().c_str();
     for (int a = 0; a < 3; ++a) {
@@ -285,12 +295,13 @@ deform_status deform_mesh_joint(const deform_mesh* mesh, uint32_t joint, deform_
 
 deform_status deform_mesh_joint_dof(const deform_mesh* mesh, uint32_t joint, uint32_t dof,
                                     deform_dof_info* info) {
-  return Guarded(__func__, [&] {
+  const char* const fn = __func__;
+  return Guarded(fn, [&] {
     deform_status status;
-    if (Missing(mesh, __func__, "mesh", &status) || Missing(info, __func__, "info", &status)) {
+    if (Missing(mesh, fn, "mesh", &status) || Missing(info, fn, "info", &status)) {
       return status;
     }
-    const deform::v1::JointInfo* found = deform::c_api::FindJoint(mesh, joint, __func__, &status);
+    const deform::v1::JointInfo* found = deform::c_api::FindJoint(mesh, joint, fn, &status);
     if (found == nullptr) return status;
     if (dof >= static_cast<uint32_t>(found->dofs_size())) {
       return Fail(DEFORM_OUT_OF_RANGE, "deform_mesh_joint_dof: degree of freedom " +
@@ -310,9 +321,10 @@ deform_status deform_mesh_joint_dof(const deform_mesh* mesh, uint32_t joint, uin
 
 deform_status deform_list_meshes(deform_client* client, char* buffer, size_t capacity,
                                  size_t* needed, size_t* count) {
-  return Guarded(__func__, [&] {
+  const char* const fn = __func__;
+  return Guarded(fn, [&] {
     deform_status status;
-    if (Missing(client, __func__, "client", &status)) return status;
+    if (Missing(client, fn, "client", &status)) return status;
     if (buffer == nullptr && capacity > 0) {
       return Fail(DEFORM_INVALID_ARGUMENT, "deform_list_meshes: buffer is NULL, capacity > 0");
     }
@@ -334,10 +346,10 @@ deform_status deform_list_meshes(deform_client* client, char* buffer, size_t cap
 }
 
 deform_status deform_unload_mesh(deform_client* client, const char* mesh_id) {
-  return Guarded(__func__, [&] {
+  const char* const fn = __func__;
+  return Guarded(fn, [&] {
     deform_status status;
-    if (Missing(client, __func__, "client", &status) ||
-        Missing(mesh_id, __func__, "mesh_id", &status)) {
+    if (Missing(client, fn, "client", &status) || Missing(mesh_id, fn, "mesh_id", &status)) {
       return status;
     }
     return FromGrpc(client->client->UnloadMesh(mesh_id), "deform_unload_mesh");

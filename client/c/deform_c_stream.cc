@@ -127,10 +127,11 @@ extern "C" {
 
 deform_status deform_stream_open(deform_client* client, const char* mesh_id,
                                  deform_encoding encoding, double max_error, deform_stream** out) {
-  return Guarded(__func__, [&] {
+  const char* const fn = __func__;
+  return Guarded(fn, [&] {
     deform_status status;
-    if (Missing(client, __func__, "client", &status) ||
-        Missing(mesh_id, __func__, "mesh_id", &status) || Missing(out, __func__, "out", &status)) {
+    if (Missing(client, fn, "client", &status) || Missing(mesh_id, fn, "mesh_id", &status) ||
+        Missing(out, fn, "out", &status)) {
       return status;
     }
     if (encoding < DEFORM_ENCODING_FLOAT32 || encoding > DEFORM_ENCODING_PREDICTED) {
@@ -162,10 +163,10 @@ deform_status deform_stream_open(deform_client* client, const char* mesh_id,
 }
 
 deform_status deform_stream_vertex_count(const deform_stream* stream, uint32_t* count) {
-  return Guarded(__func__, [&] {
+  const char* const fn = __func__;
+  return Guarded(fn, [&] {
     deform_status status;
-    if (Missing(stream, __func__, "stream", &status) ||
-        Missing(count, __func__, "count", &status)) {
+    if (Missing(stream, fn, "stream", &status) || Missing(count, fn, "count", &status)) {
       return status;
     }
     *count = stream->vertex_count;
@@ -177,9 +178,10 @@ deform_status deform_stream_send_pose(deform_stream* stream, const deform_joint_
                                       size_t angle_count, const deform_joint_rotation* rotations,
                                       size_t rotation_count, const deform_root_transform* root,
                                       uint64_t* sequence) {
-  return Guarded(__func__, [&] {
+  const char* const fn = __func__;
+  return Guarded(fn, [&] {
     deform_status status;
-    if (Missing(stream, __func__, "stream", &status)) return status;
+    if (Missing(stream, fn, "stream", &status)) return status;
     if ((angles == nullptr && angle_count > 0) || (rotations == nullptr && rotation_count > 0)) {
       return Fail(DEFORM_INVALID_ARGUMENT,
                   "deform_stream_send_pose: an array is NULL but its count is not 0");
@@ -223,10 +225,10 @@ deform_status deform_stream_send_pose(deform_stream* stream, const deform_joint_
 
 deform_status deform_stream_send_pose_text(deform_stream* stream, const char* pose_text,
                                            uint64_t* sequence) {
-  return Guarded(__func__, [&] {
+  const char* const fn = __func__;
+  return Guarded(fn, [&] {
     deform_status status;
-    if (Missing(stream, __func__, "stream", &status) ||
-        Missing(pose_text, __func__, "pose", &status)) {
+    if (Missing(stream, fn, "stream", &status) || Missing(pose_text, fn, "pose", &status)) {
       return status;
     }
     deform::v1::PoseUpdate pose;
@@ -244,9 +246,10 @@ deform_status deform_stream_send_stiffness(deform_stream* stream,
                                            const deform_region_weight* regions, size_t region_count,
                                            const uint32_t* vertex_indices,
                                            const double* vertex_weights, size_t vertex_count) {
-  return Guarded(__func__, [&] {
+  const char* const fn = __func__;
+  return Guarded(fn, [&] {
     deform_status status;
-    if (Missing(stream, __func__, "stream", &status)) return status;
+    if (Missing(stream, fn, "stream", &status)) return status;
     if ((materials == nullptr && material_count > 0) || (regions == nullptr && region_count > 0) ||
         ((vertex_indices == nullptr || vertex_weights == nullptr) && vertex_count > 0)) {
       return Fail(DEFORM_INVALID_ARGUMENT,
@@ -293,10 +296,10 @@ deform_status deform_stream_send_stiffness(deform_stream* stream,
 deform_status deform_stream_next_frame(deform_stream* stream, float* positions,
                                        size_t capacity_floats, int timeout_ms,
                                        deform_frame_info* info) {
-  return Guarded(__func__, [&] {
+  const char* const fn = __func__;
+  return Guarded(fn, [&] {
     deform_status status;
-    if (Missing(stream, __func__, "stream", &status) ||
-        Missing(positions, __func__, "positions", &status)) {
+    if (Missing(stream, fn, "stream", &status) || Missing(positions, fn, "positions", &status)) {
       return status;
     }
     deform::c_api::StreamInbox& inbox = *stream->inbox;
@@ -349,9 +352,10 @@ deform_status deform_stream_next_frame(deform_stream* stream, float* positions,
 
 deform_status deform_stream_next_notice(deform_stream* stream, deform_notice_info* info,
                                         char* message, size_t message_capacity) {
-  return Guarded(__func__, [&] {
+  const char* const fn = __func__;
+  return Guarded(fn, [&] {
     deform_status status;
-    if (Missing(stream, __func__, "stream", &status) || Missing(info, __func__, "info", &status)) {
+    if (Missing(stream, fn, "stream", &status) || Missing(info, fn, "info", &status)) {
       return status;
     }
     if (message == nullptr && message_capacity > 0) {
@@ -376,9 +380,10 @@ deform_status deform_stream_next_notice(deform_stream* stream, deform_notice_inf
 }
 
 deform_status deform_stream_close(deform_stream* stream, int timeout_ms) {
-  return Guarded(__func__, [&] {
+  const char* const fn = __func__;
+  return Guarded(fn, [&] {
     deform_status status;
-    if (Missing(stream, __func__, "stream", &status)) return status;
+    if (Missing(stream, fn, "stream", &status)) return status;
     {
       std::lock_guard<std::mutex> lock(stream->send_mutex);
       stream->closed = true;
