@@ -426,6 +426,26 @@ static void test_phantom_session(const char* target) {
   frame_for(stream, sequence, frame, floats, &info);
   CHECK(info.stiffness_version == notice.stiffness_version);
 
+  /* Latest wins: pose A's frame waits untaken (a poll with a buffer one float short sees it
+   * without taking it), pose B is sent, and a poll a second later gets B's frame with A's counted
+   * as replaced (or, if B's frame were that late, A's frame with none replaced, then B's). */
+  uint64_t pose_a = 0, pose_b = 0;
+  CHECK(deform_stream_send_pose_text(stream, "knee:flexion:30", &pose_a) == DEFORM_OK);
+  status = DEFORM_NO_DATA;
+  for (int tries = 0; status == DEFORM_NO_DATA && tries < 20; ++tries) {
+    status = deform_stream_next_frame(stream, frame, floats - 1, 500, &info);
+  }
+  CHECK(status == DEFORM_INVALID_ARGUMENT);
+  CHECK(deform_stream_send_pose_text(stream, "knee:flexion:60", &pose_b) == DEFORM_OK);
+  sleep_ms(1000);
+  CHECK(deform_stream_next_frame(stream, frame, floats, 0, &info) == DEFORM_OK);
+  CHECK((info.sequence == pose_b && info.frames_dropped == 1) ||
+        (info.sequence == pose_a && info.frames_dropped == 0));
+  printf("c_api_test: latest wins: the poll after two frames got pose %s's frame, %llu replaced\n",
+         info.sequence == pose_b ? "B" : "A", (unsigned long long)info.frames_dropped);
+  if (info.sequence == pose_a) frame_for(stream, pose_b, frame, floats, &info);
+  CHECK(deform_stream_next_frame(stream, frame, floats, 0, &info) == DEFORM_NO_DATA);
+
   /* Latency of one stream through the C API: one pose at a time, each waiting for its frame. */
   enum { kPoses = 200 };
   double latencies[kPoses];
