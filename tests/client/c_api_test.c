@@ -3,9 +3,9 @@
  * phantom (and the shared leg from its files when ../shared/data is present), read its joints and
  * rest geometry, stream a 90-degree knee flexion in each encoding and check the shape, root motion,
  * notices, stiffness, the error paths (unknown mesh, too small buffers, closed streams, malformed
- * poses) and a server with a token file. Prints the pose-to-frame latency of one stream measured
- * through the C API. Exits 0 when everything passed, 1 with the failed check, the last error and
- * the server's log otherwise. Every wait is bounded. */
+ * poses), a server with a token file and one with mutual TLS. Prints the pose-to-frame latency of
+ * one stream measured through the C API. Exits 0 when everything passed, 1 with the failed check,
+ * the last error and the server's log otherwise. Every wait is bounded. */
 #define _POSIX_C_SOURCE 200809L
 
 #include <errno.h>
@@ -603,6 +603,108 @@ static void test_token_server(void) {
   CHECK(deform_connect(&options, &nobody) == DEFORM_UNAVAILABLE && nobody == NULL);
 }
 
+/* The whole of a small text file, NUL-terminated (malloc'd). */
+static char* read_text(const char* path) {
+  FILE* file = fopen(path, "rb");
+  CHECK(file != NULL);
+  char* text = malloc(65536);
+  CHECK(text != NULL);
+  const size_t length = fread(text, 1, 65535, file);
+  fclose(file);
+  text[length] = '\0';
+  return text;
+}
+
+/* A server with mutual TLS (certificates from scripts/make-test-certificates.sh): plaintext and a
+ * client without a certificate, or with one from another CA, do not get in; the CA and client
+ * certificate as files or as PEM text do, with the server name given. */
+static void test_tls_server(void) {
+  char dir[] = "/tmp/deform-c-api-certs-XXXXXX";
+  CHECK(mkdtemp(dir) != NULL);
+  const pid_t maker = fork();
+  CHECK(maker >= 0);
+  if (maker == 0) {
+    const int null_fd = open("/dev/null", O_WRONLY);
+    dup2(null_fd, STDOUT_FILENO);
+    execl("/bin/bash", "bash", DEFORM_SOURCE_DIR "/scripts/make-test-certificates.sh", dir,
+          (char*)NULL);
+    _exit(127);
+  }
+  int made = 0;
+  CHECK(waitpid(maker, &made, 0) == maker && WIFEXITED(made) && WEXITSTATUS(made) == 0);
+  char ca[128], server_cert[128], server_key[128], client_cert[128], client_key[128],
+      other_cert[128], other_key[128];
+  snprintf(ca, sizeof ca, "%s/ca.pem", dir);
+  snprintf(server_cert, sizeof server_cert, "%s/server.pem", dir);
+  snprintf(server_key, sizeof server_key, "%s/server.key", dir);
+  snprintf(client_cert, sizeof client_cert, "%s/client.pem", dir);
+  snprintf(client_key, sizeof client_key, "%s/client.key", dir);
+  snprintf(other_cert, sizeof other_cert, "%s/other-client.pem", dir);
+  snprintf(other_key, sizeof other_key, "%s/other-client.key", dir);
+
+  deformd_process server;
+  memset(&server, 0, sizeof server);
+  g_servers[1] = &server;
+  const char* const extra[] = {"--tls-cert",      server_cert, "--tls-key", server_key,
+                               "--tls-client-ca", ca,          NULL};
+  start_deformd(&server, extra);
+
+  deform_connect_options options;
+  memset(&options, 0, sizeof options);
+  options.target = server.target;
+  options.connect_timeout_ms = 1500;
+  deform_client* client = NULL;
+  CHECK(deform_connect(&options, &client) == DEFORM_UNAVAILABLE); /* plaintext */
+  options.ca_file = ca;
+  CHECK(deform_connect(&options, &client) == DEFORM_UNAVAILABLE); /* no client certificate */
+  options.cert_file = other_cert;
+  options.key_file = other_key;
+  CHECK(deform_connect(&options, &client) == DEFORM_UNAVAILABLE); /* another CA's client */
+  CHECK(client == NULL);
+
+  options.cert_file = client_cert;
+  options.key_file = client_key;
+  options.server_name = "not-the-server"; /* the certificate is for localhost and 127.0.0.1 */
+  CHECK(deform_connect(&options, &client) == DEFORM_UNAVAILABLE);
+  options.server_name = "localhost";
+  options.connect_timeout_ms = 10000;
+  CHECK(deform_connect(&options, &client) == DEFORM_OK);
+  deform_mesh* mesh = NULL;
+  CHECK(deform_load_phantom(client, 400, NULL, &mesh) == DEFORM_OK);
+  deform_mesh_free(mesh);
+  deform_client_free(client);
+
+  deform_connect_options pem;
+  memset(&pem, 0, sizeof pem);
+  pem.target = server.target;
+  pem.ca_pem = read_text(ca);
+  pem.cert_pem = read_text(client_cert);
+  pem.key_pem = read_text(client_key);
+  pem.connect_timeout_ms = 10000;
+  CHECK(deform_connect(&pem, &client) == DEFORM_OK);
+  size_t count = 0;
+  CHECK(deform_list_meshes(client, NULL, 0, NULL, &count) == DEFORM_INVALID_ARGUMENT);
+  CHECK(count == 1);
+  deform_client_free(client);
+  free((char*)pem.ca_pem);
+  free((char*)pem.cert_pem);
+  free((char*)pem.key_pem);
+  printf(
+      "c_api_test: mutual TLS: refused plaintext, no certificate, another CA's and a wrong "
+      "server name; files and PEM text got in\n");
+
+  CHECK(stop_deformd(&server) == 0);
+  const char* names[] = {"ca.pem",           "ca.key",          "server.pem",   "server.key",
+                         "client.pem",       "client.key",      "other-ca.pem", "other-ca.key",
+                         "other-client.pem", "other-client.key"};
+  for (size_t k = 0; k < sizeof names / sizeof names[0]; ++k) {
+    char path[160];
+    snprintf(path, sizeof path, "%s/%s", dir, names[k]);
+    unlink(path);
+  }
+  CHECK(rmdir(dir) == 0);
+}
+
 int main(void) {
   signal(SIGPIPE, SIG_IGN);
   test_arguments_without_a_server();
@@ -614,6 +716,7 @@ int main(void) {
   test_files(server.target);
   CHECK(stop_deformd(&server) == 0);
   test_token_server();
+  test_tls_server();
   printf("c_api_test: passed\n");
   return 0;
 }
