@@ -2,10 +2,11 @@
  * or $DEFORM_TEST_DEFORMD) started on 127.0.0.1 with a kernel-chosen port: connect, load the
  * phantom (and the shared leg from its files when ../shared/data is present), read its joints and
  * rest geometry, stream a 90-degree knee flexion in each encoding and check the shape, root motion,
- * notices, stiffness, the error paths (unknown mesh, too small buffers, closed streams, malformed
- * poses), a server with a token file and one with mutual TLS. Prints the pose-to-frame latency of
- * one stream measured through the C API. Exits 0 when everything passed, 1 with the failed check,
- * the last error and the server's log otherwise. Every wait is bounded. */
+ * latest wins, polling while another thread sends, notices, stiffness, the error paths (unknown
+ * mesh, too small buffers, closed streams, malformed poses), a server with a token file and one
+ * with mutual TLS. Prints the pose-to-frame latency of one stream measured through the C API.
+ * Exits 0 when everything passed, 1 with the failed check, the last error and the server's log
+ * otherwise. Every wait is bounded. */
 #define _POSIX_C_SOURCE 200809L
 
 #include <errno.h>
@@ -17,6 +18,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/wait.h>
+#include <threads.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -214,6 +216,27 @@ static double along(const float* p, const float* origin, const float* toward, do
 static int compare_doubles(const void* a, const void* b) {
   const double x = *(const double*)a, y = *(const double*)b;
   return (x > y) - (x < y);
+}
+
+/* A thread that sends `count` flexion poses on `stream`, 1 ms apart (C11 threads). */
+typedef struct pose_sender {
+  deform_stream* stream;
+  int count;
+  uint64_t last_sequence;
+  int failures;
+} pose_sender;
+
+static int send_poses(void* argument) {
+  pose_sender* sender = argument;
+  for (int k = 0; k < sender->count; ++k) {
+    const deform_joint_angle angle = {"knee", "flexion", 100.0 * k / sender->count};
+    if (deform_stream_send_pose(sender->stream, &angle, 1, NULL, 0, NULL, &sender->last_sequence) !=
+        DEFORM_OK) {
+      ++sender->failures;
+    }
+    sleep_ms(1);
+  }
+  return 0;
 }
 
 /* ---- The tests ----------------------------------------------------------------------------- */
@@ -460,6 +483,31 @@ static void test_phantom_session(const char* target) {
       "c_api_test: pose-to-frame latency through the C API, %u-vertex phantom, %d poses one at "
       "a time: p50 %.2f ms, p90 %.2f ms, max %.2f ms\n",
       n, kPoses, latencies[kPoses / 2], latencies[kPoses * 9 / 10], latencies[kPoses - 1]);
+
+  /* One thread sends while this one polls: every frame taken is whole and newer than the last,
+   * and after the sender stops the last pose's frame arrives. */
+  pose_sender sender = {stream, 300, 0, 0};
+  thrd_t thread;
+  CHECK(thrd_create(&thread, send_poses, &sender) == thrd_success);
+  uint64_t previous = 0, taken = 0, dropped = 0;
+  const double polling_ends = now_ms() + 200;
+  while (now_ms() < polling_ends) {
+    status = deform_stream_next_frame(stream, frame, floats, 20, &info);
+    CHECK(status == DEFORM_OK || status == DEFORM_NO_DATA);
+    if (status != DEFORM_OK) continue;
+    CHECK(info.sequence > previous && info.vertex_count == n);
+    previous = info.sequence;
+    ++taken;
+    dropped += info.frames_dropped;
+  }
+  CHECK(thrd_join(thread, NULL) == thrd_success);
+  CHECK(sender.failures == 0 && sender.last_sequence > previous);
+  frame_for(stream, sender.last_sequence, frame, floats, &info);
+  printf(
+      "c_api_test: polling while another thread sent 300 poses: %llu frames taken in 200 ms, "
+      "%llu replaced before being taken\n",
+      (unsigned long long)taken, (unsigned long long)dropped);
+  CHECK(taken > 0);
 
   /* Closing ends the stream: no more poses, frames report the end. */
   CHECK(deform_stream_close(stream, 5000) == DEFORM_OK);
