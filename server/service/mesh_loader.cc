@@ -46,6 +46,12 @@ StatusOr<std::shared_ptr<const MeshEntry>> Build(MeshRegistry* registry,
       "about {} KiB",
       entry->id, EscapeForLog(entry->tenant), EscapeForLog(entry->name), vertices, entry->precompute_ms, entry->factor_ms,
       entry->memory_bytes >> 10);
+  std::string phases;
+  for (const DeformationModel::BuildPhase& phase : entry->model->build_phases()) {
+    phases += fmt::format("{}{} {:.0f} ms", phases.empty() ? "" : ", ", phase.name,
+                          phase.seconds * 1e3);
+  }
+  spdlog::debug("mesh={} build phases: {}", entry->id, phases);
   for (const std::string& warning : entry->model->binding_report().warnings) {
     spdlog::warn("mesh={} binding: {}", entry->id, EscapeForLog(warning));
   }

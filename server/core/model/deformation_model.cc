@@ -79,8 +79,9 @@ StatusOr<std::shared_ptr<const DeformationModel>> DeformationModel::Build(
   DEFORM_RETURN_IF_ERROR(ValidateMesh(mesh, options.limits));
   DEFORM_RETURN_IF_ERROR(ValidateModelOptions(options));
   if (hooks.validated) DEFORM_RETURN_IF_ERROR(hooks.validated());
-  DEFORM_RETURN_IF_ERROR(CheckCancelled(hooks.cancel, "validation"));
   std::shared_ptr<DeformationModel> model(new DeformationModel());
+  model->phase_start_ = start;
+  DEFORM_RETURN_IF_ERROR(model->EndPhase(hooks.cancel, "validation"));
   model->id_ = NextModelId();
   model->mesh_ = std::move(mesh);
   model->skeleton_ = std::move(skeleton);
@@ -90,6 +91,8 @@ StatusOr<std::shared_ptr<const DeformationModel>> DeformationModel::Build(
   if (hooks.precomputed) hooks.precomputed();
   DEFORM_ASSIGN_OR_RETURN(model->default_factorization_,
                           model->FactorizeCancellable(Stiffness{}, hooks.cancel));
+  model->build_phases_.push_back(
+      {"the numeric factorisation", model->default_factorization_->factor_seconds()});
   spdlog::debug("model built: {} vertices, {} joint nodes, {} anchors, factor {} non-zeros",
                 model->mesh_.num_vertices(), model->system_.num_nodes,
                 model->system_.anchors.size(), model->default_factorization_->factor().nonzeros());
@@ -101,15 +104,15 @@ Status DeformationModel::Precompute(const SkinWeights* weights, const CancelToke
   const VertexAdjacency adjacency = BuildVertexAdjacency(mesh_.triangles, mesh_.num_vertices());
   const TriangleBvh bvh(mesh_);
   DEFORM_RETURN_IF_ERROR(CheckSkeletonAgainstMesh(mesh_, skeleton_, bvh));
-  DEFORM_RETURN_IF_ERROR(CheckCancelled(cancel, "the mesh's adjacency"));
+  DEFORM_RETURN_IF_ERROR(EndPhase(cancel, "the mesh's adjacency"));
   if (weights != nullptr) {
     DEFORM_RETURN_IF_ERROR(BindToWeights(*weights, adjacency));
   } else {
     DEFORM_RETURN_IF_ERROR(BindAutomatically(adjacency, bvh, cancel));
   }
-  DEFORM_RETURN_IF_ERROR(CheckCancelled(cancel, "the harmonic weights"));
+  DEFORM_RETURN_IF_ERROR(EndPhase(cancel, "the harmonic weights"));
   system_ = BuildLaplacianSystem(mesh_, adjacency, regions_, rigid_bones_, bone_weights_, options_);
-  DEFORM_RETURN_IF_ERROR(CheckCancelled(cancel, "the Laplacian system"));
+  DEFORM_RETURN_IF_ERROR(EndPhase(cancel, "the Laplacian system"));
   if (options_.rotation_blend == RotationBlend::kLinear) {
     linear_blend_plan_ = std::make_shared<const LinearBlendPlan>(LinearBlendPlan::Build(
         bone_weights_, skeleton_.num_bones(), options_.linear_blend_segments));
@@ -121,14 +124,14 @@ Status DeformationModel::Precompute(const SkinWeights* weights, const CancelToke
   report.reached_along_surface = binding_report_.reached_along_surface;
   report.straight_line = binding_report_.straight_line;
   binding_report_ = std::move(report);
-  DEFORM_RETURN_IF_ERROR(CheckCancelled(cancel, "the binding report"));
+  DEFORM_RETURN_IF_ERROR(EndPhase(cancel, "the binding report"));
   DEFORM_ASSIGN_OR_RETURN(
       symbolic_, SymbolicCholesky::Analyze(NormalMatrixPattern(system_), options_.ordering));
-  return CheckCancelled(cancel, "the symbolic analysis");
+  return EndPhase(cancel, "the symbolic analysis");
 }
 
-Status DeformationModel::BindAutomatically(const VertexAdjacency& adjacency,
-                                           const TriangleBvh& bvh, const CancelToken* cancel) {
+Status DeformationModel::BindAutomatically(const VertexAdjacency& adjacency, const TriangleBvh& bvh,
+                                           const CancelToken* cancel) {
   std::vector<NearestBone> bound;
   if (options_.binding == BindingMethod::kThroughBody) {
     BodyBinding binding = BindThroughBody(mesh_, skeleton_, adjacency, bvh);
@@ -142,13 +145,12 @@ Status DeformationModel::BindAutomatically(const VertexAdjacency& adjacency,
     binding_report_.source = "straight line";
     binding_report_.straight_line = mesh_.num_vertices();
   }
-  DEFORM_RETURN_IF_ERROR(CheckCancelled(cancel, "the binding"));
-  DEFORM_ASSIGN_OR_RETURN(
-      JointRegions regions,
-      ComputeJointRegions(mesh_, skeleton_, adjacency, bound, options_.regions));
+  DEFORM_RETURN_IF_ERROR(EndPhase(cancel, "the binding"));
+  DEFORM_ASSIGN_OR_RETURN(JointRegions regions, ComputeJointRegions(mesh_, skeleton_, adjacency,
+                                                                    bound, options_.regions));
   regions_ = KeepRigidCores(mesh_, adjacency, bound, std::move(regions), kMinRigidFraction);
   rigid_bones_ = RigidZones(regions_, bound);
-  DEFORM_RETURN_IF_ERROR(CheckCancelled(cancel, "the joint regions"));
+  DEFORM_RETURN_IF_ERROR(EndPhase(cancel, "the joint regions"));
   DEFORM_ASSIGN_OR_RETURN(bone_weights_,
                           HarmonicBoneWeights(adjacency, rigid_bones_, skeleton_.num_bones(),
                                               RegionBonesPerVertex(regions_, skeleton_, bound)));
@@ -172,6 +174,13 @@ Status DeformationModel::BindToWeights(const SkinWeights& weights,
   given_weights_ = normalized;
   binding_report_.source = "given weights";
   return Status::Ok();
+}
+
+Status DeformationModel::EndPhase(const CancelToken* cancel, const char* phase) {
+  const auto now = Clock::now();
+  build_phases_.push_back({phase, std::chrono::duration<double>(now - phase_start_).count()});
+  phase_start_ = now;
+  return CheckCancelled(cancel, phase);
 }
 
 StatusOr<std::shared_ptr<const MaterialFactorization>> DeformationModel::Factorize(
@@ -260,7 +269,7 @@ DeformScratch DeformationModel::MakeScratch() const {
   scratch.num_vertices = mesh_.num_vertices();
   scratch.bone_transforms.resize(skeleton_.num_bones());
   scratch.slot_rotations.resize(linear_blend_plan_ ? linear_blend_plan_->num_slots()
-                                                  : skeleton_.num_bones());
+                                                   : skeleton_.num_bones());
   scratch.solution.resize(mesh_.num_vertices() + system_.num_nodes, 3);
   scratch.rotated_deltas.resize(mesh_.num_vertices(), 3);
   scratch.solve_work.resize(default_factorization_->factor().WorkSize());

@@ -19,6 +19,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -199,6 +200,15 @@ class DeformationModel {
   double bounding_box_diagonal() const { return diagonal_; }
   // Seconds spent in Build() before the first numeric factorisation.
   double precompute_seconds() const { return precompute_seconds_; }
+  // The build's phases in order, each with its wall-clock seconds: the stretches between the
+  // points where a build can be cancelled (BuildHooks::cancel), so each is the longest a cancel
+  // waits. Names as in the "cancelled during ..." errors; the last is "the numeric
+  // factorisation" (with the linear response, if any).
+  struct BuildPhase {
+    const char* name;
+    double seconds;
+  };
+  const std::vector<BuildPhase>& build_phases() const { return build_phases_; }
 
   // The memory a model holds, estimated; the one formula behind every memory budget, calibrated
   // against the growth of a server's resident memory when it loads the model (the 133k-vertex
@@ -264,6 +274,10 @@ class DeformationModel {
   std::shared_ptr<const SymbolicCholesky> symbolic_;
   std::shared_ptr<const MaterialFactorization> default_factorization_;
   double precompute_seconds_ = 0;
+  std::vector<BuildPhase> build_phases_;
+  std::chrono::steady_clock::time_point phase_start_;  // during Build
+  // Records the phase that ends now (since phase_start_), then checks `cancel` (CheckCancelled).
+  Status EndPhase(const CancelToken* cancel, const char* phase);
 };
 
 }  // namespace deform

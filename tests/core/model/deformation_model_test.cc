@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <string>
 #include <thread>
+#include <vector>
 
 #include "core/io/mesh_io.h"
 #include "core/io/phantom.h"
@@ -349,6 +351,25 @@ TEST(DeformationModel, ScratchAndFactorizationBytesAreWhatAStreamAllocates) {
   auto other = model->Factorize(stiffer);
   ASSERT_TRUE(other.ok()) << other.status().ToString();
   EXPECT_EQ(model->FactorizationBytes(), (*other)->factor().bytes());
+}
+
+TEST(DeformationModel, BuildPhasesAreTheCancellablePhasesInOrder) {
+  auto model = BuildPhantomModel(600);
+  std::vector<std::string> names;
+  double total = 0;
+  for (const DeformationModel::BuildPhase& phase : model->build_phases()) {
+    names.push_back(phase.name);
+    EXPECT_GE(phase.seconds, 0) << phase.name;
+    total += phase.seconds;
+  }
+  EXPECT_EQ(names, (std::vector<std::string>{
+                       "validation", "the mesh's adjacency", "the binding", "the joint regions",
+                       "the harmonic weights", "the Laplacian system", "the binding report",
+                       "the symbolic analysis", "the numeric factorisation"}));
+  // The phases cover the build: precomputation and factorisation, validation besides.
+  EXPECT_GE(total, model->precompute_seconds());
+  EXPECT_NEAR(model->build_phases().back().seconds,
+              model->default_factorization()->factor_seconds(), 1e-12);
 }
 
 TEST(DeformationModel, TheEstimateBeforeTheBuildGrowsFasterThanTheMesh) {
