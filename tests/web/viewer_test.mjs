@@ -246,6 +246,27 @@ async function browserChecks(port) {
     console.log(`shin region ${JSON.stringify(shin)}: ${(shinChange * 100).toFixed(1)}% of pixels changed; hip region ${JSON.stringify(hipRect)}: ${(hipChange * 100).toFixed(1)}%`);
     check(shinChange > 0.2, `the knee at 90 degrees changes the picture where the shin was (${(shinChange * 100).toFixed(1)}% of its pixels)`);
     check(hipChange < shinChange / 2, `and far less at the hip (${(hipChange * 100).toFixed(1)}%)`);
+    // A sweep of the knee, 0 to 120 degrees and back at the page's frame rate, for the figures.
+    const sweep = await page.evaluate(async () => {
+      const slider = document.querySelector('input[data-joint="knee"][data-axis="flexion"]');
+      const s = window.viewerState;
+      const before = s.framesReceived;
+      s.latencies.length = 0;
+      const start = performance.now();
+      for (let i = 0; i <= 120; i++) {
+        slider.value = String(i <= 60 ? i * 2 : (120 - i) * 2);
+        slider.dispatchEvent(new Event('input'));
+        await new Promise((r) => requestAnimationFrame(r));
+      }
+      await new Promise((r) => setTimeout(r, 200));
+      const seconds = (performance.now() - start) / 1000;
+      const sorted = [...s.latencies].sort((a, b) => a - b);
+      return { frames: s.framesReceived - before, seconds, framesPerSecond: (s.framesReceived - before) / seconds,
+               latencyP50: sorted[Math.floor(sorted.length / 2)], latencyP99: sorted[Math.floor(sorted.length * 0.99)],
+               normalsMs: s.normalsMs };
+    });
+    console.log(`knee sweep: ${JSON.stringify(sweep)}`);
+    check(sweep.frames >= 30, `frames keep arriving while the knee slider moves (${sweep.frames} frames in ${sweep.seconds.toFixed(1)} s)`);
     check(consoleErrors.length === 0, `no console error (${consoleErrors.join(' | ') || 'none'})`);
   } finally {
     await browser.close();
