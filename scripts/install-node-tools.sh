@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Installs the project's npm tooling from its lock files (npm ci: exactly the locked versions,
-# nothing else): proto/ (buf). Installs Debian's nodejs and npm first if npm is missing.
+# nothing else): proto/ (buf) and client/web/ (three.js for the browser viewer, copied beside
+# deformd by the build; puppeteer-core for its browser test, which drives Debian's chromium and
+# downloads no browser). Installs Debian's nodejs and npm first if npm is missing.
 # Idempotent: a folder whose node_modules was installed from its current lock file is skipped.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -13,7 +15,7 @@ if ! command -v npm >/dev/null 2>&1; then
   $SUDO apt-get install -y -qq --no-install-recommends nodejs npm
 fi
 
-for dir in proto; do
+for dir in proto client/web; do
   stamp="$dir/node_modules/.installed-lock.json"  # the lock file the last npm ci installed
   if cmp -s "$dir/package-lock.json" "$stamp"; then continue; fi
   echo "install-node-tools: npm ci in $dir"

@@ -5,6 +5,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
+scripts/install-node-tools.sh
 scripts/build.sh
 BIN="${DEFORM_BUILD_DIR:-build}"
 ADDR="127.0.0.1:${DEFORM_DEMO_PORT:-50051}"

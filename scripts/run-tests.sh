@@ -2,7 +2,8 @@
 # The test command: installs what is missing, builds, and runs the whole test suite.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-scripts/install-deps.sh
+scripts/install-deps.sh scripts/packages/build.txt scripts/packages/browser.txt
+scripts/install-node-tools.sh
 scripts/build.sh
 ctest --test-dir "${DEFORM_BUILD_DIR:-build}" --output-on-failure --parallel "$(nproc)" \
   --timeout 600

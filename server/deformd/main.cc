@@ -7,18 +7,25 @@
 //           [--tls-cert PEM --tls-key PEM [--tls-client-ca PEM]] [--plaintext]
 //           [--token-file FILE] [--tenant-max-meshes N] [--tenant-max-streams N]
 //           [--tenant-max-memory-mb N] [--preload-tenant NAME] [--store DIR] [--metrics ADDR]
+//           [--http ADDR [--http-root DIR] [--http-max-connections N]]
 //
 // --metrics ADDR serves GET /metrics in Prometheus' format on its own port: plain HTTP, on a
 // loopback address unless --plaintext, and with a token file for operators' tokens only
 // (service/metrics_endpoint.h).
 //
+// --http ADDR also serves the browser viewer and the API over HTTP and WebSockets
+// (web/web_server.h) from the same service core; its files come from --http-root, by default the
+// `web` directory beside the executable (the build copies client/web there), else
+// ../share/deformd/web.
+//
 // --store DIR keeps loaded meshes on disk and builds them again, under their ids and owners, when
 // the server starts (service/mesh_store.h); preloads are not kept (their flags bring them back).
 //
 // Transport: TLS with --tls-cert/--tls-key (mutual TLS with --tls-client-ca); without a
-// certificate, plaintext on a loopback address only, unless --plaintext (service/transport_security.h).
-// Each of these flags also reads an environment variable (DEFORMD_TLS_CERT, DEFORMD_TLS_KEY,
-// DEFORMD_TLS_CLIENT_CA, DEFORMD_PLAINTEXT=1); a flag given on the command line wins.
+// certificate, plaintext on a loopback address only, unless --plaintext
+// (service/transport_security.h). Each of these flags also reads an environment variable
+// (DEFORMD_TLS_CERT, DEFORMD_TLS_KEY, DEFORMD_TLS_CLIENT_CA, DEFORMD_PLAINTEXT=1); a flag given on
+// the command line wins.
 //
 // Preloaded meshes are built before the server listens. SIGTERM or SIGINT drains: open streams
 // end with UNAVAILABLE, calls in progress get most of --shutdown-grace-s, and the process exits 0
@@ -33,15 +40,18 @@
 #include <cstddef>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <future>
-#include <thread>
+#include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "core/io/model_input.h"
 #include "service/deform_server.h"
 #include "service/identity.h"
 #include "service/service_options.h"
+#include "web/web_server.h"
 
 namespace {
 
@@ -66,7 +76,23 @@ struct Args {
   double keepalive_s = 30;
   double keepalive_timeout_s = 10;
   double idle_timeout_s = 300;
+  std::string http_address;
+  std::string http_root;
+  int http_max_connections = 64;
 };
+
+// The viewer's files when --http-root is not given: `web` beside the executable, else
+// ../share/deformd/web (an installed layout); empty when neither exists.
+std::string DefaultHttpRoot() {
+  std::error_code error;
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", error);
+  if (error) return {};
+  for (const auto& candidate :
+       {exe.parent_path() / "web", exe.parent_path().parent_path() / "share/deformd/web"}) {
+    if (std::filesystem::is_directory(candidate, error)) return candidate.string();
+  }
+  return {};
+}
 
 // One mesh to load before serving: files (--preload MESH:SKELETON) or the phantom
 // (--preload-phantom N). `flag` is the flag as given, for error messages.
@@ -249,6 +275,16 @@ int main(int argc, char** argv) {
                  "Close a connection without any call for this many seconds")
       ->capture_default_str()
       ->check(CLI::Range(0.1, 86400.0));
+  app.add_option("--http", args.http_address,
+                 "Also serve the browser viewer, the API over HTTP and its streams over "
+                 "WebSockets on ADDR (host:port; port 0 = any); plaintext: loopback only unless "
+                 "--plaintext");
+  app.add_option("--http-root", args.http_root,
+                 "The viewer's files (default: 'web' beside the executable)");
+  app.add_option("--http-max-connections", args.http_max_connections,
+                 "Open HTTP and WebSocket connections at once")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 65536));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -261,14 +297,14 @@ int main(int argc, char** argv) {
   args.server.limits.max_upload_bytes = args.max_upload_mb << 20;
   args.server.limits.upload_idle_timeout_ms =
       static_cast<long long>(args.upload_idle_timeout_s * 1000);
-  args.server.limits.upload_time_limit_ms =
-      static_cast<long long>(args.upload_time_limit_s * 1000);
+  args.server.limits.upload_time_limit_ms = static_cast<long long>(args.upload_time_limit_s * 1000);
   args.server.max_message_bytes = args.max_message_mb << 20;
   args.server.limits.tenant_max_memory_bytes = args.tenant_max_memory_mb << 20;
   args.server.connections.keepalive_time_ms = static_cast<int>(args.keepalive_s * 1000);
   args.server.connections.keepalive_timeout_ms = static_cast<int>(args.keepalive_timeout_s * 1000);
   args.server.connections.max_connection_idle_ms = static_cast<int>(args.idle_timeout_s * 1000);
 
+  std::unique_ptr<deform::web::WebServer> web;  // declared first: outlives the server's Shutdown
   DeformServer server(args.server);
   if (!args.token_file.empty()) {
     const deform::Status tokens = server.UseTokenFile(args.token_file);
@@ -285,10 +321,30 @@ int main(int argc, char** argv) {
     }
   }
   if (!PreloadAll(args, &server)) return 1;
+  if (!args.http_address.empty()) {
+    deform::web::WebOptions web_options;
+    web_options.address = args.http_address;
+    web_options.static_root = args.http_root.empty() ? DefaultHttpRoot() : args.http_root;
+    web_options.max_connections = args.http_max_connections;
+    web_options.allow_plaintext = args.server.security.allow_plaintext;
+    if (web_options.static_root.empty()) {
+      spdlog::error("--http: no viewer files beside the executable; give --http-root DIR");
+      return 1;
+    }
+    web = std::make_unique<deform::web::WebServer>(&server.core(), web_options);
+    server.AddTransportStop([&web](std::chrono::milliseconds grace) { web->Stop(grace); });
+  }
   const deform::Status started = server.Start();
   if (!started.ok()) {
     spdlog::error("{}", started.ToString());
     return 1;
+  }
+  if (web != nullptr) {
+    const deform::Status web_started = web->Start();
+    if (!web_started.ok()) {
+      spdlog::error("{}", web_started.ToString());
+      return 1;
+    }
   }
 
   int signal_number = 0;

@@ -5,6 +5,8 @@
 #include <grpcpp/health_check_service_interface.h>
 #include <spdlog/spdlog.h>
 
+#include <vector>
+
 #include "health.pb.h"
 #include "service/annotated_mutex.h"
 #include "service/deform_service.h"
@@ -59,6 +61,7 @@ struct DeformServer::Impl {
   std::unique_ptr<grpc::Server> server;
   std::unique_ptr<MetricsEndpoint> metrics;  // null without options.metrics_address
   int port = 0;
+  std::vector<std::function<void(std::chrono::milliseconds)>> transport_stops;
   Mutex shutdown_mutex;  // serialises Shutdown()
   bool shut_down DEFORM_GUARDED_BY(shutdown_mutex) = false;
 };
@@ -107,9 +110,10 @@ Status DeformServer::Start() {
   spdlog::info("listening on {} ({}) with {} workers", listening_address(), transport,
                impl_->core.pool.size());
   if (!impl_->core.auth.uses_tokens()) {
-    spdlog::warn("no token file: every caller is the single implicit tenant '{}' and sees every "
-                 "mesh (give --token-file for per-client tokens)",
-                 Identity::Implicit().tenant);
+    spdlog::warn(
+        "no token file: every caller is the single implicit tenant '{}' and sees every "
+        "mesh (give --token-file for per-client tokens)",
+        Identity::Implicit().tenant);
   }
   return Status::Ok();
 }
@@ -127,9 +131,9 @@ Status DeformServer::UseStore(const std::string& dir, int* restored) {
       job->start = start;
       job->metrics = &core.metrics;
       auto reservation = core.registry.Reserve(stored.tenant);
-      entry = reservation.ok() ? BuildAndRegister(&core.registry, std::move(*reservation),
-                                                  std::move(*job))
-                               : StatusOr<std::shared_ptr<const MeshEntry>>(reservation.status());
+      entry = reservation.ok()
+                  ? BuildAndRegister(&core.registry, std::move(*reservation), std::move(*job))
+                  : StatusOr<std::shared_ptr<const MeshEntry>>(reservation.status());
     }
     if (!entry.ok()) {
       spdlog::error("store: mesh={} tenant={} not restored: {}", stored.id,
@@ -204,9 +208,14 @@ void DeformServer::Shutdown(std::chrono::milliseconds grace) {
     impl_->server->Shutdown(std::chrono::system_clock::now() + grace);
     impl_->server->Wait();
   }
+  for (const auto& stop : impl_->transport_stops) stop(grace / 10);
   impl_->core.pool.Shutdown();
   impl_->metrics.reset();
   spdlog::info("stopped");
+}
+
+void DeformServer::AddTransportStop(std::function<void(std::chrono::milliseconds)> stop) {
+  impl_->transport_stops.push_back(std::move(stop));
 }
 
 ServiceCore& DeformServer::core() { return impl_->core; }

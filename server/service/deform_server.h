@@ -8,6 +8,7 @@
 #pragma once
 
 #include <chrono>
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -61,9 +62,14 @@ class DeformServer {
   // for the next call. On error the old tokens stay and the error is returned (and logged).
   Status ReloadTokens();
 
+  // Another transport over the same core (deformd's HTTP port, web/web_server.h): Shutdown() calls
+  // `stop` with a grace period after the streams were drained and gRPC has stopped, before the
+  // worker pool stops, so that its streams end while the pool still runs. Before Start().
+  void AddTransportStop(std::function<void(std::chrono::milliseconds)> stop);
+
   // Drains: marks the server not serving, ends open Deform streams with UNAVAILABLE, stops
-  // accepting calls, waits up to `grace` for calls in progress (then cancels them), and stops the
-  // worker pool. Idempotent.
+  // accepting calls, waits up to `grace` for calls in progress (then cancels them), stops the
+  // other transports (AddTransportStop, a tenth of `grace` each) and the worker pool. Idempotent.
   void Shutdown(std::chrono::milliseconds grace = std::chrono::seconds(5));
 
   ServiceCore& core();

@@ -15,7 +15,6 @@
 #include "service/deform_outbox.h"
 #include "service/frame_encoding.h"
 #include "service/frame_solver.h"
-#include "service/grpc_stream_sink.h"
 #include "service/log_text.h"
 #include "service/pending_pose_slot.h"
 #include "service/pose_input.h"
@@ -54,16 +53,19 @@ void CountWritten(const v1::DeformResponse& message, ServiceMetrics* metrics) {
 //  order), StreamWritePump (one write in flight, the finish), FrameSolver (the solve itself).
 // The first four are guarded by mutex_; the solver and the pose it solves belong to the solve
 // task, the request buffers to the reader (one read outstanding at a time).
-class DeformStreamReactor final
-    : public grpc::ServerBidiReactor<v1::DeformRequest, v1::DeformResponse>,
-      public SharedReactor<DeformStreamReactor>,
-      public UrgentTask,
-      private Drainable,
-      private StreamWriteSource<v1::DeformResponse> {
+class DeformStreamReactor final : public StreamHandler,
+                                  public SharedReactor<DeformStreamReactor>,
+                                  public UrgentTask,
+                                  private Drainable,
+                                  private StreamWriteSource<v1::DeformResponse> {
  public:
-  DeformStreamReactor(ServiceCore* core, Identity caller)
-      : core_(core), caller_(std::move(caller)), stream_id_(core->next_stream_id.fetch_add(1)) {
-    log_context_ = "stream=" + std::to_string(stream_id_) + " tenant=" + EscapeForLog(caller_.tenant);
+  DeformStreamReactor(ServiceCore* core, Identity caller, DeformTransport* transport)
+      : core_(core),
+        caller_(std::move(caller)),
+        stream_id_(core->next_stream_id.fetch_add(1)),
+        transport_(transport) {
+    log_context_ =
+        "stream=" + std::to_string(stream_id_) + " tenant=" + EscapeForLog(caller_.tenant);
     outbox_.set_backlog_gauge(&core->notice_backlog_bytes);
     StartRead(&request_);
   }
@@ -107,10 +109,13 @@ class DeformStreamReactor final
   void WriteCompleted(bool ok) override;
   bool ReadyToFinish() override;
 
+  void StartRead(v1::DeformRequest* request) { transport_->StartRead(request); }
+
   ServiceCore* const core_;
   const Identity caller_;
   const std::uint64_t stream_id_;
-  std::string log_context_;  // "stream=N tenant=T mesh=ID", for logs
+  DeformTransport* const transport_;  // the pump's sink too; not used after its Finish()
+  std::string log_context_;           // "stream=N tenant=T mesh=ID", for logs
 
   // Set by HandleStart before any worker can see the stream; read-only afterwards.
   std::shared_ptr<const MeshEntry> entry_;
@@ -128,13 +133,12 @@ class DeformStreamReactor final
   PoseInput solving_;
   std::shared_ptr<const MaterialFactorization> solve_factorization_;
 
-  GrpcStreamSink<v1::DeformRequest, v1::DeformResponse> sink_{this};
   Mutex mutex_;
   PendingPoseSlot poses_ DEFORM_GUARDED_BY(mutex_);
   StiffnessSwitch stiffness_ DEFORM_GUARDED_BY(mutex_);
   DeformOutbox outbox_ DEFORM_GUARDED_BY(mutex_);
   StreamWritePump<v1::DeformResponse> pump_ DEFORM_GUARDED_BY(mutex_){
-      this, &sink_, FinishRule::kErrorOverridesGraceful};
+      this, transport_, FinishRule::kErrorOverridesGraceful};
   // The message being written (DeformOutbox keeps it untouched until the next TakeNextWrite).
   const v1::DeformResponse* in_flight_ DEFORM_GUARDED_BY(mutex_) = nullptr;
   std::uint64_t frames_written_ DEFORM_GUARDED_BY(mutex_) = 0;
@@ -479,9 +483,8 @@ void DeformStreamReactor::OnDone() {
 
 }  // namespace
 
-grpc::ServerBidiReactor<v1::DeformRequest, v1::DeformResponse>* NewDeformStreamReactor(
-    ServiceCore* core, Identity caller) {
-  return DeformStreamReactor::Create(core, std::move(caller));
+StreamHandler* NewDeformStream(ServiceCore* core, Identity caller, DeformTransport* transport) {
+  return DeformStreamReactor::Create(core, std::move(caller), transport);
 }
 
 }  // namespace deform::service

@@ -1,5 +1,9 @@
-// The Deform RPC: one reactor per stream, owned by shared_ptrs (gRPC's until OnDone, and each
-// posted worker task's; shared_reactor.h): freed when the last of them is done with it.
+// The Deform RPC: one stream handler per call, whatever the transport (gRPC, or a WebSocket:
+// stream_transport.h), owned by shared_ptrs (the transport's until OnDone, and each posted worker
+// task's; shared_reactor.h): freed when the last of them is done with it. Both transports run
+// this same code: validation, limits (--max-streams, per tenant), the worker pool, the outbox and
+// its backpressure, and the per-stream counts of the closing log line (frames written, poses
+// rejected, notices dropped: where per-stream metrics are fed, for every transport at once).
 //
 // Per stream: a shared_ptr to the mesh entry (keeps the model alive after UnloadMesh; frames then
 // carry mesh_unloaded), its own solve buffers and frame messages, its current factorisation and
@@ -39,16 +43,17 @@
 // UNAVAILABLE when the server drains.
 #pragma once
 
-#include <grpcpp/support/server_callback.h>
-
 #include "deform/v1/deform.pb.h"
 #include "service/identity.h"
 #include "service/service_core.h"
+#include "service/stream_transport.h"
 
 namespace deform::service {
 
-// A new reactor for one Deform call. `core` must outlive it.
-grpc::ServerBidiReactor<v1::DeformRequest, v1::DeformResponse>* NewDeformStreamReactor(
-    ServiceCore* core, Identity caller);
+using DeformTransport = StreamTransport<v1::DeformRequest, v1::DeformResponse>;
+
+// A new handler for one Deform call over `transport`; it starts reading at once. `core` and the
+// transport must outlive it (the transport until its OnDone()).
+StreamHandler* NewDeformStream(ServiceCore* core, Identity caller, DeformTransport* transport);
 
 }  // namespace deform::service

@@ -13,7 +13,6 @@
 #include "core/model/deformation_model.h"
 #include "service/annotated_mutex.h"
 #include "service/audit_log.h"
-#include "service/grpc_stream_sink.h"
 #include "service/load_header.h"
 #include "service/load_request.h"
 #include "service/log_text.h"
@@ -60,15 +59,15 @@ double MillisecondsSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
-class LoadMeshReactor final
-    : public grpc::ServerBidiReactor<v1::LoadMeshRequest, v1::LoadMeshResponse>,
-      public SharedReactor<LoadMeshReactor>,
-      public ExpiringUpload,
-      private StreamWriteSource<v1::LoadMeshResponse> {
+class LoadMeshReactor final : public StreamHandler,
+                              public SharedReactor<LoadMeshReactor>,
+                              public ExpiringUpload,
+                              private StreamWriteSource<v1::LoadMeshResponse> {
  public:
-  LoadMeshReactor(ServiceCore* core, Identity caller)
+  LoadMeshReactor(ServiceCore* core, Identity caller, LoadMeshTransport* transport)
       : core_(core),
         caller_(std::move(caller)),
+        transport_(transport),
         log_context_("load=" + std::to_string(core->next_load_id.fetch_add(1)) +
                      " tenant=" + EscapeForLog(caller_.tenant)) {
     StartRead(&request_);
@@ -98,8 +97,11 @@ class LoadMeshReactor final
   void WriteCompleted(bool ok) override;
   bool ReadyToFinish() override { return true; }  // a finish is only requested when all is queued
 
+  void StartRead(v1::LoadMeshRequest* request) { transport_->StartRead(request); }
+
   ServiceCore* const core_;
   const Identity caller_;
+  LoadMeshTransport* const transport_;  // the pump's sink too; not used after its Finish()
   std::string log_context_;
   Clock::time_point start_;
   // The build's: cancelled by the client's cancel or a failed write, and at server shutdown.
@@ -114,13 +116,12 @@ class LoadMeshReactor final
   MeshRegistry::Reservation reservation_;
   std::uint64_t upload_watch_ = 0;  // core_->uploads' id while an upload arrives; 0: none
 
-  GrpcStreamSink<v1::LoadMeshRequest, v1::LoadMeshResponse> sink_{this};
   Mutex mutex_;
   std::deque<v1::LoadMeshResponse> outbox_ DEFORM_GUARDED_BY(mutex_);
   v1::LoadMeshResponse in_flight_ DEFORM_GUARDED_BY(mutex_);
   bool cancelled_ DEFORM_GUARDED_BY(mutex_) = false;  // by the client, or a write failed
   StreamWritePump<v1::LoadMeshResponse> pump_ DEFORM_GUARDED_BY(mutex_){
-      this, &sink_, FinishRule::kFirstRequestWins};
+      this, transport_, FinishRule::kFirstRequestWins};
 };
 
 void LoadMeshReactor::OnReadDone(bool ok) {
@@ -363,9 +364,8 @@ void LoadMeshReactor::OnDone() {
 
 }  // namespace
 
-grpc::ServerBidiReactor<v1::LoadMeshRequest, v1::LoadMeshResponse>* NewLoadMeshReactor(
-    ServiceCore* core, Identity caller) {
-  return LoadMeshReactor::Create(core, std::move(caller));
+StreamHandler* NewLoadMeshStream(ServiceCore* core, Identity caller, LoadMeshTransport* transport) {
+  return LoadMeshReactor::Create(core, std::move(caller), transport);
 }
 
 }  // namespace deform::service

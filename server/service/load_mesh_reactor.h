@@ -1,5 +1,6 @@
-// The LoadMesh RPC: one reactor per call, owned by shared_ptrs (gRPC's until OnDone, and the
-// build task's; shared_reactor.h): freed when both are done with it.
+// The LoadMesh RPC: one stream handler per call, whatever the transport (gRPC, or a WebSocket:
+// stream_transport.h), owned by shared_ptrs (the transport's until OnDone, and the build task's;
+// shared_reactor.h): freed when both are done with it.
 //
 // Reads the header, then the upload's chunks into memory (checking the announced size and the
 // upload limit as they come), then on half-close sends RECEIVED and hands parsing, validation and
@@ -20,16 +21,17 @@
 // reactor's mutex.
 #pragma once
 
-#include <grpcpp/support/server_callback.h>
-
 #include "deform/v1/deform.pb.h"
 #include "service/identity.h"
 #include "service/service_core.h"
+#include "service/stream_transport.h"
 
 namespace deform::service {
 
-// A new reactor for one LoadMesh call. `core` must outlive it.
-grpc::ServerBidiReactor<v1::LoadMeshRequest, v1::LoadMeshResponse>* NewLoadMeshReactor(
-    ServiceCore* core, Identity caller);
+using LoadMeshTransport = StreamTransport<v1::LoadMeshRequest, v1::LoadMeshResponse>;
+
+// A new handler for one LoadMesh call over `transport`; it starts reading at once. `core` and the
+// transport must outlive it (the transport until its OnDone()).
+StreamHandler* NewLoadMeshStream(ServiceCore* core, Identity caller, LoadMeshTransport* transport);
 
 }  // namespace deform::service

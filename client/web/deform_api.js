@@ -1,0 +1,109 @@
+// deformd's HTTP port from the browser (server/web/web_server.h): the unary calls as POSTs of
+// protobuf bodies, the streaming calls as WebSockets carrying one protobuf message per binary
+// message, ended by the server's "status CODE MESSAGE" text message. The bearer token (optional)
+// goes in the Authorization header of POSTs and as the "bearer.<base64url>" subprotocol of
+// WebSockets (browsers cannot set headers on an upgrade).
+import * as wire from './proto_wire.js';
+
+function base64url(text) {
+  const bytes = new TextEncoder().encode(text);
+  let s = '';
+  for (const b of bytes) s += String.fromCharCode(b);
+  return btoa(s).replace(/\+/g, '-').replace(/\//g, '_').replace(/=+$/, '');
+}
+
+export class DeformApi {
+  constructor(token = '') { this.token = token; }
+
+  async call(method, body) {
+    const headers = { 'Content-Type': 'application/x-protobuf' };
+    if (this.token) headers.Authorization = `Bearer ${this.token}`;
+    const response = await fetch(`/api/${method}`, { method: 'POST', headers, body });
+    const bytes = new Uint8Array(await response.arrayBuffer());
+    if (!response.ok) {
+      throw new Error(`${method}: ${response.status} ${new TextDecoder().decode(bytes).trim()}`);
+    }
+    return bytes;
+  }
+
+  async listMeshes() {
+    return wire.decodeListMeshesResponse(await this.call('ListMeshes', wire.encodeListMeshesRequest()));
+  }
+
+  async meshInfo(meshId) {
+    return wire.decodeGetMeshInfoResponse(
+      await this.call('GetMeshInfo', wire.encodeGetMeshInfoRequest(meshId, true)));
+  }
+
+  // A WebSocket to /ws/<method> with the protocol's subprotocols.
+  openSocket(method) {
+    const protocols = ['deform.v1'];
+    if (this.token) protocols.push(`bearer.${base64url(this.token)}`);
+    const socket = new WebSocket(`${location.origin.replace(/^http/, 'ws')}/ws/${method}`, protocols);
+    socket.binaryType = 'arraybuffer';
+    return socket;
+  }
+
+  // Loads the phantom; onProgress(stage name, elapsed ms). Resolves with the mesh summary.
+  loadPhantom(vertices, onProgress) {
+    return new Promise((resolve, reject) => {
+      const socket = this.openSocket('LoadMesh');
+      let mesh = null;
+      socket.onopen = () => {
+        socket.send(wire.encodeLoadPhantomHeader(`phantom ${vertices}`, vertices));
+        socket.send('end');
+      };
+      socket.onmessage = (event) => {
+        if (typeof event.data === 'string') {
+          const [, code, message] = event.data.match(/^status (\d+) ?(.*)$/s) || [];
+          if (code === '0' && mesh) resolve(mesh);
+          else reject(new Error(`LoadMesh: status ${code}: ${message}`));
+          return;
+        }
+        const progress = wire.decodeLoadMeshResponse(new Uint8Array(event.data));
+        onProgress(wire.STAGE_NAMES[progress.stage] || String(progress.stage), progress.elapsedMs);
+        if (progress.mesh) mesh = progress.mesh;
+      };
+      socket.onerror = () => reject(new Error('LoadMesh: the WebSocket failed'));
+    });
+  }
+}
+
+// One Deform stream over a WebSocket. Callbacks: onFrame(frame, bytes), onNotice(notice),
+// onEnd(code, message).
+export class DeformStream {
+  constructor(api, meshId, { onFrame, onNotice, onEnd, onOpen }) {
+    this.socket = api.openSocket('Deform');
+    this.sequence = 0;
+    this.open = false;
+    this.socket.onopen = () => {
+      this.open = true;
+      this.socket.send(wire.encodeDeformStart(meshId));
+      if (onOpen) onOpen();
+    };
+    this.socket.onmessage = (event) => {
+      if (typeof event.data === 'string') {
+        const [, code, message] = event.data.match(/^status (\d+) ?(.*)$/s) || [];
+        onEnd(Number(code), message);
+        return;
+      }
+      const response = wire.decodeDeformResponse(new Uint8Array(event.data));
+      if (response.frame) onFrame(response.frame, event.data.byteLength);
+      else if (response.notice) onNotice(response.notice);
+    };
+    this.socket.onclose = () => { if (this.open) { this.open = false; } };
+  }
+
+  // Sends a pose: [{joint, axis, degrees}]. Returns its sequence.
+  sendPose(angles) {
+    if (!this.open) return 0;
+    this.sequence += 1;
+    const nowNs = Math.round(performance.now() * 1e6);
+    this.socket.send(wire.encodeDeformPose(this.sequence, nowNs, angles));
+    return this.sequence;
+  }
+
+  sendRegionWeights(weights) { if (this.open) this.socket.send(wire.encodeRegionWeights(weights)); }
+
+  close() { this.open = false; this.socket.close(); }
+}
