@@ -87,6 +87,10 @@ StatusOr<ModelOptions> ModelOptionsFromProto(const v1::MethodOptions& proto,
       return Status::InvalidArgument("unknown rotation_blend " +
                                      std::to_string(proto.rotation_blend()));
   }
+  // DeformationModel::Build checks the range (INVALID_ARGUMENT naming the field).
+  if (proto.has_rigid_weight_tolerance()) {
+    options.rigid_weight_tolerance = proto.rigid_weight_tolerance();
+  }
   // 0 keeps the default; DeformationModel::Build checks the range.
   if (proto.linear_blend_segments() != 0) {
     options.linear_blend_segments = static_cast<int>(

@@ -4,16 +4,19 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iterator>
+#include <optional>
 
 #include "core/io/gltf_writer.h"
 #include "core/io/mesh_io.h"
 #include "core/io/phantom.h"
 #include "core/io/skeleton_io.h"
 #include "core/model/deformation_model.h"
+#include "service/service_core.h"
 #include "tests/service/service_fixture.h"
 
 namespace deform {
@@ -109,6 +112,56 @@ TEST_F(RigUploadTest, GltfRigDeformsLikeTheSameRigAsObjJsonAndWeights) {
     worst = std::max(worst, static_cast<double>(std::abs(from_gltf[c] - from_files[c])));
   }
   EXPECT_LT(worst, 1e-6 * diagonal);
+  ExpectBackgroundStreamAlive();
+}
+
+TEST_F(RigUploadTest, RigidWeightToleranceChoosesTheRigidZonesOfGivenWeights) {
+  StartServer();
+  auto phantom = MakeKneePhantom(600);
+  ASSERT_TRUE(phantom.ok());
+  const auto [weights, csv] = PhantomWeights(*phantom);
+  const std::string obj_path = ::testing::TempDir() + "/rig_tolerance.obj";
+  ASSERT_TRUE(WriteMeshFile(phantom->mesh, obj_path).ok());
+  std::ifstream obj_file(obj_path);
+  const std::string obj((std::istreambuf_iterator<char>(obj_file)), {});
+  const auto load = [&](std::optional<double> tolerance, v1::MeshSummary* summary) {
+    v1::LoadMeshHeader header;
+    v1::UploadSource* upload = header.mutable_upload();
+    upload->set_format(v1::MESH_FORMAT_OBJ);
+    upload->set_skeleton_format(v1::SKELETON_FORMAT_JSON);
+    upload->set_skeleton(SkeletonToJson(phantom->skeleton));
+    upload->set_weights_format(v1::SKIN_WEIGHTS_FORMAT_CSV);
+    upload->set_weights(csv);
+    if (tolerance) header.mutable_options()->set_rigid_weight_tolerance(*tolerance);
+    return client_->LoadMesh(header, obj, summary);
+  };
+  const auto rigid_vertices = [&](const std::string& id, double* tolerance) {
+    auto entry = server_->server().core().registry.Find(id);
+    EXPECT_TRUE(entry.ok());
+    *tolerance = (*entry)->model->options().rigid_weight_tolerance;
+    const std::vector<int>& rigid = (*entry)->model->rigid_bones();
+    return std::count_if(rigid.begin(), rigid.end(), [](int bone) { return bone >= 0; });
+  };
+  v1::MeshSummary unset, exact, loose;
+  ASSERT_TRUE(load(std::nullopt, &unset).ok());
+  ASSERT_TRUE(load(0.0, &exact).ok());
+  ASSERT_TRUE(load(0.3, &loose).ok());
+  double tolerance = -1;
+  const auto unset_count = rigid_vertices(unset.mesh_id(), &tolerance);
+  EXPECT_EQ(tolerance, 0.01) << "unset is the default";
+  const auto exact_count = rigid_vertices(exact.mesh_id(), &tolerance);
+  EXPECT_EQ(tolerance, 0.0) << "0 is a value, not unset";
+  const auto loose_count = rigid_vertices(loose.mesh_id(), &tolerance);
+  EXPECT_EQ(tolerance, 0.3);
+  EXPECT_LE(exact_count, unset_count);
+  EXPECT_LT(unset_count, loose_count) << "a looser tolerance makes more of the mesh rigid";
+
+  v1::MeshSummary refused;
+  for (const double bad : {0.5, -0.1, std::nan("")}) {
+    const grpc::Status status = load(bad, &refused);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << bad;
+    EXPECT_THAT(status.error_message(), HasSubstr("rigid_weight_tolerance")) << bad;
+  }
   ExpectBackgroundStreamAlive();
 }
 
