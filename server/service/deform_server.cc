@@ -49,6 +49,20 @@ std::string RenderMetrics(ServiceCore* core) {
   return core->metrics.Serialize();
 }
 
+// Builds `stored` again under its id and owner and registers it (`start` is when its restore
+// began).
+StatusOr<std::shared_ptr<const MeshEntry>> Restore(ServiceCore* core, StoredMesh* stored,
+                                                   std::chrono::steady_clock::time_point start) {
+  DEFORM_ASSIGN_OR_RETURN(LoadJob job,
+                          LoadJobFromRequest(stored->header, &stored->mesh_bytes, core->limits));
+  job.id = stored->id;
+  job.start = start;
+  job.metrics = &core->metrics;
+  DEFORM_ASSIGN_OR_RETURN(MeshRegistry::Reservation reservation,
+                          core->registry.Reserve(stored->tenant));
+  return BuildAndRegister(&core->registry, std::move(reservation), std::move(job));
+}
+
 }  // namespace
 
 struct DeformServer::Impl {
@@ -124,17 +138,7 @@ Status DeformServer::UseStore(const std::string& dir, int* restored) {
   int count = 0;
   for (StoredMesh& stored : store->LoadAll()) {
     const auto start = std::chrono::steady_clock::now();
-    StatusOr<LoadJob> job = LoadJobFromRequest(stored.header, &stored.mesh_bytes, core.limits);
-    StatusOr<std::shared_ptr<const MeshEntry>> entry = job.status();
-    if (job.ok()) {
-      job->id = stored.id;
-      job->start = start;
-      job->metrics = &core.metrics;
-      auto reservation = core.registry.Reserve(stored.tenant);
-      entry = reservation.ok()
-                  ? BuildAndRegister(&core.registry, std::move(*reservation), std::move(*job))
-                  : StatusOr<std::shared_ptr<const MeshEntry>>(reservation.status());
-    }
+    const StatusOr<std::shared_ptr<const MeshEntry>> entry = Restore(&core, &stored, start);
     if (!entry.ok()) {
       spdlog::error("store: mesh={} tenant={} not restored: {}", stored.id,
                     EscapeForLog(stored.tenant), entry.status().ToString());
