@@ -4,9 +4,9 @@
 # failing test or sanitizer report. Run by .ci/run after scripts/run-fuzz.sh.
 #
 #   ASan+UBSan: build-asan ($DEFORM_ASAN_BUILD_DIR, shared with scripts/run-fuzz.sh:
-#               scripts/sanitizers/asan-build.sh), the test programs and the executables they
-#               start (deformd, deform-vr, deform-health-probe; no benchmarks, no deformctl or
-#               deform-loadtest), then ctest, 2 at a time: every test of the ctest suite, the
+#               scripts/sanitizers/asan-build.sh), everything ctest runs (the test programs,
+#               deformd and the clients the process tests start, the C API, the Python stubs, the
+#               viewer's files; no benchmarks), then ctest, 2 at a time: every test of the suite, the
 #               tests on the large shared meshes as they are (the slowest takes ~16 s). The
 #               benchmarks' ctest tests (bench/animation) are not built here (Release suite only).
 #               Leaks: scripts/sanitizers/lsan.supp lists OpenMesh's one-time registry only.
@@ -34,11 +34,6 @@ ASAN_DIR="$DEFORM_ASAN_BUILD_DIR"
 TSAN_DIR="${DEFORM_TSAN_BUILD_DIR:-build-tsan}"
 only="${1:-all}"  # all, asan or tsan
 # What ctest runs in build-asan: every test program, and what the process tests execute.
-ASAN_TARGETS=(deform_core_base_tests deform_core_geometry_tests deform_core_io_tests
-  deform_core_solver_tests deform_core_model_tests deform_core_eval_tests deform_core_codec_tests
-  deform_service_tests deform_hostile_client_tests deform_client_tests deformd deform-vr
-  deform-health-probe)
-# The deform_service_tests suites run under TSan (no gRPC server or channel in them).
 TSAN_SUITES=(AnnotatedMutexTest DeformOutboxTest FrameSlotsTest FrameSolverTest PendingPoseSlotTest
   PoseInputTest SharedReactorTest StiffnessSwitchTest StreamWritePumpTest WorkerPoolTest
   MeshRegistryTest StatusMappingTest TokenTableTest)
@@ -56,7 +51,9 @@ configure_tsan_build() {  # DIR
 
 if [ "$only" = all ] || [ "$only" = asan ]; then
   configure_asan_build "$ASAN_DIR"
-  cmake --build "$ASAN_DIR" --parallel "$(nproc)" --target "${ASAN_TARGETS[@]}"
+  # Everything ctest runs (benchmarks are off in this build): the test programs, deformd and
+  # the clients the process tests start, the C API, the Python stubs, the viewer's files.
+  cmake --build "$ASAN_DIR" --parallel "$(nproc)"
   echo "check-sanitizers: ASan+UBSan build done after $(($(date +%s) - start)) s"
   (export_sanitizer_options &&
     ctest --test-dir "$ASAN_DIR" --output-on-failure --parallel "$(nproc)" --timeout 1200)

@@ -43,6 +43,7 @@ std::string RenderMetrics(ServiceCore* core) {
   gauges.loads_in_progress = core->registry.loads_in_progress();
   gauges.memory_used_bytes = core->registry.memory_bytes_used();
   gauges.memory_reserved_bytes = core->registry.memory_bytes_reserved();
+  gauges.memory_streams_bytes = core->registry.memory_bytes_streams();
   gauges.memory_budget_bytes = core->limits.max_memory_bytes;
   gauges.notice_backlog_bytes = core->notice_backlog_bytes.load(std::memory_order_relaxed);
   core->metrics.SetGauges(gauges);

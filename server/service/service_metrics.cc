@@ -112,6 +112,8 @@ ServiceMetrics::ServiceMetrics() : registry_(std::make_shared<prometheus::Regist
                        "Memory budget used by loaded meshes and unloaded ones still streamed");
   memory_reserved_ =
       gauge("deformd_memory_budget_reserved_bytes", "Memory budget held by loads in progress");
+  memory_streams_ = gauge("deformd_memory_budget_streams_bytes",
+                          "Memory budget held by streams' buffers and own factorisations");
   memory_budget_ = gauge("deformd_memory_budget_bytes", "The memory budget (--max-memory-mb)");
   notice_backlog_ =
       gauge("deformd_notice_backlog_bytes", "Serialised bytes of notices waiting unwritten");
@@ -152,6 +154,7 @@ void ServiceMetrics::SetGauges(const Gauges& gauges) {
   loads_in_progress_->Set(gauges.loads_in_progress);
   memory_used_->Set(static_cast<double>(gauges.memory_used_bytes));
   memory_reserved_->Set(static_cast<double>(gauges.memory_reserved_bytes));
+  memory_streams_->Set(static_cast<double>(gauges.memory_streams_bytes));
   memory_budget_->Set(static_cast<double>(gauges.memory_budget_bytes));
   notice_backlog_->Set(static_cast<double>(gauges.notice_backlog_bytes));
 }

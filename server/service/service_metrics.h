@@ -16,7 +16,8 @@
 //  - deformd_refactorisation_seconds: stiffness refactorisations of Deform streams.
 //  - Gauges set at each scrape (SetGauges): deformd_streams_open, deformd_meshes_loaded,
 //    deformd_loads_in_progress, deformd_memory_budget_used_bytes,
-//    deformd_memory_budget_reserved_bytes, deformd_memory_budget_bytes,
+//    deformd_memory_budget_reserved_bytes, deformd_memory_budget_streams_bytes,
+//    deformd_memory_budget_bytes,
 //    deformd_notice_backlog_bytes.
 //
 // A client's errors as deform-loadtest counts them are the Deform RPCs that ended with a code
@@ -75,6 +76,7 @@ class ServiceMetrics {
     int loads_in_progress = 0;
     std::size_t memory_used_bytes = 0;
     std::size_t memory_reserved_bytes = 0;
+    std::size_t memory_streams_bytes = 0;
     std::size_t memory_budget_bytes = 0;
     std::int64_t notice_backlog_bytes = 0;
   };
@@ -99,6 +101,7 @@ class ServiceMetrics {
   prometheus::Gauge* loads_in_progress_ = nullptr;
   prometheus::Gauge* memory_used_ = nullptr;
   prometheus::Gauge* memory_reserved_ = nullptr;
+  prometheus::Gauge* memory_streams_ = nullptr;
   prometheus::Gauge* memory_budget_ = nullptr;
   prometheus::Gauge* notice_backlog_ = nullptr;
 };

@@ -73,12 +73,15 @@ loadtest)
   after=$(series "$WORK/after.txt" 'deformd_frames_sent_total{encoding="float32"}')
   bytes=$(series "$WORK/after.txt" 'deformd_frame_bytes_sent_total{encoding="float32"}')
   open_during=$(series "$WORK/during.txt" 'deformd_streams_open')
+  streams_memory=$(series "$WORK/during.txt" 'deformd_memory_budget_streams_bytes')
   echo "loadtest frames_received=$received; server frames during=$during after=$after" \
     "bytes=$bytes; streams open during=$open_during"
   [ "$received" -gt 100 ] || fail "too few frames received ($received)"
   [ "$after" -eq "$received" ] || fail "server counted $after frames, the loadtest $received"
   [ "$during" -gt 0 ] && [ "$during" -lt "$after" ] || fail "frames not counted live ($during)"
   [ "$open_during" -eq 4 ] || fail "streams open during the run: $open_during, expected 4"
+  [ "$streams_memory" -gt $((4 * 3 * 12 * 1900)) ] ||
+    fail "the four streams' buffers are not in the budget gauge ($streams_memory bytes)"
   [ "$bytes" -gt $((after * 12 * 100)) ] || fail "frame bytes $bytes too few for $after frames"
   [ "$(series "$WORK/after.txt" 'deformd_rpcs_total{code="OK",method="LoadMesh"}')" -eq 1 ] ||
     fail "the load is not counted"
