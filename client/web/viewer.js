@@ -168,7 +168,7 @@ function onFrame(frame, bytes) {
   $('stat-bytes').textContent = `${bytes} (${(bytes / Math.max(decoder.vertexCount, 1)).toFixed(2)} per vertex)`;
   $('stat-encoding').textContent = state.lastFrameEncoding;
   $('stat-max-error').textContent = frame.encoded
-    ? `${state.lastMaxError.toExponential(2)} (${(state.lastMaxError / state.diagonal).toExponential(1)} of the diagonal)`
+    ? `${state.lastMaxError.toExponential(2)} units (${(state.lastMaxError / state.diagonal).toExponential(1)} of the diagonal)`
     : 'float32 rounding';
   // The page's clock ticks in 0.1 ms: the mean of the last frames' decodes says more than one.
   const meanDecode = state.decodeTimes.reduce((sum, t) => sum + t, 0) / state.decodeTimes.length;

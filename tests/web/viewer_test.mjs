@@ -15,9 +15,9 @@
 // the encoding selector restarts the stream and the picture matches the float32 one. With a token
 // file, an upgrade without a valid token is refused (401) and one with the token as its
 // subprotocol is upgraded. The screenshots stay in DIR (rest.png, knee90.png, knee90-quantized.png,
-// knee90-predicted.png). Exit code 0 when every check passes, 1 with the failed check on stderr.
-//
-//   (--deform-vr PATH: the C++ client, default build/client/vr/deform-vr)
+// knee90-predicted.png; the whole page with its panel: page-quantized.png, page-predicted.png).
+// --deform-vr PATH names the C++ client (default build/client/vr/deform-vr). Exit code 0 when
+// every check passes, 1 with the failed check on stderr.
 import { spawn } from 'node:child_process';
 import { createHash } from 'node:crypto';
 import { createRequire } from 'node:module';
@@ -442,6 +442,7 @@ async function browserChecks(server) {
                     `the viewer restarts its stream in ${encoding} and decodes its frames`, 30_000, encoding);
       await new Promise((r) => setTimeout(r, 300));
       const shot = await view.screenshot({ path: path.join(artifacts, `knee90-${encoding}.png`) });
+      await page.screenshot({ path: path.join(artifacts, `page-${encoding}.png`) });
       const shown = await page.evaluate(() => ({
         encoding: document.getElementById('stat-encoding').textContent,
         maxError: document.getElementById('stat-max-error').textContent,
