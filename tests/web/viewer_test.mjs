@@ -12,7 +12,8 @@
 // (plus float32 rounding) of the float32 frame for the same pose, predicted frames are smaller
 // than quantized ones, which are smaller than float32; for one pose the page's decoding equals, bit
 // for bit, what the C++ client library decodes (deform-vr --encoding X --out, a PLY of doubles);
-// the encoding selector restarts the stream and the picture matches the float32 one. With a token
+// malformed frames are refused by name; the encoding selector restarts the stream and the picture
+// matches the float32 one. With a token
 // file, an upgrade without a valid token is refused (401) and one with the token as its
 // subprotocol is upgraded. The screenshots stay in DIR (rest.png, knee90.png, knee90-quantized.png,
 // knee90-predicted.png; the whole page with its panel: page-quantized.png, page-predicted.png).
@@ -277,6 +278,35 @@ function runDeformVr(grpcPort, meshId, encoding, pose, out) {
   });
 }
 
+// In the page: frame_codec.js refuses malformed frames and prediction weights with an Error naming
+// the problem (as core/codec and deform_client/codec.py do). Returns [what, message] pairs; a
+// decode that did not throw gives the message 'accepted'.
+function malformedFrameMessages(page, meshId) {
+  return page.evaluate(async (id) => {
+    const { DeformApi } = await import(`${location.origin}/deform_api.js`);
+    const codec = await import(`${location.origin}/frame_codec.js`);
+    await codec.frameCodecReady();
+    const info = await new DeformApi().meshInfo(id, true);
+    const n = info.summary.vertexCount;
+    const quantized = new codec.FrameDecoder(n);
+    const predicted = new codec.FrameDecoder(n, info.restPositions, info.predictionWeights);
+    const encoded = (fields) => ({ encoding: codec.QUANTIZED, origin: [0, 0, 0], step: 0.1, maxError: 0.05,
+                                   data: new Uint8Array(0), boneTransforms: new Float32Array(0), ...fields });
+    const attempt = (what, run) => { try { run(); return [what, 'accepted']; } catch (error) { return [what, error.message]; } };
+    return [
+      attempt('bytes that do not decode', () => quantized.decodeEncoded(encoded({ data: new Uint8Array(10) }))),
+      attempt('a zero step', () => quantized.decodeEncoded(encoded({ step: 0 }))),
+      attempt('no origin', () => quantized.decodeEncoded(encoded({ origin: [] }))),
+      attempt('predicted without weights', () => quantized.decodeEncoded(encoded({ encoding: codec.PREDICTED }))),
+      attempt('5 transform floats', () => predicted.decodeEncoded(encoded({ encoding: codec.PREDICTED, boneTransforms: new Float32Array(5) }))),
+      attempt('an unknown encoding', () => quantized.decodeEncoded(encoded({ encoding: 7 }))),
+      attempt('a float32 frame of the wrong size', () => quantized.decode({ positions: new Float32Array(5), encoded: null })),
+      attempt('weights naming a bone out of range', () => new codec.FrameDecoder(n, info.restPositions, { ...info.predictionWeights, numBones: 1 })),
+      attempt('an unknown encoding name', () => codec.encodingFromName('png')),
+    ];
+  }, meshId);
+}
+
 async function codecChecks(page, server, summary) {
   const result = await framesInEveryEncoding(page, summary.meshId, CODEC_POSES);
   const exact = result.encodings.float32;
@@ -309,6 +339,12 @@ async function codecChecks(page, server, summary) {
   const bytesPerFrame = Object.fromEntries(ENCODINGS.map((e) => [e, result.encodings[e].map((f) => f.bytes)]));
   console.log(`frame encodings on ${n} vertices: bytes per frame ${JSON.stringify(bytesPerFrame)}; ` +
               `decode ms per frame in the page (median over the poses of the mean of 200 decodes) ${JSON.stringify(result.decodeMs)}`);
+
+  const expected = [/do not decode to \d+ vertices/, /step must be positive/, /without its box origin/,
+                    /needs the mesh's prediction weights/, /needs 24 transform floats, got 5/, /unknown encoding \(7\)/,
+                    /float32 frame of 20 bytes/, /bone out of range/, /unknown frame encoding "png"/];
+  const refusals = await malformedFrameMessages(page, summary.meshId);
+  refusals.forEach(([what, message], i) => check(expected[i].test(message), `a malformed frame is refused by name: ${what} (${message})`));
 
   // Bit for bit against the C++ client library: deform-vr decodes the same pose's frame through
   // core/codec and writes it as doubles (lossless). Same mesh, same pose: the same frame.
