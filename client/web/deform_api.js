@@ -30,9 +30,11 @@ export class DeformApi {
     return wire.decodeListMeshesResponse(await this.call('ListMeshes', wire.encodeListMeshesRequest()));
   }
 
-  async meshInfo(meshId) {
+  // The summary, rest positions and triangles, and (by default) the prediction weights that
+  // FRAME_ENCODING_PREDICTED frames are decoded with.
+  async meshInfo(meshId, includePredictionWeights = true) {
     return wire.decodeGetMeshInfoResponse(
-      await this.call('GetMeshInfo', wire.encodeGetMeshInfoRequest(meshId, true)));
+      await this.call('GetMeshInfo', wire.encodeGetMeshInfoRequest(meshId, true, includePredictionWeights)));
   }
 
   // A WebSocket to /ws/<method> with the protocol's subprotocols.
@@ -69,16 +71,18 @@ export class DeformApi {
   }
 }
 
-// One Deform stream over a WebSocket. Callbacks: onFrame(frame, bytes), onNotice(notice),
+// One Deform stream over a WebSocket, its frames in `encoding` (FrameEncoding value; 1 = float32,
+// the default) with `maxError` (PREDICTED: a fraction of the diagonal; 0 = the server's default).
+// Callbacks: onFrame(frame, byte length, the DeformResponse message's bytes), onNotice(notice),
 // onEnd(code, message).
 export class DeformStream {
-  constructor(api, meshId, { onFrame, onNotice, onEnd, onOpen }) {
+  constructor(api, meshId, { onFrame, onNotice, onEnd, onOpen, encoding = 1, maxError = 0 }) {
     this.socket = api.openSocket('Deform');
     this.sequence = 0;
     this.open = false;
     this.socket.onopen = () => {
       this.open = true;
-      this.socket.send(wire.encodeDeformStart(meshId));
+      this.socket.send(wire.encodeDeformStart(meshId, encoding, maxError));
       if (onOpen) onOpen();
     };
     this.socket.onmessage = (event) => {
@@ -87,8 +91,9 @@ export class DeformStream {
         onEnd(Number(code), message);
         return;
       }
-      const response = wire.decodeDeformResponse(new Uint8Array(event.data));
-      if (response.frame) onFrame(response.frame, event.data.byteLength);
+      const bytes = new Uint8Array(event.data);
+      const response = wire.decodeDeformResponse(bytes);
+      if (response.frame) onFrame(response.frame, event.data.byteLength, bytes);
       else if (response.notice) onNotice(response.notice);
     };
     this.socket.onclose = () => { if (this.open) { this.open = false; } };

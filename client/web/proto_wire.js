@@ -26,8 +26,10 @@ class Writer {
   finish() { return new Uint8Array(this.bytes); }
 }
 
-export function encodeGetMeshInfoRequest(meshId, includeGeometry) {
-  const w = new Writer(); w.string(1, meshId); w.bool(2, includeGeometry); return w.finish();
+export function encodeGetMeshInfoRequest(meshId, includeGeometry, includePredictionWeights = false) {
+  const w = new Writer();
+  w.string(1, meshId); w.bool(2, includeGeometry); w.bool(3, includePredictionWeights);
+  return w.finish();
 }
 export function encodeListMeshesRequest() { return new Uint8Array(0); }
 
@@ -38,10 +40,11 @@ export function encodeLoadPhantomHeader(name, vertices) {
   return w.finish();
 }
 
-// DeformRequest{start: DeformStart{mesh_id, encoding}}; encoding 1 = FRAME_ENCODING_FLOAT32.
-export function encodeDeformStart(meshId, encoding = 1) {
+// DeformRequest{start: DeformStart{mesh_id, encoding, max_error}}; encoding 1 =
+// FRAME_ENCODING_FLOAT32, 2 = QUANTIZED, 3 = PREDICTED; maxError 0 = the server's default.
+export function encodeDeformStart(meshId, encoding = 1, maxError = 0) {
   const w = new Writer();
-  w.message(1, (s) => { s.string(1, meshId); s.uint(2, encoding); });
+  w.message(1, (s) => { s.string(1, meshId); s.uint(2, encoding); s.double(3, maxError); });
   return w.finish();
 }
 
@@ -132,11 +135,36 @@ export function decodeListMeshesResponse(b) { return all(fields(b), 1).map(decod
 // Little-endian arrays out of a bytes field (copied: the field need not be aligned).
 function float32s(v) { return v ? new Float32Array(v.slice().buffer) : new Float32Array(0); }
 function uint32s(v) { return v ? new Uint32Array(v.slice().buffer) : new Uint32Array(0); }
+function uint16s(v) { return v ? new Uint16Array(v.slice().buffer) : new Uint16Array(0); }
+// Packed or unpacked repeated floats, as a Float32Array.
+function floats(f, n) {
+  const parts = all(f, n).map((v) => (v instanceof Uint8Array ? float32s(v) : [v]));
+  const result = new Float32Array(parts.reduce((sum, p) => sum + p.length, 0));
+  let at = 0;
+  for (const p of parts) { result.set(p, at); at += p.length; }
+  return result;
+}
+
+// PredictionWeights{bones: uint16 x 4 per vertex, weights: float32 x 4 per vertex, num_bones}.
+function decodePredictionWeights(b) {
+  const f = fields(b);
+  return { bones: uint16s(one(f, 1)), weights: float32s(one(f, 2)), numBones: one(f, 3, 0) };
+}
+
+// EncodedPositions (FrameEncoding 2 QUANTIZED or 3 PREDICTED): origin (3 doubles, QUANTIZED),
+// step and maxError (model units), data (meshoptimizer's vertex codec), boneTransforms
+// (Float32Array, 12 per bone, PREDICTED).
+export function decodeEncodedPositions(b) {
+  const f = fields(b);
+  return { encoding: one(f, 1, 0), origin: doubles(f, 2), step: one(f, 3, 0), maxError: one(f, 4, 0),
+           data: one(f, 5, new Uint8Array(0)), boneTransforms: floats(f, 6) };
+}
 
 export function decodeGetMeshInfoResponse(b) {
   const f = fields(b);
   return { summary: decodeMeshSummary(one(f, 1, new Uint8Array(0))),
-           restPositions: float32s(one(f, 2)), triangles: uint32s(one(f, 3)) };
+           restPositions: float32s(one(f, 2)), triangles: uint32s(one(f, 3)),
+           predictionWeights: f.has(4) ? decodePredictionWeights(one(f, 4)) : null };
 }
 export function decodeLoadMeshResponse(b) {
   const f = fields(b);
@@ -145,7 +173,8 @@ export function decodeLoadMeshResponse(b) {
 }
 export const STAGE_NAMES = ['UNSPECIFIED', 'RECEIVED', 'VALIDATED', 'WEIGHTS', 'FACTORISED', 'READY'];
 
-// DeformResponse: {frame} or {notice}.
+// DeformResponse: {frame} or {notice}. A frame's positions are float32 (FRAME_ENCODING_FLOAT32) or
+// `encoded` (frame_codec.js decodes both).
 export function decodeDeformResponse(b) {
   const f = fields(b);
   if (f.has(1)) {
@@ -155,7 +184,7 @@ export function decodeDeformResponse(b) {
       sequence: one(g, 1, 0), clientTimestampNs: one(g, 2, 0), stiffnessVersion: one(g, 3, 0),
       skippedPoses: one(g, 4, 0), clampedAngles: one(g, 5, 0), meshUnloaded: one(g, 6, 0) === 1,
       timings: { queueMs: one(t, 1, 0), rhsMs: one(t, 2, 0), solveMs: one(t, 3, 0), encodeMs: one(t, 4, 0) },
-      positions: float32s(one(g, 8)), encoded: g.has(9) } };
+      positions: float32s(one(g, 8)), encoded: g.has(9) ? decodeEncodedPositions(one(g, 9)) : null } };
   }
   if (f.has(2)) {
     const g = fields(one(f, 2));

@@ -1,20 +1,26 @@
 // The deformd browser viewer: lists the caller's meshes, loads the phantom, shows the selected
 // mesh shaded (three.js), streams its deformation over a WebSocket while the joint sliders move,
-// and shows frames per second, latency and bytes per frame. Frames carry positions only (float32);
-// normals are recomputed here for every frame (shown in the panel with their cost).
-// window.viewerState exposes the counters (the browser test reads them).
+// and shows frames per second, latency, bytes per frame, the frame's encoding and stated error and
+// the time to decode it. The encoding selector (float32, quantized, predicted; initially `?encoding=`
+// or float32) restarts the stream in the chosen encoding; frame_codec.js decodes every encoding.
+// Frames carry positions only; normals are recomputed here for every frame (shown in the panel with
+// their cost). window.viewerState exposes the counters (the browser test reads them).
 import * as THREE from './vendor/three.module.js';
 import { DeformApi, DeformStream } from './deform_api.js';
 import { NOTICE_KINDS } from './proto_wire.js';
+import { ENCODING_NAMES, FrameDecoder, encodingFromName, frameCodecReady } from './frame_codec.js';
 
 const params = new URLSearchParams(location.search);
 const api = new DeformApi(params.get('token') || '');
 const $ = (id) => document.getElementById(id);
+const codecReady = frameCodecReady();  // meshoptimizer's WebAssembly; selectMesh awaits it
 
 const state = window.viewerState = {
   meshes: [], meshId: null, framesReceived: 0, lastFrameSequence: 0, lastPoseSequence: 0,
   lastBytes: 0, latencies: [], errors: [], streamStatus: 'none', normalsMs: 0,
+  encoding: 'float32', lastFrameEncoding: null, lastMaxError: 0, decodeMs: 0, decodeTimes: [], diagonal: 0,
 };
+let decoder = null;  // the selected mesh's FrameDecoder
 
 // ---- rendering ----
 const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
@@ -81,6 +87,7 @@ function showGeometry(info) {
   scene.add(mesh);
   const box = geometry.boundingBox;
   const size = box.getSize(new THREE.Vector3());
+  state.diagonal = size.length();
   box.getCenter(orbit.center);
   const axes = [new THREE.Vector3(1, 0, 0), new THREE.Vector3(0, 1, 0), new THREE.Vector3(0, 0, 1)];
   const longest = size.x >= size.y && size.x >= size.z ? 0 : (size.y >= size.z ? 1 : 2);
@@ -134,6 +141,18 @@ function sendPoseSoon() {
 const frameTimes = [];
 function onFrame(frame, bytes) {
   const now = performance.now();
+  let positions;
+  try {
+    positions = decoder.decode(frame);
+  } catch (error) {
+    report(error);
+    return;
+  }
+  state.decodeMs = performance.now() - now;
+  state.decodeTimes.push(state.decodeMs);
+  if (state.decodeTimes.length > 120) state.decodeTimes.shift();
+  state.lastFrameEncoding = frame.encoded ? ENCODING_NAMES[frame.encoded.encoding] : 'float32';
+  state.lastMaxError = frame.encoded ? frame.encoded.maxError : 0;
   state.framesReceived += 1;
   state.lastFrameSequence = frame.sequence;
   state.lastBytes = bytes;
@@ -142,11 +161,18 @@ function onFrame(frame, bytes) {
   if (state.latencies.length > 120) state.latencies.shift();
   frameTimes.push(now);
   while (frameTimes.length && frameTimes[0] < now - 1000) frameTimes.shift();
-  applyFrame(frame.positions);
+  applyFrame(positions);
   const sorted = [...state.latencies].sort((a, b) => a - b);
   $('stat-fps').textContent = String(frameTimes.length);
   $('stat-latency').textContent = `${latency.toFixed(1)} ms, ${sorted[sorted.length >> 1].toFixed(1)} ms`;
-  $('stat-bytes').textContent = `${bytes} (${(bytes / Math.max(frame.positions.length / 3, 1)).toFixed(1)} per vertex)`;
+  $('stat-bytes').textContent = `${bytes} (${(bytes / Math.max(decoder.vertexCount, 1)).toFixed(2)} per vertex)`;
+  $('stat-encoding').textContent = state.lastFrameEncoding;
+  $('stat-max-error').textContent = frame.encoded
+    ? `${state.lastMaxError.toExponential(2)} units (${(state.lastMaxError / state.diagonal).toExponential(1)} of the diagonal)`
+    : 'float32 rounding';
+  // The page's clock ticks in 0.1 ms: the mean of the last frames' decodes says more than one.
+  const meanDecode = state.decodeTimes.reduce((sum, t) => sum + t, 0) / state.decodeTimes.length;
+  $('stat-decode').textContent = `${meanDecode.toFixed(3)} ms (mean of the last ${state.decodeTimes.length} frames)`;
   $('stat-solve').textContent = `${(frame.timings.rhsMs + frame.timings.solveMs).toFixed(2)} ms (queue ${frame.timings.queueMs.toFixed(2)} ms)`;
   $('stat-normals').textContent = `not carried by frames: recomputed here per frame (${state.normalsMs.toFixed(2)} ms)`;
 }
@@ -162,6 +188,7 @@ function openStream(meshId) {
   state.streamStatus = 'opening';
   $('stat-status').textContent = 'opening';
   stream = new DeformStream(api, meshId, {
+    encoding: encodingFromName(state.encoding),
     onOpen: () => { state.streamStatus = 'open'; $('stat-status').textContent = 'open'; sendPoseSoon(); },
     onFrame,
     onNotice,
@@ -235,6 +262,8 @@ async function selectMesh(meshId) {
   state.meshId = meshId;
   for (const li of $('meshes').children) li.classList.toggle('selected', li.dataset.meshId === meshId);
   const info = await api.meshInfo(meshId);
+  await codecReady;
+  decoder = new FrameDecoder(info.summary.vertexCount, info.restPositions, info.predictionWeights);
   state.summary = info.summary;
   buildJointControls(info.summary);
   showGeometry(info);
@@ -262,6 +291,15 @@ function report(error) {
 }
 
 $('refresh').addEventListener('click', () => refreshMeshes().catch(report));
+// A new encoding restarts the stream (DeformStart fixes a stream's encoding); the sliders' pose is
+// sent again when it opens.
+const requested = params.get('encoding');
+state.encoding = Object.values(ENCODING_NAMES).includes(requested) ? requested : 'float32';
+$('encoding').value = state.encoding;
+$('encoding').addEventListener('change', () => {
+  state.encoding = $('encoding').value;
+  if (state.meshId && decoder) openStream(state.meshId);
+});
 $('load-phantom').addEventListener('click', async () => {
   try {
     const vertices = Number($('phantom-vertices').value) || 2000;
@@ -276,4 +314,5 @@ $('load-phantom').addEventListener('click', async () => {
 });
 
 resize();
+codecReady.catch(report);
 refreshMeshes().catch(report);

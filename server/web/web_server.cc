@@ -120,8 +120,11 @@ Response MakeResponse(const Request& request, http::status status, std::string_v
   response.set(http::field::content_type, std::string(content_type));
   response.set(http::field::cache_control, "no-store");
   response.set("X-Content-Type-Options", "nosniff");
+  // 'wasm-unsafe-eval': the page compiles meshoptimizer's decoder (WebAssembly, served from
+  // this root); no script from elsewhere and no eval of script text.
   response.set("Content-Security-Policy",
-               "default-src 'self'; connect-src 'self'; img-src 'self' data:");
+               "default-src 'self'; script-src 'self' 'wasm-unsafe-eval'; connect-src 'self'; "
+               "img-src 'self' data:");
   response.keep_alive(request.keep_alive());
   response.body() = std::move(body);
   response.prepare_payload();
