@@ -98,6 +98,16 @@ std::vector<int> ParentsFirstOrder(const std::vector<Bone>& bones) {
 
 StatusOr<Skeleton> Skeleton::Create(std::vector<Joint> joints,
                                     std::vector<std::pair<int, int>> bones) {
+  return Create(std::move(joints), std::move(bones), {});
+}
+
+StatusOr<Skeleton> Skeleton::Create(std::vector<Joint> joints,
+                                    std::vector<std::pair<int, int>> bones,
+                                    const std::vector<int>& parents) {
+  if (!parents.empty() && parents.size() != bones.size()) {
+    return Status::InvalidArgument("the skeleton gives " + std::to_string(parents.size()) +
+                                   " bone parents for " + std::to_string(bones.size()) + " bones");
+  }
   if (joints.empty()) return Status::InvalidArgument("skeleton has no joints");
   if (bones.empty()) return Status::InvalidArgument("skeleton has no bones");
   DEFORM_RETURN_IF_ERROR(CheckJoints(&joints));
@@ -108,6 +118,25 @@ StatusOr<Skeleton> Skeleton::Create(std::vector<Joint> joints,
     DEFORM_RETURN_IF_ERROR(CheckBone(joints, s.incoming_bone_, k, head, tail));
     s.incoming_bone_[tail] = k;
     s.bones_.push_back({head, tail, -1});
+  }
+  // Explicit parents: the head joint of such a bone is carried by its parent.
+  const int num_bones = static_cast<int>(s.bones_.size());
+  for (int k = 0; k < static_cast<int>(parents.size()); ++k) {
+    const int parent = parents[k];
+    if (parent < 0) continue;
+    const std::string bone = "bone " + std::to_string(k);
+    if (parent >= num_bones || parent == k) {
+      return Status::InvalidArgument(bone + " names parent bone " + std::to_string(parent) +
+                                     ", which is not another bone of the " +
+                                     std::to_string(num_bones));
+    }
+    int& carrier = s.incoming_bone_[s.bones_[k].head_joint];
+    if (carrier >= 0 && carrier != parent) {
+      return Status::InvalidArgument(bone + " names parent bone " + std::to_string(parent) +
+                                     " but its head joint '" + joints[s.bones_[k].head_joint].name +
+                                     "' is carried by bone " + std::to_string(carrier));
+    }
+    carrier = parent;
   }
   for (Bone& b : s.bones_) b.parent_bone = s.incoming_bone_[b.head_joint];
   s.bones_parents_first_ = ParentsFirstOrder(s.bones_);

@@ -29,7 +29,9 @@ struct Joint {
 struct Bone {
   int head_joint = -1;  // the parent side: rotations of this joint move the bone
   int tail_joint = -1;
-  int parent_bone = -1;  // the bone whose tail is this bone's head, or -1 for a root bone
+  // The bone whose transform carries this one: the bone whose tail is this bone's head, or one
+  // given explicitly (Skeleton::Create's `parents`); -1 for a root bone.
+  int parent_bone = -1;
 };
 
 class Skeleton {
@@ -39,6 +41,17 @@ class Skeleton {
   // dof axes non-zero (normalised here) and min <= max. Parent bones are derived here.
   static StatusOr<Skeleton> Create(std::vector<Joint> joints,
                                    std::vector<std::pair<int, int>> bones);
+  // As above, with explicit parents for rigs whose bones do not meet (a game-engine thigh hangs
+  // off the pelvis bone at the hip, away from the pelvis bone's tail): `parents[k]` >= 0 makes
+  // bone k a child of that bone, carried by its transform; -1 derives the parent as above. The
+  // joint at such a bone's head is then carried by the parent bone (IncomingBone) and is an inner
+  // joint (a joint region and a joint centre node), as where bones meet. `parents` is empty or
+  // has one entry per bone. INVALID_ARGUMENT, naming the bone, for a parent out of range or
+  // itself, a parent that contradicts the bone ending at the head joint, two bones on one head
+  // joint with different parents, or a cycle.
+  static StatusOr<Skeleton> Create(std::vector<Joint> joints,
+                                   std::vector<std::pair<int, int>> bones,
+                                   const std::vector<int>& parents);
 
   int num_joints() const { return static_cast<int>(joints_.size()); }
   int num_bones() const { return static_cast<int>(bones_.size()); }
@@ -47,8 +60,15 @@ class Skeleton {
   const Joint& joint(int j) const { return joints_[j]; }
   const Bone& bone(int b) const { return bones_[b]; }
 
-  // The bone whose tail is joint j, or -1 (a root joint).
+  // The bone that carries joint j: the bone whose tail is j, or the explicit parent of the bones
+  // whose head is j (Create with parents); -1 for a root joint.
   int IncomingBone(int j) const { return incoming_bone_[j]; }
+  // Whether bone k's parent was given explicitly and is not the bone ending at its head (what a
+  // writer must state: TGF cannot, the project's JSON does).
+  bool HasExplicitParent(int k) const {
+    const int parent = bones_[k].parent_bone;
+    return parent >= 0 && bones_[parent].tail_joint != bones_[k].head_joint;
+  }
   // Bones in an order where every parent precedes its children.
   const std::vector<int>& BonesParentsFirst() const { return bones_parents_first_; }
   // Joints where a parent bone and at least one child bone meet (rotation centres: knee, ankle...).

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -237,15 +238,39 @@ StatusOr<Skeleton> ParseSkeletonJsonValue(const nlohmann::json& doc) {
     joints.push_back(std::move(joint));
   }
   std::vector<std::pair<int, int>> bones;
+  std::vector<int> parents;
   for (const auto& b : doc["bones"]) {
-    if (!b.is_array() || b.size() != 2) {
-      return Status::InvalidArgument("each bone must be [head, tail]");
+    const std::string where = "bone " + std::to_string(bones.size());
+    int parent = -1;
+    nlohmann::json head_value, tail_value;
+    if (b.is_array() && b.size() == 2) {
+      head_value = b[0];
+      tail_value = b[1];
+    } else if (b.is_object() && b.contains("head") && b.contains("tail")) {
+      DEFORM_RETURN_IF_ERROR(RefuseUnknownKeys(b, where, {"head", "tail", "parent"}));
+      head_value = b["head"];
+      tail_value = b["tail"];
+      if (b.contains("parent") && !b["parent"].is_null()) {
+        if (!b["parent"].is_number_integer()) {
+          return Status::InvalidArgument(where + " 'parent' must be a 0-based bone index");
+        }
+        const auto value = b["parent"].get<long long>();
+        if (value < -1 || value > std::numeric_limits<int>::max()) {
+          return Status::InvalidArgument(where + " 'parent' " + std::to_string(value) +
+                                         " is not a bone index");
+        }
+        parent = static_cast<int>(value);
+      }
+    } else {
+      return Status::InvalidArgument(
+          "each bone must be [head, tail] or {\"head\": ..., \"tail\": ..., \"parent\": ...}");
     }
-    DEFORM_ASSIGN_OR_RETURN(const int head, JsonJointReference(b[0], joints));
-    DEFORM_ASSIGN_OR_RETURN(const int tail, JsonJointReference(b[1], joints));
+    DEFORM_ASSIGN_OR_RETURN(const int head, JsonJointReference(head_value, joints));
+    DEFORM_ASSIGN_OR_RETURN(const int tail, JsonJointReference(tail_value, joints));
     bones.emplace_back(head, tail);
+    parents.push_back(parent);
   }
-  return Skeleton::Create(std::move(joints), std::move(bones));
+  return Skeleton::Create(std::move(joints), std::move(bones), parents);
 }
 
 }  // namespace
@@ -275,8 +300,16 @@ std::string SkeletonToJson(const Skeleton& skeleton) {
     doc["joints"].push_back(joint);
   }
   doc["bones"] = nlohmann::json::array();
-  for (const Bone& b : skeleton.bones()) {
-    doc["bones"].push_back({skeleton.joint(b.head_joint).name, skeleton.joint(b.tail_joint).name});
+  for (int k = 0; k < skeleton.num_bones(); ++k) {
+    const Bone& b = skeleton.bone(k);
+    if (skeleton.HasExplicitParent(k)) {
+      doc["bones"].push_back({{"head", skeleton.joint(b.head_joint).name},
+                              {"tail", skeleton.joint(b.tail_joint).name},
+                              {"parent", b.parent_bone}});
+    } else {
+      doc["bones"].push_back(
+          {skeleton.joint(b.head_joint).name, skeleton.joint(b.tail_joint).name});
+    }
   }
   return doc.dump(2);
 }

@@ -35,9 +35,13 @@ StatusOr<Skeleton> ParseTgf(std::string_view text);
 //                   "dofs": [ { "name": "flexion", "axis": [1, 0, 0],
 //                               "min": -10, "max": 150 }, ... ] }, ... ],
 //     "bones": [ ["hip", "knee"], ["knee", "ankle"] ] }
-// Bones name their head then tail joint (names or 0-based indices). Keys other than these
-// (top-level "joints" and "bones"; a joint's "name", "position", "dofs"; a dof's "name", "axis",
-// "min", "max") are refused by name rather than ignored.
+// Bones name their head then tail joint (names or 0-based indices). A bone may instead be an
+// object { "head": ..., "tail": ..., "parent": 3 } whose "parent" (a 0-based bone index; -1 or
+// null derives it) makes it a child of that bone even where that bone's tail is not its head
+// (Skeleton::Create with parents: game-engine rigs whose thighs hang off the pelvis bone).
+// Keys other than these (top-level "joints" and "bones"; a joint's "name", "position", "dofs"; a
+// dof's "name", "axis", "min", "max"; a bone object's "head", "tail", "parent") are refused by
+// name rather than ignored. SkeletonToJson writes the object form for explicit parents only.
 StatusOr<Skeleton> ParseSkeletonJson(std::string_view text);
 std::string SkeletonToJson(const Skeleton& skeleton);
 

@@ -10,8 +10,11 @@
 namespace deform {
 namespace {
 
+// The bone ends at the joint, starts there, or carries it (an explicit parent whose tail lies
+// elsewhere: Skeleton::IncomingBone).
 bool BoneTouchesJoint(const Skeleton& skeleton, int bone, int joint) {
-  return skeleton.bone(bone).head_joint == joint || skeleton.bone(bone).tail_joint == joint;
+  return skeleton.bone(bone).head_joint == joint || skeleton.bone(bone).tail_joint == joint ||
+         skeleton.IncomingBone(joint) == bone;
 }
 
 double ShortestAdjacentBone(const Skeleton& skeleton, int joint) {

@@ -53,6 +53,11 @@ std::vector<std::vector<int>> RegionBonesPerVertex(const JointRegions& regions,
     bones_of_joint[skeleton.bone(k).head_joint].push_back(k);
     bones_of_joint[skeleton.bone(k).tail_joint].push_back(k);
   }
+  for (int j = 0; j < skeleton.num_joints(); ++j) {  // an explicit parent carrying the joint
+    const int carrier = skeleton.IncomingBone(j);
+    if (carrier >= 0 && skeleton.bone(carrier).tail_joint != j)
+      bones_of_joint[j].push_back(carrier);
+  }
   std::vector<std::vector<int>> allowed(n);
   for (int i = 0; i < n; ++i) {
     std::vector<int>& bones = allowed[i];

@@ -5,8 +5,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <fstream>
 #include <memory>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -320,8 +323,8 @@ TEST(RigBinding, BendingTheBodysHipLeavesTheUpperBodyStill) {
   ASSERT_TRUE(mesh.ok() && skeleton.ok());
   auto model = DeformationModel::Build(*mesh, *skeleton, ModelOptions::Paper());
   ASSERT_TRUE(model.ok()) << model.status().ToString();
-  // Its TGF file's bones form 16 trees in one connected surface (a thigh's bone does not start where
-  // the pelvis's ends): the report says so, since a root joint's turn has no joint region.
+  // Its TGF file's bones form 16 trees in one connected surface (a thigh's bone does not start
+  // where the pelvis's ends): the report says so, since a root joint's turn has no joint region.
   const auto& warnings = (*model)->binding_report().warnings;
   EXPECT_TRUE(std::any_of(warnings.begin(), warnings.end(), [](const std::string& w) {
     return w.find("16 separate skeleton trees") != std::string::npos;
@@ -334,8 +337,9 @@ TEST(RigBinding, BendingTheBodysHipLeavesTheUpperBodyStill) {
   }
   for (int k = 0; k < skeleton->num_bones(); ++k) EXPECT_GE(5 * rigid[k], bound[k]) << "bone " << k;
   // The chest and above: higher than the middle spine joint by a fifth of the torso.
-  const double chest = (*model)->skeleton().joint(*(*model)->skeleton().FindJoint("joint15"))
-                           .rest_position.y() + 0.5;
+  const double chest =
+      (*model)->skeleton().joint(*(*model)->skeleton().FindJoint("joint15")).rest_position.y() +
+      0.5;
   for (const char* spec : {"joint4:x:-60", "joint9:x:-60", "joint5:x:90"}) {
     const Frame frame = Deform(**model, PoseFromSpec((*model)->skeleton(), spec));
     double worst = 0;
@@ -346,6 +350,80 @@ TEST(RigBinding, BendingTheBodysHipLeavesTheUpperBodyStill) {
     EXPECT_LT(worst / (*model)->bounding_box_diagonal(), 1e-3) << spec;
     EXPECT_LT(RigidZoneError(**model, frame), 1e-3) << spec;
   }
+}
+
+// The shared body's bones as its rig has them: body.tgf's bones with the parents body_parents.txt
+// gives (its second column, bone i = TGF edge i), through Skeleton::Create's explicit parents.
+StatusOr<Skeleton> BodySkeletonWithParents(const std::string& tgf_path,
+                                           const std::string& parents_path) {
+  DEFORM_ASSIGN_OR_RETURN(const Skeleton tgf, ReadSkeletonFile(tgf_path));
+  std::ifstream in(parents_path);
+  std::vector<int> parents(tgf.num_bones(), -1);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream fields(line);
+    int bone = -1, parent = -1;
+    fields >> bone >> parent;
+    if (bone >= 0 && bone < tgf.num_bones()) parents[bone] = parent;
+  }
+  std::vector<std::pair<int, int>> bones;
+  for (const Bone& b : tgf.bones()) bones.emplace_back(b.head_joint, b.tail_joint);
+  return Skeleton::Create(tgf.joints(), std::move(bones), parents);
+}
+
+// With its parents the body is one tree: a hip is a joint (a region, a centre node) where the TGF
+// file alone left a root; the skeleton goes through the project's JSON and back unchanged; bending
+// the hip moves what hangs from it and leaves every rigid vertex that does not hang from it still.
+TEST(RigBinding, WithItsParentsTheBodyIsOneTreeAndAHipIsAJoint) {
+  DEFORM_REQUIRE_SHARED_FILE(mesh_path, "body/body_13380.obj");
+  DEFORM_REQUIRE_SHARED_FILE(skeleton_path, "body/body.tgf");
+  DEFORM_REQUIRE_SHARED_FILE(parents_path, "body/body_parents.txt");
+  auto mesh = ReadMeshFile(mesh_path);
+  auto skeleton = BodySkeletonWithParents(skeleton_path, parents_path);
+  ASSERT_TRUE(mesh.ok() && skeleton.ok()) << skeleton.status().ToString();
+  int roots = 0;
+  for (const Bone& b : skeleton->bones()) roots += b.parent_bone < 0;
+  EXPECT_EQ(roots, 1);
+  auto round_trip = ParseSkeletonJson(SkeletonToJson(*skeleton));
+  ASSERT_TRUE(round_trip.ok()) << round_trip.status().ToString();
+  for (int k = 0; k < skeleton->num_bones(); ++k) {
+    EXPECT_EQ(round_trip->bone(k).parent_bone, skeleton->bone(k).parent_bone) << "bone " << k;
+  }
+
+  auto model = DeformationModel::Build(*mesh, *skeleton, ModelOptions::Paper());
+  ASSERT_TRUE(model.ok()) << model.status().ToString();
+  for (const std::string& warning : (*model)->binding_report().warnings) {
+    EXPECT_EQ(warning.find("separate skeleton trees"), std::string::npos) << warning;
+  }
+  const int hip = skeleton->bone(2).head_joint;  // thigh_l's head: a root joint in the TGF alone
+  const std::vector<int> inner = skeleton->InnerJoints();
+  EXPECT_NE(std::find(inner.begin(), inner.end(), hip), inner.end());
+  const std::string spec = "joint" + std::to_string(hip) + ":x:-60";
+  const Frame frame = Deform(**model, PoseFromSpec((*model)->skeleton(), spec));
+  const std::vector<char> moved = BonesMovedBy((*model)->skeleton(), hip);
+  const double diagonal = (*model)->bounding_box_diagonal();
+  double still_worst = 0, still_outside_bend = 0, still_any = 0;
+  for (int i = 0; i < mesh->num_vertices(); ++i) {
+    if (moved[(*model)->bound_bones()[i]]) continue;
+    const double distance = (frame.posed.row(i) - mesh->vertices.row(i)).norm() / diagonal;
+    if ((*model)->rigid_bones()[i] >= 0) still_worst = std::max(still_worst, distance);
+    if (!NextToTheBend(**model, hip, i))
+      still_outside_bend = std::max(still_outside_bend, distance);
+    still_any = std::max(still_any, distance);
+  }
+  std::printf("not hanging from the hip: outside the bend's regions moved %.3g, any vertex %.3g\n",
+              still_outside_bend, still_any);
+  RecordProperty("rigid_zone_error", std::to_string(RigidZoneError(**model, frame)));
+  RecordProperty("still_rigid_worst", std::to_string(still_worst));
+  std::printf(
+      "%s: rigid-zone error %.3g, rigid vertices not hanging from the hip moved %.3g "
+      "(of the diagonal)\n",
+      spec.c_str(), RigidZoneError(**model, frame), still_worst);
+  EXPECT_LT(still_worst, 1e-3) << spec;
+  EXPECT_LT(RigidZoneError(**model, frame), 1e-3) << spec;
+  // Not yet within 1e-3: soft skin in other joints' regions (the chest beside the clavicles'
+  // joints) moves up to about 1% of the diagonal, coupled through the solve (README).
 }
 
 }  // namespace

@@ -79,6 +79,36 @@ TEST(ForwardKinematics, KneeFlexionSwingsTheAnkleBackward) {
   EXPECT_NEAR((bones[0].Apply(knee) - knee).norm(), 0, 1e-12);
 }
 
+TEST(ForwardKinematics, AnExplicitParentCarriesABoneThatDoesNotMeetIt) {
+  // A pelvis bone (joint 0 -> 1) and a thigh hanging off it at a hip (joint 2 -> 3).
+  std::vector<Joint> joints(4);
+  joints[0] = {"pelvis", {0, 0, 0}, {}};
+  joints[1] = {"spine", {0, 1, 0}, {}};
+  joints[2] = {"hip", {1, 0, 0}, {}};
+  joints[3] = {"knee", {1, -2, 0}, {}};
+  auto skeleton = Skeleton::Create(joints, {{0, 1}, {2, 3}}, {-1, 0});
+  ASSERT_TRUE(skeleton.ok()) << skeleton.status().ToString();
+  Pose pose = Pose::Rest(*skeleton);
+  // Turning the pelvis joint by 90 degrees about z turns the pelvis bone and, with it, the hip
+  // and the whole thigh.
+  pose.joint_rotations[0] =
+      Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()));
+  std::vector<RigidTransform> bones;
+  ForwardKinematics(*skeleton, pose, &bones);
+  EXPECT_TRUE(
+      PosedJointPosition(*skeleton, pose, bones, 2).isApprox(Eigen::Vector3d(0, 1, 0), 1e-12));
+  EXPECT_TRUE(
+      PosedJointPosition(*skeleton, pose, bones, 3).isApprox(Eigen::Vector3d(2, 1, 0), 1e-12));
+  // Turning the hip moves the thigh only.
+  pose = Pose::Rest(*skeleton);
+  pose.joint_rotations[2] =
+      Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()));
+  ForwardKinematics(*skeleton, pose, &bones);
+  EXPECT_TRUE(bones[0].rotation.isApprox(Eigen::Quaterniond::Identity()));
+  EXPECT_TRUE(
+      PosedJointPosition(*skeleton, pose, bones, 3).isApprox(Eigen::Vector3d(3, 0, 0), 1e-12));
+}
+
 TEST(ForwardKinematics, MatchesTheSharedReferenceTransforms) {
   DEFORM_REQUIRE_SHARED_FILE(tgf, "leg/leg.tgf");
   DEFORM_REQUIRE_SHARED_FILE(json_path, "leg/reference_poses.json");

@@ -38,6 +38,58 @@ TEST(Skeleton, DerivesParentsAndNormalisesAxes) {
   EXPECT_EQ(skeleton->FindJoint("3").status().code(), StatusCode::kNotFound);
 }
 
+// A pelvis bone (0 -> 1) and a thigh (2 -> 3) hanging off it at a hip away from the pelvis
+// bone's tail, as game-engine rigs have them.
+std::vector<Joint> PelvisAndThigh() {
+  std::vector<Joint> joints(4);
+  joints[0] = {"pelvis", {0, 0, 0}, {}};
+  joints[1] = {"spine", {0, 1, 0}, {}};
+  joints[2] = {"hip", {1, 0, 0}, {}};
+  joints[3] = {"knee", {1, -2, 0}, {}};
+  return joints;
+}
+
+TEST(Skeleton, ExplicitParentsCarryBonesThatDoNotMeetTheirParent) {
+  auto derived = Skeleton::Create(PelvisAndThigh(), {{0, 1}, {2, 3}});
+  ASSERT_TRUE(derived.ok());
+  EXPECT_EQ(derived->bone(1).parent_bone, -1) << "without parents: two trees";
+  EXPECT_TRUE(derived->InnerJoints().empty());
+
+  auto skeleton = Skeleton::Create(PelvisAndThigh(), {{0, 1}, {2, 3}}, {-1, 0});
+  ASSERT_TRUE(skeleton.ok()) << skeleton.status().ToString();
+  EXPECT_EQ(skeleton->bone(1).parent_bone, 0);
+  EXPECT_TRUE(skeleton->HasExplicitParent(1));
+  EXPECT_FALSE(skeleton->HasExplicitParent(0));
+  EXPECT_EQ(skeleton->IncomingBone(2), 0) << "the pelvis bone carries the hip";
+  EXPECT_EQ(skeleton->InnerJoints(), (std::vector<int>{2}));
+  EXPECT_EQ(skeleton->BonesParentsFirst(), (std::vector<int>{0, 1}));
+}
+
+TEST(Skeleton, ExplicitParentsAreChecked) {
+  const auto error = [](std::vector<std::pair<int, int>> bones, std::vector<int> parents) {
+    auto skeleton = Skeleton::Create(PelvisAndThigh(), std::move(bones), parents);
+    EXPECT_FALSE(skeleton.ok());
+    return skeleton.status().message();
+  };
+  EXPECT_EQ(error({{0, 1}, {2, 3}}, {-1}), "the skeleton gives 1 bone parents for 2 bones");
+  EXPECT_EQ(error({{0, 1}, {2, 3}}, {-1, 2}),
+            "bone 1 names parent bone 2, which is not another bone of the 2");
+  EXPECT_EQ(error({{0, 1}, {2, 3}}, {-1, 1}),
+            "bone 1 names parent bone 1, which is not another bone of the 2");
+  // The hip ends bone 2, so bone 1 (starting there) cannot name bone 0 as its parent.
+  EXPECT_EQ(error({{0, 1}, {2, 3}, {1, 2}}, {-1, 0, -1}),
+            "bone 1 names parent bone 0 but its head joint 'hip' is carried by bone 2");
+  // Two bones at one head joint with different parents.
+  auto joints = PelvisAndThigh();
+  joints.push_back({"toe", {2, -2, 0}, {}});
+  auto two = Skeleton::Create(joints, {{0, 1}, {2, 3}, {2, 4}}, {-1, 0, 1});
+  ASSERT_FALSE(two.ok());
+  EXPECT_EQ(two.status().message(),
+            "bone 2 names parent bone 1 but its head joint 'hip' is carried by bone 0");
+  // A cycle through explicit parents.
+  EXPECT_EQ(error({{0, 1}, {2, 3}}, {1, 0}), "skeleton bones form a cycle");
+}
+
 TEST(Skeleton, NamesTheFirstProblem) {
   EXPECT_EQ(CreateError({}, {{0, 1}}), "skeleton has no joints");
   EXPECT_EQ(CreateError(ThreeJoints(), {}), "skeleton has no bones");
