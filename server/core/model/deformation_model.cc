@@ -196,8 +196,9 @@ StatusOr<std::shared_ptr<const MaterialFactorization>> DeformationModel::Factori
   DEFORM_ASSIGN_OR_RETURN(const Eigen::VectorXd row_weights, RowWeights(stiffness));
   result->row_weights_squared_ = row_weights.array().square();
   DEFORM_ASSIGN_OR_RETURN(
-      result->factor_, CholeskyFactor::Factorize(
-                           symbolic_, deform::NormalMatrix(system_, result->row_weights_squared_)));
+      result->factor_,
+      CholeskyFactor::Factorize(
+          symbolic_, deform::NormalMatrix(system_, result->row_weights_squared_), cancel));
   DEFORM_RETURN_IF_ERROR(CheckCancelled(cancel, "the numeric factorisation"));
   if (options_.rotation_blend == RotationBlend::kLinear) {
     result->linear_response_ = BuildLinearPoseResponse(

@@ -10,11 +10,12 @@
 namespace deform {
 
 StatusOr<CholeskyFactor> CholeskyFactor::Factorize(std::shared_ptr<const SymbolicCholesky> symbolic,
-                                                   const ColMajorMatrix& a) {
+                                                   const ColMajorMatrix& a,
+                                                   const CancelToken* cancel) {
   if (!symbolic) return Status::InvalidArgument("no symbolic analysis to factorise with");
   DEFORM_RETURN_IF_ERROR(CheckAnalysedPattern(*symbolic, a));
   DEFORM_ASSIGN_OR_RETURN(const ColumnFactor l,
-                          UpLookingCholesky(*symbolic, PermutedUpperValues(*symbolic, a)));
+                          UpLookingCholesky(*symbolic, PermutedUpperValues(*symbolic, a), cancel));
   CholeskyFactor f;
   f.PackSupernodes(*symbolic, l);
   f.symbolic_ = std::move(symbolic);
@@ -43,7 +44,7 @@ std::vector<double> CholeskyFactor::PermutedUpperValues(const SymbolicCholesky& 
 
 // Up-looking factorisation (CSparse's cs_chol): row k of L from the rows above it.
 StatusOr<CholeskyFactor::ColumnFactor> CholeskyFactor::UpLookingCholesky(
-    const SymbolicCholesky& s, const std::vector<double>& c_values) {
+    const SymbolicCholesky& s, const std::vector<double>& c_values, const CancelToken* cancel) {
   const int n = s.n_;
   ColumnFactor l{std::vector<int>(s.column_pointers_[n], 0),
                  std::vector<double>(s.column_pointers_[n], 0.0)};
@@ -51,6 +52,9 @@ StatusOr<CholeskyFactor::ColumnFactor> CholeskyFactor::UpLookingCholesky(
   std::vector<double> x(n, 0.0);
   std::vector<int> stack(n), mark(n, -1);
   for (int k = 0; k < n; ++k) {
+    if (k % kCancelCheckRows == 0) {
+      DEFORM_RETURN_IF_ERROR(CheckCancelled(cancel, "the numeric factorisation"));
+    }
     const int top = solver_internal::RowPattern(k, s.c_column_pointers_, s.c_row_indices_,
                                                 s.elimination_tree_, &stack, &mark);
     x[k] = 0;

@@ -7,6 +7,8 @@
 #include <random>
 #include <string>
 
+#include "core/base/cancel_token.h"
+
 namespace deform {
 namespace {
 
@@ -99,6 +101,31 @@ TEST_P(SparseCholeskyTest, RefactorisationReusesTheAnalysis) {
   ASSERT_TRUE(reused->Solve3(b.data(), x1.data(), work.data()).ok());
   ASSERT_TRUE(fresh->Solve3(b.data(), x2.data(), work.data()).ok());
   EXPECT_LT((x1 - x2).norm(), 1e-12 * x2.norm());
+}
+
+TEST_P(SparseCholeskyTest, ACancelledFactorisationStopsAndAnUncancelledOneCompletes) {
+  const int n = 3 * CholeskyFactor::kCancelCheckRows;
+  ColMajorMatrix a = RandomSpdMatrix(n, 3, 29);
+  auto symbolic = SymbolicCholesky::Analyze(a, GetParam());
+  ASSERT_TRUE(symbolic.ok());
+  CancelToken cancelled;
+  cancelled.Cancel();
+  const auto stopped = CholeskyFactor::Factorize(*symbolic, a, &cancelled);
+  EXPECT_EQ(stopped.status().ToString(),
+            "FAILED_PRECONDITION: cancelled during the numeric factorisation");
+  // A parent's cancel (the server's shutdown) reaches it too.
+  CancelToken child(&cancelled);
+  EXPECT_FALSE(CholeskyFactor::Factorize(*symbolic, a, &child).ok());
+  CancelToken never;
+  const auto done = CholeskyFactor::Factorize(*symbolic, a, &never);
+  const auto plain = CholeskyFactor::Factorize(*symbolic, a);
+  ASSERT_TRUE(done.ok() && plain.ok());
+  const auto b = RandomRightHandSides(n, 31);
+  Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> x1(n, 3), x2(n, 3);
+  std::vector<double> work(done->WorkSize());
+  ASSERT_TRUE(done->Solve3(b.data(), x1.data(), work.data()).ok());
+  ASSERT_TRUE(plain->Solve3(b.data(), x2.data(), work.data()).ok());
+  EXPECT_EQ((x1 - x2).norm(), 0.0);
 }
 
 TEST(Ordering, NamesRoundTrip) {
