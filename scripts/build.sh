@@ -5,6 +5,8 @@
 # the same machine are fast.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# shellcheck source=scripts/ccache-env.sh
+source scripts/ccache-env.sh
 BUILD_DIR="${DEFORM_BUILD_DIR:-build}"
 GENERATOR=()
 if command -v ninja >/dev/null 2>&1; then GENERATOR=(-G Ninja); fi

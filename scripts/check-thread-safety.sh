@@ -11,6 +11,8 @@
 # end. Installs what is missing (scripts/packages/build.txt and checks.txt: clang). About a minute on 2 cores from scratch; ccache makes reruns fast.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# shellcheck source=scripts/ccache-env.sh
+source scripts/ccache-env.sh
 start=$(date +%s)
 BUILD_DIR="${DEFORM_TSA_BUILD_DIR:-build-tsa}"
 # The targets whose sources carry annotations.

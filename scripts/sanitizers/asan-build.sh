@@ -8,6 +8,8 @@
 #                              benchmarks.
 #   export_sanitizer_options   ASAN_OPTIONS, UBSAN_OPTIONS and LSAN_OPTIONS (halt at the first
 #                              report; scripts/sanitizers/lsan.supp) unless already set.
+# shellcheck source=scripts/ccache-env.sh
+source scripts/ccache-env.sh  # the sourcing script is at the repository root
 DEFORM_ASAN_BUILD_DIR="${DEFORM_ASAN_BUILD_DIR:-build-asan}"
 DEFORM_SANITIZER_FLAGS="-fsanitize=address,undefined -fno-sanitize-recover=undefined"
 
