@@ -119,7 +119,7 @@ TEST_F(RigUploadTest, RigidWeightToleranceChoosesTheRigidZonesOfGivenWeights) {
   StartServer();
   auto phantom = MakeKneePhantom(600);
   ASSERT_TRUE(phantom.ok());
-  const auto [weights, csv] = PhantomWeights(*phantom);
+  const std::string csv = PhantomWeights(*phantom).second;
   const std::string obj_path = ::testing::TempDir() + "/rig_tolerance.obj";
   ASSERT_TRUE(WriteMeshFile(phantom->mesh, obj_path).ok());
   std::ifstream obj_file(obj_path);
