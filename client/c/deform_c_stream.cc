@@ -139,9 +139,14 @@ deform_status deform_stream_open(deform_client* client, const char* mesh_id,
         Missing(out, fn, "out", &status)) {
       return status;
     }
-    if (encoding < DEFORM_ENCODING_FLOAT32 || encoding > DEFORM_ENCODING_PREDICTED) {
+    // A C caller may pass any int; in C++ loading an enum outside its values is undefined, so
+    // the value is checked as the int it was passed as (its bytes), before it is used as an enum.
+    static_assert(sizeof(deform_encoding) == sizeof(int), "a C enum is passed as an int");
+    int raw_encoding = 0;
+    std::memcpy(&raw_encoding, &encoding, sizeof raw_encoding);
+    if (raw_encoding < DEFORM_ENCODING_FLOAT32 || raw_encoding > DEFORM_ENCODING_PREDICTED) {
       return Fail(DEFORM_INVALID_ARGUMENT, "deform_stream_open: unknown encoding " +
-                                               std::to_string(static_cast<int>(encoding)) +
+                                               std::to_string(raw_encoding) +
                                                " (1 float32, 2 quantized, 3 predicted)");
     }
     // The mesh's existence and vertex count now, rather than as the stream's end later.

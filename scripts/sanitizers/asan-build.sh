@@ -16,7 +16,10 @@ DEFORM_SANITIZER_FLAGS="-fsanitize=address,undefined -fno-sanitize-recover=undef
 configure_asan_build() {
   local launcher=()
   command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
-  cmake -S . -B "$1" -G Ninja -DCMAKE_CXX_COMPILER=clang++ "${launcher[@]}" \
+  # C (the C API's test) with clang too: with gcc, CMake would take gcc's sanitizer runtime among
+  # the C compiler's implicit link libraries, beside clang's (two ASan runtimes in one program).
+  cmake -S . -B "$1" -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_C_COMPILER=clang \
+    -DCMAKE_C_FLAGS="$DEFORM_SANITIZER_FLAGS -fno-omit-frame-pointer" "${launcher[@]}" \
     -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" \
     -DCMAKE_CXX_FLAGS="$DEFORM_SANITIZER_FLAGS -fsanitize=fuzzer-no-link -fno-omit-frame-pointer" \
     -DCMAKE_EXE_LINKER_FLAGS="$DEFORM_SANITIZER_FLAGS" \
