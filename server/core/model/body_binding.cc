@@ -22,10 +22,10 @@ NearestBone MeasureToBone(const Skeleton& skeleton, int bone, const Eigen::Vecto
 // A vertex whose closest point on `seen` is the bone's head lies behind the joint the bone turns
 // about, on its parent's side: it follows the parent bone (and so on up the chain) when it sees the
 // parent through the body: the segment to the parent's closest point enters the body (against the
-// vertex's outward normal), crosses no surface, and is at most kParentSideReach times as long as the
-// one to the head. Without this, skin above a hip whose thigh hangs from a short pelvis
-// segment some way off (an explicit parent, RIGS.md) is closer to the thigh's head than to the
-// pelvis and follows the thigh: the flank then tears away from the belly when the hip bends.
+// vertex's outward normal), crosses no surface, and is at most kParentSideReach times as long as
+// the one to the head. Without this, skin above a hip whose thigh hangs from a short pelvis segment
+// some way off (an explicit parent, RIGS.md) is closer to the thigh's head than to the pelvis and
+// follows the thigh: the flank then tears away from the belly when the hip bends.
 constexpr double kParentSideReach = 2.0;
 
 NearestBone OnTheParentSide(const Skeleton& skeleton, const TriangleBvh& bvh,
@@ -51,9 +51,8 @@ NearestBone OnTheParentSide(const Skeleton& skeleton, const TriangleBvh& bvh,
 // The first of the vertex's nearest bones whose closest point it sees through the body, or a
 // NearestBone with bone -1.
 NearestBone FirstVisibleBone(const Skeleton& skeleton, const TriangleBvh& bvh,
-                             const Eigen::Vector3d& p, const Eigen::Vector3d& outward,
-                             int vertex, int max_candidates,
-                             double distance_ratio, double margin,
+                             const Eigen::Vector3d& p, const Eigen::Vector3d& outward, int vertex,
+                             int max_candidates, double distance_ratio, double margin,
                              std::vector<NearestBone>* candidates, int* tested) {
   candidates->clear();
   for (int k = 0; k < skeleton.num_bones(); ++k) {
@@ -129,10 +128,9 @@ BodyBinding BindThroughBody(const TriangleMesh& mesh, const Skeleton& skeleton,
   std::vector<NearestBone> candidates;
   const Positions outward = OutwardVertexNormals(mesh);
   for (int i = 0; i < n; ++i) {
-    const NearestBone visible =
-        FirstVisibleBone(skeleton, bvh, mesh.vertices.row(i).transpose(),
-                         outward.row(i).transpose(), i, max_candidates,
-                         distance_ratio, margin, &candidates, &result.candidates_tested);
+    const NearestBone visible = FirstVisibleBone(
+        skeleton, bvh, mesh.vertices.row(i).transpose(), outward.row(i).transpose(), i,
+        max_candidates, distance_ratio, margin, &candidates, &result.candidates_tested);
     bone[i] = visible.bone;
     if (visible.bone >= 0) ++result.seen_through_body;
   }

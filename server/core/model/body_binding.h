@@ -5,7 +5,10 @@
 // vertex excepted). Vertices that see no bone that way (thin flaps such as ears, whose every
 // segment leaves and re-enters the skin) take the bone of the nearest bound vertex along the
 // surface (shortest path over mesh edges). Only a connected piece of the mesh in which no vertex
-// sees any bone falls back to the straight-line nearest bone. Straight-line nearest alone would
+// sees any bone falls back to the straight-line nearest bone. A vertex whose closest point on the
+// bone it sees is that bone's head (it lies behind the joint, on the parent's side) follows the
+// parent bone instead where it sees the parent through the body, at most twice as far (a flank
+// above a hip whose thigh hangs from a pelvis segment some way off belongs to the pelvis). Straight-line nearest alone would
 // bind an ear lying beside a hand to the hand bones, a finger to its neighbour's bone.
 #pragma once
 
