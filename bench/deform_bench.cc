@@ -140,6 +140,45 @@ void BM_TriangularSolve(benchmark::State& state, BenchMesh mesh, SolveKernel ker
   ReportAgainstBound(state, factor.bytes(), seconds);
 }
 
+// `frames` frames' two triangular passes in one batch (CholeskyFactor::SolveMany over 3 * frames
+// columns), the right-hand sides those of the benchmark pose. Besides the counters of the other
+// solves (median_ms and the bounds are per batch): frame_ms, the median per frame;
+// unbatched_frame_ms, Solve3's median on the same right-hand side timed in the same benchmark;
+// x_unbatched, their ratio; frame_bound_ms and frame_cache_bound_ms, the bounds per frame.
+void BM_BatchedSolve(benchmark::State& state, BenchMesh mesh, int frames_per_batch) {
+  auto frames = SetUpFrames(state, mesh);
+  if (!frames) return;
+  const CholeskyFactor& factor = frames->factorization->factor();
+  DeformScratch& scratch = frames->scratch;
+  frames->model->AssembleRightHandSide(*frames->factorization, frames->pose, &scratch);
+  const auto rhs = scratch.solution;
+  const int columns = 3 * frames_per_batch;
+  const Eigen::Index n = rhs.rows();
+  std::vector<double> batch(static_cast<std::size_t>(n) * columns), solved(batch.size());
+  for (Eigen::Index i = 0; i < n; ++i) {
+    for (int c = 0; c < columns; ++c) batch[i * columns + c] = rhs(i, c % 3);
+  }
+  std::vector<double> work(factor.WorkSizeMany(columns));
+  const auto seconds = TimeEach(state, [&] {
+    benchmark::DoNotOptimize(factor.SolveMany(batch.data(), solved.data(), columns, work.data()));
+  });
+  std::vector<double> unbatched;
+  for (std::size_t run = 0; run < std::max<std::size_t>(seconds.size(), 20); ++run) {
+    const auto start = Clock::now();
+    benchmark::DoNotOptimize(
+        factor.Solve3(rhs.data(), scratch.solution.data(), scratch.solve_work.data()));
+    unbatched.push_back(std::chrono::duration<double>(Clock::now() - start).count());
+  }
+  ReportAgainstBound(state, factor.bytes(), seconds);
+  const double frame_ms = Median(seconds) * 1e3 / frames_per_batch;
+  state.counters["frames"] = frames_per_batch;
+  state.counters["frame_ms"] = frame_ms;
+  state.counters["unbatched_frame_ms"] = Median(unbatched) * 1e3;
+  state.counters["x_unbatched"] = frame_ms / (Median(unbatched) * 1e3);
+  state.counters["frame_bound_ms"] = state.counters["bound_ms"] / frames_per_batch;
+  state.counters["frame_cache_bound_ms"] = state.counters["cache_bound_ms"] / frames_per_batch;
+}
+
 // The right-hand side alone: kinematics, rotation blend and the product with L'^T.
 void BM_RightHandSide(benchmark::State& state, BenchMesh mesh) {
   auto frames = SetUpFrames(state, mesh);
@@ -218,6 +257,10 @@ void RegisterBenchmarks(const BenchMesh& mesh) {
   RegisterFor(mesh, "TriangularSolve", BM_TriangularSolve, BestSolveKernel())->MinTime(1.0);
   if (BestSolveKernel() != SolveKernel::kBaseline) {
     RegisterFor(mesh, "TriangularSolveBaselineKernel", BM_TriangularSolve, SolveKernel::kBaseline)
+        ->MinTime(1.0);
+  }
+  for (const int frames : {1, 2, 4, 8, 16}) {
+    RegisterFor(mesh, "BatchedSolve/frames:" + std::to_string(frames), BM_BatchedSolve, frames)
         ->MinTime(1.0);
   }
   RegisterFor(mesh, "EigenBaselineSolve", BM_EigenBaselineSolve)->MinTime(1.0);

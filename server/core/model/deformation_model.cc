@@ -305,6 +305,53 @@ bool DeformationModel::Deform(const MaterialFactorization& factorization, const 
   return true;
 }
 
+DeformBatchScratch DeformationModel::MakeBatchScratch(int max_frames) const {
+  DeformBatchScratch batch;
+  batch.model_id_ = id_;
+  batch.max_frames = std::clamp(max_frames, 1, kMaxBatchFrames);
+  const int columns = 3 * batch.max_frames;
+  batch.columns.resize(static_cast<std::size_t>(mesh_.num_vertices() + system_.num_nodes) *
+                       columns);
+  batch.solve_work.resize(default_factorization_->factor().WorkSizeMany(columns));
+  return batch;
+}
+
+bool DeformationModel::DeformBatch(const MaterialFactorization& factorization,
+                                   const Pose* const* poses, DeformScratch* const* scratches,
+                                   int count, DeformBatchScratch* batch) const {
+  const bool valid = count >= 1 && count <= batch->max_frames && batch->model_id_ == id_;
+  assert(valid && "a batch of another model or of a size its scratch does not hold");
+  if (!valid) return false;
+  for (int f = 0; f < count; ++f) {
+    if (RefusesForeign(factorization, *scratches[f])) return false;
+  }
+  if (factorization.linear_response() != nullptr || count == 1) {
+    for (int f = 0; f < count; ++f) Deform(factorization, *poses[f], scratches[f]);
+    return true;
+  }
+  const Eigen::Index rows = mesh_.num_vertices() + system_.num_nodes;
+  const int columns = 3 * count;
+  double* packed = batch->columns.data();
+  for (int f = 0; f < count; ++f) {
+    AssembleOwnedRightHandSide(factorization, *poses[f], scratches[f]);
+    const double* rhs = scratches[f]->solution.data();
+    for (Eigen::Index i = 0; i < rows; ++i) {
+      for (int c = 0; c < 3; ++c) packed[i * columns + 3 * f + c] = rhs[3 * i + c];
+    }
+  }
+  const Status solved =
+      factorization.factor().SolveMany(packed, packed, columns, batch->solve_work.data());
+  assert(solved.ok());
+  (void)solved;
+  for (int f = 0; f < count; ++f) {
+    double* x = scratches[f]->solution.data();
+    for (Eigen::Index i = 0; i < rows; ++i) {
+      for (int c = 0; c < 3; ++c) x[3 * i + c] = packed[i * columns + 3 * f + c];
+    }
+  }
+  return true;
+}
+
 bool DeformationModel::AssembleRightHandSide(const MaterialFactorization& factorization,
                                              const Pose& pose, DeformScratch* scratch) const {
   if (RefusesForeign(factorization, *scratch)) return false;

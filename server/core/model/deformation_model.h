@@ -86,6 +86,18 @@ struct DeformScratch {
   std::uint64_t model_id_ = 0;  // the model that made it; 0 for a default-constructed scratch
 };
 
+// Buffers for DeformationModel::DeformBatch(): the batch's right-hand sides side by side and the
+// batched solve's work. Create with MakeBatchScratch(); one per caller that batches (a worker).
+struct DeformBatchScratch {
+  int max_frames = 0;
+  std::vector<double> columns;     // (n + m) rows of 3 * max_frames
+  std::vector<double> solve_work;  // CholeskyFactor::WorkSizeMany(3 * max_frames)
+
+ private:
+  friend class DeformationModel;
+  std::uint64_t model_id_ = 0;
+};
+
 // Wall-clock split of one Deform() call, in seconds.
 struct DeformTimings {
   double right_hand_side = 0;  // forward kinematics, rotation blend, A^T b
@@ -164,6 +176,20 @@ class DeformationModel {
   // `timings`; debug builds assert, as for any programmer error. Returns true otherwise.
   bool Deform(const MaterialFactorization& factorization, const Pose& pose, DeformScratch* scratch,
               DeformTimings* timings = nullptr) const;
+
+  // Frames solved together at most: three columns each, CholeskyFactor::SolveMany's limit.
+  static constexpr int kMaxBatchFrames = kMaxSolveColumns / 3;
+  // A batch scratch for up to `max_frames` frames, clamped to [1, kMaxBatchFrames].
+  DeformBatchScratch MakeBatchScratch(int max_frames) const;
+  // Deforms `count` frames at once, frame f's poses[f] into scratches[f] (distinct scratches of
+  // this model): each right-hand side is assembled as Deform() does, then all are solved in one
+  // pass over the factor, so the factor's bytes are read once for the batch. Each frame equals
+  // Deform()'s to round-off (1e-12 of the diagonal, tested). With a linear response there is no
+  // solve to share and each frame is evaluated alone. No allocation. Refuses (false, nothing
+  // written) a count outside [1, batch->max_frames], another model's factorisation, scratch or
+  // batch scratch, as Deform() does.
+  bool DeformBatch(const MaterialFactorization& factorization, const Pose* const* poses,
+                   DeformScratch* const* scratches, int count, DeformBatchScratch* batch) const;
 
   // The two halves of the solving path of Deform(), for tests and diagnostics (they never use the
   // linear response). AssembleRightHandSide writes A^T b ((n + m) by 3) into scratch->solution;

@@ -132,6 +132,26 @@ Status CholeskyFactor::Solve3(const double* b, double* x, double* work, SolveKer
   return Status::Ok();
 }
 
+std::size_t CholeskyFactor::WorkSizeMany(int columns) const {
+  return symbolic_ ? static_cast<std::size_t>(SolveManyWorkSize(symbolic_->n_, columns)) : 0;
+}
+
+Status CholeskyFactor::SolveMany(const double* b, double* x, int columns, double* work) const {
+  return SolveMany(b, x, columns, work, BestSolveKernel());
+}
+
+Status CholeskyFactor::SolveMany(const double* b, double* x, int columns, double* work,
+                                 SolveKernel kernel) const {
+  if (!symbolic_) return Status::FailedPrecondition("the Cholesky factor is empty");
+  if (columns < 1 || columns > kMaxSolveColumns) {
+    return Status::InvalidArgument("a batched solve takes 1 to " +
+                                   std::to_string(kMaxSolveColumns) + " columns, not " +
+                                   std::to_string(columns));
+  }
+  SolveManyFor(kernel)(View(), b, x, columns, work);
+  return Status::Ok();
+}
+
 SupernodalFactorView CholeskyFactor::View() const {
   const SymbolicCholesky& s = *symbolic_;
   SupernodalFactorView view;

@@ -40,6 +40,14 @@ class CholeskyFactor {
   Status Solve3(const double* b, double* x, double* work) const;
   // The same with a chosen kernel, which must be available (for tests and benchmarks).
   Status Solve3(const double* b, double* x, double* work, SolveKernel kernel) const;
+  // Solves A X = B for `columns` (1 to kMaxSolveColumns) right-hand sides stored by rows:
+  // b[columns * i + c]; several frames' three coordinates side by side, solved in one pass over
+  // the factor. `x` may equal `b`; `work` holds WorkSizeMany(columns) doubles. Allocation-free;
+  // const and thread-safe. Each column matches Solve3's to round-off. FAILED_PRECONDITION for an
+  // empty factor, INVALID_ARGUMENT for a column count out of range, nothing written either way.
+  Status SolveMany(const double* b, double* x, int columns, double* work) const;
+  Status SolveMany(const double* b, double* x, int columns, double* work, SolveKernel kernel) const;
+  std::size_t WorkSizeMany(int columns) const;
   // Doubles of scratch Solve3 needs (SolveWorkSize: a four-double row per unknown plus room for
   // the widest supernode). The same for every factor of one symbolic analysis.
   std::size_t WorkSize() const;

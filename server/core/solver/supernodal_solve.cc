@@ -4,8 +4,12 @@ namespace deform {
 
 // Defined in supernodal_solve_baseline.cc and, where built, supernodal_solve_avx2.cc.
 void Solve3Baseline(const SupernodalFactorView& factor, const double* b, double* x, double* work);
+void SolveManyBaseline(const SupernodalFactorView& factor, const double* b, double* x, int columns,
+                       double* work);
 #if defined(DEFORM_HAVE_AVX2_KERNEL)
 void Solve3Avx2Fma(const SupernodalFactorView& factor, const double* b, double* x, double* work);
+void SolveManyAvx2Fma(const SupernodalFactorView& factor, const double* b, double* x, int columns,
+                      double* work);
 #endif
 
 const char* SolveKernelName(SolveKernel kernel) {
@@ -46,6 +50,14 @@ Solve3Function Solve3For(SolveKernel kernel) {
 #endif
   (void)kernel;
   return &Solve3Baseline;
+}
+
+SolveManyFunction SolveManyFor(SolveKernel kernel) {
+#if defined(DEFORM_HAVE_AVX2_KERNEL)
+  if (kernel == SolveKernel::kAvx2Fma) return &SolveManyAvx2Fma;
+#endif
+  (void)kernel;
+  return &SolveManyBaseline;
 }
 
 }  // namespace deform

@@ -38,6 +38,17 @@ inline std::int64_t SolveWorkSize(int size, int widest_supernode) {
 using Solve3Function = void (*)(const SupernodalFactorView& factor, const double* b, double* x,
                                 double* work);
 
+// Solves P^T L L^T P X = B for `columns` right-hand sides (1 to kMaxSolveColumns) stored by rows:
+// b[columns * i + c]. `x` may equal `b`; `work` holds SolveManyWorkSize() doubles. One pass over
+// the factor per direction for all the columns; allocates nothing. Each column's result equals
+// Solve3's for that column to round-off (the sums run in another order).
+inline constexpr int kMaxSolveColumns = 48;  // sixteen frames of three coordinates
+inline std::int64_t SolveManyWorkSize(int size, int columns) {
+  return 4 * ((static_cast<std::int64_t>(columns) + 3) / 4) * size + 4;
+}
+using SolveManyFunction = void (*)(const SupernodalFactorView& factor, const double* b, double* x,
+                                   int columns, double* work);
+
 enum class SolveKernel {
   kBaseline,  // any CPU the project builds for
   kAvx2Fma,   // x86-64 with AVX2 and FMA (checked at run time)
@@ -50,5 +61,6 @@ bool SolveKernelAvailable(SolveKernel kernel);
 SolveKernel BestSolveKernel();
 // The kernel's function; it must be available.
 Solve3Function Solve3For(SolveKernel kernel);
+SolveManyFunction SolveManyFor(SolveKernel kernel);
 
 }  // namespace deform

@@ -186,6 +186,57 @@ TEST_P(SolveKernelTest, MatchesDenseCholeskyOnEveryShape) {
   }
 }
 
+// The batched solve: every column count from 1 to kMaxSolveColumns (every padding of the last
+// four-wide vector) gives, frame by frame, Solve3's answer for that frame's three columns to 1e-12
+// of its norm, on every supernode shape; `x` may alias `b`.
+TEST_P(SolveKernelTest, ManyColumnsMatchThreeAtATime) {
+  if (!SolveKernelAvailable(GetParam())) {
+    GTEST_SKIP() << SolveKernelName(GetParam()) << " is not available on this build or CPU";
+  }
+  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  for (const int n : {1, 2, 5, 7, 37, 301, 303}) {
+    for (const Ordering ordering : {Ordering::kNatural, Ordering::kMetis}) {
+      const ColMajorMatrix a = RandomSpdMatrix(n, 4, 200 + n);
+      auto symbolic = SymbolicCholesky::Analyze(a, ordering);
+      ASSERT_TRUE(symbolic.ok()) << symbolic.status().ToString();
+      auto factor = CholeskyFactor::Factorize(*symbolic, a);
+      ASSERT_TRUE(factor.ok()) << factor.status().ToString();
+      std::vector<double> work3(factor->WorkSize());
+      for (int columns = 1; columns <= kMaxSolveColumns; ++columns) {
+        const RowMajor b = RowMajor::Random(n, columns);
+        RowMajor x(n, columns);
+        std::vector<double> work(factor->WorkSizeMany(columns), std::nan(""));
+        ASSERT_TRUE(factor->SolveMany(b.data(), x.data(), columns, work.data(), GetParam()).ok());
+        RowMajor in_place = b;
+        ASSERT_TRUE(
+            factor->SolveMany(in_place.data(), in_place.data(), columns, work.data(), GetParam())
+                .ok());
+        EXPECT_EQ((in_place - x).norm(), 0) << "columns " << columns;
+        for (int first = 0; first < columns; first += 3) {
+          const int count = std::min(3, columns - first);
+          Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> b3 =
+              Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>::Zero(n, 3);
+          b3.leftCols(count) = b.middleCols(first, count);
+          Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> x3(n, 3);
+          ASSERT_TRUE(factor->Solve3(b3.data(), x3.data(), work3.data(), GetParam()).ok());
+          const double difference = (x.middleCols(first, count) - x3.leftCols(count)).norm();
+          EXPECT_LE(difference, 1e-12 * x3.norm())
+              << "n " << n << ", " << OrderingName(ordering) << ", columns " << columns;
+        }
+      }
+      RowMajor b = RowMajor::Random(n, kMaxSolveColumns + 1);
+      std::vector<double> work(factor->WorkSizeMany(kMaxSolveColumns));
+      EXPECT_EQ(factor->SolveMany(b.data(), b.data(), 0, work.data()).code(),
+                StatusCode::kInvalidArgument);
+      EXPECT_EQ(factor->SolveMany(b.data(), b.data(), kMaxSolveColumns + 1, work.data()).code(),
+                StatusCode::kInvalidArgument);
+    }
+  }
+  std::vector<double> b(3), work(8);
+  EXPECT_EQ(CholeskyFactor().SolveMany(b.data(), b.data(), 3, work.data()).code(),
+            StatusCode::kFailedPrecondition);
+}
+
 INSTANTIATE_TEST_SUITE_P(AllKernels, SolveKernelTest,
                          ::testing::Values(SolveKernel::kBaseline, SolveKernel::kAvx2Fma),
                          [](const auto& info) {

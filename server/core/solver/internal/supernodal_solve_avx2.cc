@@ -8,4 +8,9 @@ void Solve3Avx2Fma(const SupernodalFactorView& factor, const double* b, double* 
   Solve3Impl(factor, b, x, work);
 }
 
+void SolveManyAvx2Fma(const SupernodalFactorView& factor, const double* b, double* x, int columns,
+                      double* work) {
+  SolveManyImpl(factor, b, x, columns, work);
+}
+
 }  // namespace deform

@@ -7,4 +7,9 @@ void Solve3Baseline(const SupernodalFactorView& factor, const double* b, double*
   Solve3Impl(factor, b, x, work);
 }
 
+void SolveManyBaseline(const SupernodalFactorView& factor, const double* b, double* x, int columns,
+                       double* work) {
+  SolveManyImpl(factor, b, x, columns, work);
+}
+
 }  // namespace deform

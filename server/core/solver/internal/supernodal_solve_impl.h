@@ -13,6 +13,7 @@
 // register, or two SSE2 registers on the baseline).
 #include <cstddef>
 #include <cstdint>
+#include <utility>
 
 #include "core/solver/supernodal_solve.h"
 
@@ -70,6 +71,7 @@ struct Vec4 {
 inline Vec4 operator+(Vec4 a, Vec4 b) { return Vec4{a.lo + b.lo, a.hi + b.hi}; }
 inline Vec4 operator-(Vec4 a, Vec4 b) { return Vec4{a.lo - b.lo, a.hi - b.hi}; }
 inline Vec4 operator*(Vec4 a, Vec4 b) { return Vec4{a.lo * b.lo, a.hi * b.hi}; }
+inline Vec4 operator/(Vec4 a, Vec4 b) { return Vec4{a.lo / b.lo, a.hi / b.hi}; }
 inline Vec4& operator+=(Vec4& a, Vec4 b) { return a = a + b; }
 inline Vec4& operator-=(Vec4& a, Vec4 b) { return a = a - b; }
 
@@ -511,6 +513,120 @@ void Solve3Impl(const SupernodalFactorView& f, const double* b, double* x, doubl
     target[1] = t[1];
     target[2] = t[2];
   }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Many right-hand sides at once (CholeskyFactor::SolveMany): one pass over the factor serves every
+// column, so the factor's bytes are read once per batch instead of once per frame. The solution
+// rows are kVecs four-double vectors wide (columns padded with zeros to a multiple of four), and
+// each factor value multiplies a whole row of them.
+
+// Forward pass of one supernode: its diagonal block solves its own rows (contiguous in y), then
+// every row below subtracts its block row times them.
+template <int kVecs>
+inline void ForwardSupernodeMany(const SupernodeBlock& s, double* __restrict y) {
+  constexpr int kStride = 4 * kVecs;
+  double* __restrict own = y + kStride * static_cast<std::ptrdiff_t>(s.first);
+  const int width = s.width;
+  for (int c = 0; c < width; ++c) {
+    const double* row = s.values + static_cast<std::ptrdiff_t>(c) * width;
+    Vec4 sum[kVecs];
+    double* target = own + kStride * c;
+    for (int j = 0; j < kVecs; ++j) sum[j] = Load4(target + 4 * j);
+    for (int k = 0; k < c; ++k) {
+      const Vec4 l = Splat4(row[k]);
+      const double* known = own + kStride * k;
+      for (int j = 0; j < kVecs; ++j) sum[j] -= l * Load4(known + 4 * j);
+    }
+    const Vec4 pivot = Splat4(row[c]);
+    for (int j = 0; j < kVecs; ++j) Store4(target + 4 * j, sum[j] / pivot);
+  }
+  for (std::int64_t r = width; r < s.num_rows; ++r) {
+    const double* row = s.values + r * width;
+    double* target = y + kStride * static_cast<std::ptrdiff_t>(s.rows[r]);
+    Vec4 sum[kVecs];
+    for (int j = 0; j < kVecs; ++j) sum[j] = Load4(target + 4 * j);
+    for (int k = 0; k < width; ++k) {
+      const Vec4 l = Splat4(row[k]);
+      const double* known = own + kStride * k;
+      for (int j = 0; j < kVecs; ++j) sum[j] -= l * Load4(known + 4 * j);
+    }
+    for (int j = 0; j < kVecs; ++j) Store4(target + 4 * j, sum[j]);
+  }
+}
+
+// Backward pass of one supernode: its own rows subtract the block's rows below times the solved
+// rows there (column by column of the block, the sums kept in registers), then the transposed
+// diagonal block solves them, last row first.
+template <int kVecs>
+inline void BackwardSupernodeMany(const SupernodeBlock& s, double* __restrict y) {
+  constexpr int kStride = 4 * kVecs;
+  double* __restrict own = y + kStride * static_cast<std::ptrdiff_t>(s.first);
+  const int width = s.width;
+  for (int k = 0; k < width; ++k) {
+    Vec4 sum[kVecs];
+    for (int j = 0; j < kVecs; ++j) sum[j] = Splat4(0);
+    for (std::int64_t r = width; r < s.num_rows; ++r) {
+      const Vec4 l = Splat4(s.values[r * width + k]);
+      const double* solved = y + kStride * static_cast<std::ptrdiff_t>(s.rows[r]);
+      for (int j = 0; j < kVecs; ++j) sum[j] += l * Load4(solved + 4 * j);
+    }
+    double* target = own + kStride * k;
+    for (int j = 0; j < kVecs; ++j) Store4(target + 4 * j, Load4(target + 4 * j) - sum[j]);
+  }
+  for (int c = width - 1; c >= 0; --c) {
+    const double* row = s.values + static_cast<std::ptrdiff_t>(c) * width;
+    double* target = own + kStride * c;
+    const Vec4 pivot = Splat4(row[c]);
+    Vec4 solved[kVecs];
+    for (int j = 0; j < kVecs; ++j) {
+      solved[j] = Load4(target + 4 * j) / pivot;
+      Store4(target + 4 * j, solved[j]);
+    }
+    for (int k = 0; k < c; ++k) {
+      const Vec4 l = Splat4(row[k]);
+      double* above = own + kStride * k;
+      for (int j = 0; j < kVecs; ++j) Store4(above + 4 * j, Load4(above + 4 * j) - l * solved[j]);
+    }
+  }
+}
+
+template <int kVecs>
+void SolveManyWithWidth(const SupernodalFactorView& f, const double* b, double* x, int columns,
+                        double* work) {
+  constexpr int kStride = 4 * kVecs;
+  const int n = f.size;
+  const std::uintptr_t misalignment = reinterpret_cast<std::uintptr_t>(work) % 32;
+  double* __restrict y = work + (misalignment ? (32 - misalignment) / sizeof(double) : 0);
+  for (int i = 0; i < n; ++i) {
+    const double* source = b + static_cast<std::ptrdiff_t>(columns) * f.permutation[i];
+    double* t = y + kStride * static_cast<std::ptrdiff_t>(i);
+    int c = 0;
+    for (; c < columns; ++c) t[c] = source[c];
+    for (; c < kStride; ++c) t[c] = 0;
+  }
+  for (int sn = 0; sn < f.num_supernodes; ++sn) ForwardSupernodeMany<kVecs>(BlockOf(f, sn), y);
+  for (int sn = f.num_supernodes - 1; sn >= 0; --sn) {
+    BackwardSupernodeMany<kVecs>(BlockOf(f, sn), y);
+  }
+  for (int i = 0; i < n; ++i) {
+    double* target = x + static_cast<std::ptrdiff_t>(columns) * f.permutation[i];
+    const double* t = y + kStride * static_cast<std::ptrdiff_t>(i);
+    for (int c = 0; c < columns; ++c) target[c] = t[c];
+  }
+}
+
+template <int... kVecs>
+void SolveManyDispatch(const SupernodalFactorView& f, const double* b, double* x, int columns,
+                       double* work, std::integer_sequence<int, kVecs...>) {
+  const int vecs = (columns + 3) / 4;
+  ((vecs == kVecs + 1 ? SolveManyWithWidth<kVecs + 1>(f, b, x, columns, work) : void()), ...);
+}
+
+void SolveManyImpl(const SupernodalFactorView& f, const double* b, double* x, int columns,
+                   double* work) {
+  SolveManyDispatch(f, b, x, columns, work,
+                    std::make_integer_sequence<int, kMaxSolveColumns / 4>());
 }
 
 }  // namespace
