@@ -100,6 +100,12 @@ std::unique_ptr<FrameSetup> SetUpFrames(benchmark::State& state, const BenchMesh
   return setup;
 }
 
+// The benchmark pose's right-hand side A^T b ((n + m) by 3), a copy that the solves keep as input.
+auto AssembledRightHandSide(FrameSetup* frames) {
+  frames->model->AssembleRightHandSide(*frames->factorization, frames->pose, &frames->scratch);
+  return frames->scratch.solution;
+}
+
 // A whole frame: kinematics, rotation blend, right-hand side and both triangular passes.
 void BM_Frame(benchmark::State& state, BenchMesh mesh) {
   auto frames = SetUpFrames(state, mesh);
@@ -131,8 +137,7 @@ void BM_TriangularSolve(benchmark::State& state, BenchMesh mesh, SolveKernel ker
   if (!frames) return;
   const CholeskyFactor& factor = frames->factorization->factor();
   DeformScratch& scratch = frames->scratch;
-  frames->model->AssembleRightHandSide(*frames->factorization, frames->pose, &scratch);
-  const auto rhs = scratch.solution;
+  const auto rhs = AssembledRightHandSide(frames.get());
   const auto seconds = TimeEach(state, [&] {
     benchmark::DoNotOptimize(
         factor.Solve3(rhs.data(), scratch.solution.data(), scratch.solve_work.data(), kernel));
@@ -150,8 +155,7 @@ void BM_BatchedSolve(benchmark::State& state, BenchMesh mesh, int frames_per_bat
   if (!frames) return;
   const CholeskyFactor& factor = frames->factorization->factor();
   DeformScratch& scratch = frames->scratch;
-  frames->model->AssembleRightHandSide(*frames->factorization, frames->pose, &scratch);
-  const auto rhs = scratch.solution;
+  const auto rhs = AssembledRightHandSide(frames.get());
   const int columns = 3 * frames_per_batch;
   const Eigen::Index n = rhs.rows();
   std::vector<double> batch(static_cast<std::size_t>(n) * columns), solved(batch.size());

@@ -8,14 +8,20 @@
 namespace deform {
 namespace {
 
+// The rest position at parameter `nearest.parameter` along bone `nearest.bone`.
+Eigen::Vector3d PointOnBone(const Skeleton& skeleton, const NearestBone& nearest) {
+  const Bone& b = skeleton.bone(nearest.bone);
+  const Eigen::Vector3d head = skeleton.joint(b.head_joint).rest_position;
+  return head + nearest.parameter * (skeleton.joint(b.tail_joint).rest_position - head);
+}
+
 NearestBone MeasureToBone(const Skeleton& skeleton, int bone, const Eigen::Vector3d& p) {
   const Bone& b = skeleton.bone(bone);
-  const Eigen::Vector3d head = skeleton.joint(b.head_joint).rest_position;
-  const Eigen::Vector3d tail = skeleton.joint(b.tail_joint).rest_position;
   NearestBone result;
   result.bone = bone;
-  result.parameter = ClosestSegmentParameter(p, head, tail);
-  result.distance = (head + result.parameter * (tail - head) - p).norm();
+  result.parameter = ClosestSegmentParameter(p, skeleton.joint(b.head_joint).rest_position,
+                                             skeleton.joint(b.tail_joint).rest_position);
+  result.distance = (PointOnBone(skeleton, result) - p).norm();
   return result;
 }
 
@@ -35,11 +41,8 @@ NearestBone OnTheParentSide(const Skeleton& skeleton, const TriangleBvh& bvh,
     const int parent = skeleton.bone(seen.bone).parent_bone;
     if (parent < 0) break;
     const NearestBone candidate = MeasureToBone(skeleton, parent, p);
-    const Bone& b = skeleton.bone(parent);
-    const Eigen::Vector3d head = skeleton.joint(b.head_joint).rest_position;
-    const Eigen::Vector3d target =
-        head + candidate.parameter * (skeleton.joint(b.tail_joint).rest_position - head);
     if (candidate.distance > kParentSideReach * seen.distance) break;
+    const Eigen::Vector3d target = PointOnBone(skeleton, candidate);
     if ((target - p).dot(outward) >= 0) break;
     ++*tested;
     if (bvh.SegmentCrossesSurface(p, target, vertex, margin)) break;
@@ -67,12 +70,8 @@ NearestBone FirstVisibleBone(const Skeleton& skeleton, const TriangleBvh& bvh,
   const double farthest = (*candidates)[0].distance * distance_ratio;
   for (int c = 0; c < count && (*candidates)[c].distance <= farthest; ++c) {
     const NearestBone& candidate = (*candidates)[c];
-    const Bone& b = skeleton.bone(candidate.bone);
-    const Eigen::Vector3d head = skeleton.joint(b.head_joint).rest_position;
-    const Eigen::Vector3d target =
-        head + candidate.parameter * (skeleton.joint(b.tail_joint).rest_position - head);
     ++*tested;
-    if (!bvh.SegmentCrossesSurface(p, target, vertex, margin)) {
+    if (!bvh.SegmentCrossesSurface(p, PointOnBone(skeleton, candidate), vertex, margin)) {
       return OnTheParentSide(skeleton, bvh, p, outward, vertex, margin, candidate, tested);
     }
   }

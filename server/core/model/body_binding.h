@@ -8,8 +8,9 @@
 // sees any bone falls back to the straight-line nearest bone. A vertex whose closest point on the
 // bone it sees is that bone's head (it lies behind the joint, on the parent's side) follows the
 // parent bone instead where it sees the parent through the body, at most twice as far (a flank
-// above a hip whose thigh hangs from a pelvis segment some way off belongs to the pelvis). Straight-line nearest alone would
-// bind an ear lying beside a hand to the hand bones, a finger to its neighbour's bone.
+// above a hip whose thigh hangs from a pelvis segment some way off belongs to the pelvis).
+// Straight-line nearest alone would bind an ear lying beside a hand to the hand bones, a finger to
+// its neighbour's bone.
 #pragma once
 
 #include <vector>

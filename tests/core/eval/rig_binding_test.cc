@@ -56,20 +56,18 @@ double RigidZoneError(const DeformationModel& model, const Frame& frame) {
   return worst / model.bounding_box_diagonal();
 }
 
-// The joint's own bones (those that start or end at it, and the parent that carries a bone
-// starting at it where the skeleton names one that ends elsewhere: a pelvis carrying a thigh) and
-// the descendants of those that start at it: the bones whose vertices may move when `joint` turns.
+// The joint's own bones (those that start or end at it, and the bone that carries it,
+// Skeleton::IncomingBone: where a bone hangs from a parent away from the parent's tail, that
+// parent, a pelvis carrying a thigh) and the descendants of those that start at it: the bones whose
+// vertices may move when `joint` turns.
 std::vector<char> BonesMovedBy(const Skeleton& skeleton, int joint) {
-  std::vector<char> own(skeleton.num_bones(), 0);
-  for (const Bone& bone : skeleton.bones()) {
-    if (bone.head_joint == joint && bone.parent_bone >= 0) own[bone.parent_bone] = 1;
-  }
+  const int carrier = skeleton.IncomingBone(joint);
   std::vector<char> moved(skeleton.num_bones(), 0);
   for (int k : skeleton.BonesParentsFirst()) {
     const Bone& bone = skeleton.bone(k);
-    moved[k] = own[k] || bone.head_joint == joint || bone.tail_joint == joint ||
+    moved[k] = k == carrier || bone.head_joint == joint || bone.tail_joint == joint ||
                (bone.parent_bone >= 0 && moved[bone.parent_bone] &&
-                skeleton.bone(bone.parent_bone).tail_joint != joint && !own[bone.parent_bone]);
+                skeleton.bone(bone.parent_bone).tail_joint != joint && bone.parent_bone != carrier);
   }
   return moved;
 }

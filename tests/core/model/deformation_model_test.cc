@@ -157,6 +157,14 @@ TEST(DeformationModel, RefusesAFactorisationOrScratchOfAnotherModel) {
   EXPECT_EQ(scratch.positions(), foreign_scratch.positions());
 }
 
+// DeformBatch's arguments: a pointer to each element, as Element* (const or not).
+template <typename Element, typename Container>
+std::vector<Element*> PointersTo(Container& elements) {
+  std::vector<Element*> pointers;
+  for (auto& element : elements) pointers.push_back(&element);
+  return pointers;
+}
+
 // Frames solved in one batch (one pass over the factor for all their columns) equal the frames
 // solved one by one to 1e-12 of the diagonal, for every batch size up to the largest, with
 // different poses in one batch and with nothing allocated per batch.
@@ -172,12 +180,8 @@ TEST(DeformationModel, ABatchOfFramesEqualsTheFramesSolvedOneByOne) {
   }
   std::vector<DeformScratch> scratches;
   for (int f = 0; f < most; ++f) scratches.push_back(model->MakeScratch());
-  std::vector<const Pose*> pose_pointers;
-  std::vector<DeformScratch*> scratch_pointers;
-  for (int f = 0; f < most; ++f) {
-    pose_pointers.push_back(&poses[f]);
-    scratch_pointers.push_back(&scratches[f]);
-  }
+  const std::vector<const Pose*> pose_pointers = PointersTo<const Pose>(poses);
+  const std::vector<DeformScratch*> scratch_pointers = PointersTo<DeformScratch>(scratches);
   DeformBatchScratch batch = model->MakeBatchScratch(most);
   EXPECT_EQ(batch.max_frames, most);
   const double tolerance = 1e-12 * model->bounding_box_diagonal();
@@ -216,12 +220,8 @@ TEST(DeformationModel, ABatchOnTheSharedLegEqualsTheFramesSolvedOneByOne) {
     poses.push_back(PoseFromSpec(model->skeleton(), "1:x:" + std::to_string(15 * f)));
     scratches.push_back(model->MakeScratch());
   }
-  std::vector<const Pose*> pose_pointers;
-  std::vector<DeformScratch*> scratch_pointers;
-  for (int f = 0; f < count; ++f) {
-    pose_pointers.push_back(&poses[f]);
-    scratch_pointers.push_back(&scratches[f]);
-  }
+  const std::vector<const Pose*> pose_pointers = PointersTo<const Pose>(poses);
+  const std::vector<DeformScratch*> scratch_pointers = PointersTo<DeformScratch>(scratches);
   DeformBatchScratch batch = model->MakeBatchScratch(count);
   ASSERT_TRUE(model->DeformBatch(factorization, pose_pointers.data(), scratch_pointers.data(),
                                  count, &batch));
