@@ -1,6 +1,7 @@
 // deformd: the real-time deformation server.
 //
-//   deformd [--listen ADDR] [--workers N] [--max-vertices N] [--max-meshes N] [--max-memory-mb N]
+//   deformd [--listen ADDR] [--workers N] [--batch-frames N] [--max-vertices N] [--max-meshes N]
+//   [--max-memory-mb N]
 //           [--max-message-mb N] [--max-upload-mb N] [--log-level LEVEL]
 //           [--preload MESH:SKELETON]... [--preload-phantom N]... [--shutdown-grace-s S]
 //           [--keepalive-s S] [--keepalive-timeout-s S] [--idle-timeout-s S]
@@ -186,6 +187,11 @@ int main(int argc, char** argv) {
                  "Worker threads for solves and precomputation; 0 = one per core")
       ->capture_default_str()
       ->check(CLI::Range(0, 1024));
+  app.add_option("--batch-frames", args.server.batch_frames,
+                 "Frames of streams on one mesh solved in one pass over its factor, at most; 1 = "
+                 "each alone")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 16));
   app.add_option("--max-vertices", args.server.limits.max_vertices, "Largest mesh, in vertices")
       ->capture_default_str();
   app.add_option("--max-meshes", args.server.limits.max_meshes, "Meshes loaded at once")

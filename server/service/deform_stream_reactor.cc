@@ -2,6 +2,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include <array>
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <memory>
@@ -25,6 +27,7 @@
 #include "service/stiffness_switch.h"
 #include "service/stream_write_pump.h"
 #include "service/thread_annotations.h"
+#include "service/worker_pool.h"
 
 namespace deform::service {
 namespace {
@@ -43,8 +46,7 @@ void CountWritten(const v1::DeformResponse& message, ServiceMetrics* metrics) {
   const double server_ms = t.queue_ms() + t.rhs_ms() + t.solve_ms() + t.encode_ms();
   const int encoding =
       frame.has_encoded() ? frame.encoded().encoding() : v1::FRAME_ENCODING_FLOAT32;
-  metrics->FrameWritten(encoding, message.ByteSizeLong(), server_ms * 1e-3,
-                        frame.skipped_poses());
+  metrics->FrameWritten(encoding, message.ByteSizeLong(), server_ms * 1e-3, frame.skipped_poses());
 }
 
 // The reactor coordinates the stream's parts; each part states its own contract:
@@ -86,8 +88,22 @@ class DeformStreamReactor final : public StreamHandler,
   // sends without reading); WriteCompleted resumes once it has drained.
   void ReadNextLocked() DEFORM_REQUIRES(mutex_);
 
-  // UrgentTask: one solve on a worker.
+  // UrgentTask: the stream's solve on a worker, alone or batched with other streams' on the same
+  // factorisation (the pool gathers streams whose BatchKey, their factorisation, is the same).
   void RunUrgent() DEFORM_EXCLUDES(mutex_) override;
+  void RunUrgentBatch(UrgentTask* const* others, int count) DEFORM_EXCLUDES(mutex_) override;
+  const void* BatchKey() const override { return batch_key_.load(std::memory_order_relaxed); }
+  // A run's steps for one stream: BeginSolveRun takes the pending pose into solving_ with its
+  // factorisation, stamp and frame (false: nothing to solve); RejectSolvingPose answers a pose the
+  // solver refused with a notice; EndSolveRun publishes the frame (`produced`), switches in a
+  // finished refactorisation and ends the run, posting the task again when a pose is pending.
+  // Every BeginSolveRun is followed by one EndSolveRun.
+  bool BeginSolveRun() DEFORM_EXCLUDES(mutex_);
+  void RejectSolvingPose(const Status& status) DEFORM_EXCLUDES(mutex_);
+  void EndSolveRun(bool produced) DEFORM_EXCLUDES(mutex_);
+  // The batch key of the stream's current factorisation: itself, or null (never batched) when it
+  // evaluates a linear response, which shares nothing.
+  void UpdateBatchKeyLocked() DEFORM_REQUIRES(mutex_);
   // Drainable.
   void Drain() DEFORM_EXCLUDES(mutex_) override;
 
@@ -132,6 +148,11 @@ class DeformStreamReactor final : public StreamHandler,
   std::optional<FrameSolver> solver_;  // emplaced by HandleStart
   PoseInput solving_;
   std::shared_ptr<const MaterialFactorization> solve_factorization_;
+  FrameStamp solve_stamp_;
+  v1::DeformFrame* solve_frame_ = nullptr;
+
+  // The current factorisation as the worker pool's batch key (BatchKey), written under mutex_.
+  std::atomic<const void*> batch_key_{nullptr};
 
   Mutex mutex_;
   PendingPoseSlot poses_ DEFORM_GUARDED_BY(mutex_);
@@ -253,6 +274,7 @@ void DeformStreamReactor::HandleStart() {
 
   MutexLock lock(&mutex_);
   stiffness_.Reset(model_->default_factorization());
+  UpdateBatchKeyLocked();
   outbox_.AllocateFrames(entry_->client_vertex_count(), encoded_bytes, transform_floats);
   if (!pump_.finish_requested()) StartRead(&request_);
 }
@@ -335,9 +357,9 @@ void DeformStreamReactor::StartRefactorLocked(StiffnessSwitch::Update update) {
   if (!held.ok()) {
     spdlog::info("{} stiffness version {} rejected: {}", log_context_, update.version,
                  held.message());
-    outbox_.AddNotice(v1::Notice::KIND_STIFFNESS_REJECTED, 0, update.version,
-                      "stiffness version " + std::to_string(update.version) + ": " +
-                          held.message());
+    outbox_.AddNotice(
+        v1::Notice::KIND_STIFFNESS_REJECTED, 0, update.version,
+        "stiffness version " + std::to_string(update.version) + ": " + held.message());
     return;
   }
   stiffness_.RefactorStarted();
@@ -386,8 +408,15 @@ void DeformStreamReactor::Refactor(const StiffnessSwitch::Update& update) {
   pump_.Pump();
 }
 
+void DeformStreamReactor::UpdateBatchKeyLocked() {
+  const MaterialFactorization* current = stiffness_.current().get();
+  batch_key_.store(current->linear_response() != nullptr ? nullptr : current,
+                   std::memory_order_relaxed);
+}
+
 void DeformStreamReactor::ApplyNextFactorizationLocked() {
   const std::uint64_t version = stiffness_.ApplyNext();
+  UpdateBatchKeyLocked();
   const double factor_ms = stiffness_.current()->factor_seconds() * 1e3;
   spdlog::info("{} stiffness version {} applied (factorisation {:.2f} ms)", log_context_, version,
                factor_ms);
@@ -397,30 +426,81 @@ void DeformStreamReactor::ApplyNextFactorizationLocked() {
   (void)HoldFactorizationsLocked(stiffness_.refactor_running() ? 1 : 0, "");  // shrinks only
 }
 
-void DeformStreamReactor::RunUrgent() {
-  MutexLock lock(&mutex_);
-  poses_.BeginRun();
-  std::optional<std::uint64_t> skipped;
-  if (!pump_.failing()) skipped = poses_.Take(&solving_);
-  bool produced = false;
-  if (skipped.has_value()) {
-    // The factorisation cannot change until EndRun(): ApplyNext waits for the end of the run.
-    solve_factorization_ = stiffness_.current();
-    FrameStamp stamp;
-    stamp.stiffness_version = stiffness_.current_version();
-    stamp.skipped_poses = *skipped;
-    stamp.mesh_unloaded = entry_->unloaded.load(std::memory_order_relaxed);
-    v1::DeformFrame* frame = outbox_.working_frame()->mutable_frame();
-    lock.Unlock();  // no lock across the solve
-    const Status solved = solver_->Solve(solving_, *solve_factorization_, stamp, frame);
-    lock.Lock();
-    produced = solved.ok();
-    if (!solved.ok()) {
-      outbox_.AddNotice(v1::Notice::KIND_POSE_REJECTED, solving_.sequence,
-                        stiffness_.current_version(),
-                        "pose " + std::to_string(solving_.sequence) + ": " + solved.message());
+void DeformStreamReactor::RunUrgent() { RunUrgentBatch(nullptr, 0); }
+
+void DeformStreamReactor::RunUrgentBatch(UrgentTask* const* others, int count) {
+  // The members: this stream and the others (all DeformStreamReactors: only they have keys).
+  std::array<DeformStreamReactor*, WorkerPool::kMaxBatch> members;
+  int size = 0;
+  members[size++] = this;
+  for (int i = 0; i < count && size < WorkerPool::kMaxBatch; ++i) {
+    members[size++] = static_cast<DeformStreamReactor*>(others[i]);
+  }
+  // Each member's run begins; those with a pose that converts get solved.
+  std::array<DeformStreamReactor*, WorkerPool::kMaxBatch> solving;
+  int to_solve = 0;
+  for (int i = 0; i < size; ++i) {
+    DeformStreamReactor* member = members[i];
+    if (!member->BeginSolveRun()) {
+      member->EndSolveRun(false);
+    } else if (const Status prepared = member->solver_->Prepare(member->solving_); !prepared.ok()) {
+      member->RejectSolvingPose(prepared);
+      member->EndSolveRun(false);
+    } else {
+      solving[to_solve++] = member;
     }
   }
+  // Grouped by factorisation (a member's may have changed since the pool read its key); each group
+  // in one pass, its frames then finished and published one by one.
+  std::array<FrameSolver*, WorkerPool::kMaxBatch> solvers;
+  std::array<DeformStreamReactor*, WorkerPool::kMaxBatch> group;
+  while (to_solve > 0) {
+    const MaterialFactorization* factorization = solving[0]->solve_factorization_.get();
+    int in_group = 0;
+    int rest = 0;
+    for (int i = 0; i < to_solve; ++i) {
+      if (solving[i]->solve_factorization_.get() == factorization) {
+        group[in_group] = solving[i];
+        solvers[in_group++] = &*solving[i]->solver_;
+      } else {
+        solving[rest++] = solving[i];
+      }
+    }
+    to_solve = rest;
+    const FrameSolver::Deformed deformed = FrameSolver::DeformPrepared(
+        *factorization, solvers.data(), in_group, group[0]->entry_->batch_scratches.get());
+    for (int i = 0; i < in_group; ++i) {
+      DeformStreamReactor* member = group[i];
+      member->solver_->Finish(member->solving_, deformed, member->solve_stamp_,
+                              member->solve_frame_);
+      member->EndSolveRun(true);
+    }
+  }
+}
+
+bool DeformStreamReactor::BeginSolveRun() {
+  MutexLock lock(&mutex_);
+  poses_.BeginRun();
+  if (pump_.failing()) return false;
+  const std::optional<std::uint64_t> skipped = poses_.Take(&solving_);
+  if (!skipped.has_value()) return false;
+  // The factorisation cannot change until EndRun(): ApplyNext waits for the end of the run.
+  solve_factorization_ = stiffness_.current();
+  solve_stamp_.stiffness_version = stiffness_.current_version();
+  solve_stamp_.skipped_poses = *skipped;
+  solve_stamp_.mesh_unloaded = entry_->unloaded.load(std::memory_order_relaxed);
+  solve_frame_ = outbox_.working_frame()->mutable_frame();
+  return true;
+}
+
+void DeformStreamReactor::RejectSolvingPose(const Status& status) {
+  MutexLock lock(&mutex_);
+  outbox_.AddNotice(v1::Notice::KIND_POSE_REJECTED, solving_.sequence, stiffness_.current_version(),
+                    "pose " + std::to_string(solving_.sequence) + ": " + status.message());
+}
+
+void DeformStreamReactor::EndSolveRun(bool produced) {
+  MutexLock lock(&mutex_);
   if (produced && !pump_.failing()) outbox_.PublishFrame();
   if (stiffness_.has_next() && !pump_.failing()) ApplyNextFactorizationLocked();
   const bool post = poses_.EndRun(/*may_continue=*/!pump_.failing());

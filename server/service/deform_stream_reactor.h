@@ -20,7 +20,10 @@
 //    replaces one not yet solved: latest wins, counted in skipped_poses); a stiffness update is
 //    checked and its refactorisation posted to the worker pool in the background.
 //  - The stream is then queued (at most once) on the worker pool's urgent queue. A worker takes
-//    the pending pose, solves it without holding any lock, encodes float32 positions into the
+//    the pending pose (together with the pending poses of other queued streams on the same mesh
+//    and factorisation, up to --batch-frames, which it solves in one pass over the factor: each
+//    stream's frame is the one it would get alone, and no stream waits for others to queue),
+//    solves it without holding any lock, encodes float32 positions into the
 //    stream's own frame message and starts the write itself. At most one write is in flight; a
 //    frame finished while one is in flight waits in a one-frame slot where a newer frame replaces
 //    it (its pose then counts as skipped in the next frame, so that skipped_poses is the number

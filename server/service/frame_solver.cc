@@ -1,6 +1,7 @@
 #include "service/frame_solver.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstddef>
 #include <string>
@@ -59,11 +60,59 @@ void FrameSolver::Encode(v1::DeformFrame* frame) {
 
 Status FrameSolver::Solve(const PoseInput& input, const MaterialFactorization& factorization,
                           const FrameStamp& stamp, v1::DeformFrame* frame) {
-  const Clock::time_point solve_start = Clock::now();
-  DEFORM_ASSIGN_OR_RETURN(const int clamped, PoseFromInput(model_.skeleton(), input, &pose_));
-  DeformTimings timings;
-  model_.Deform(factorization, pose_, &scratch_, &timings);
-  const Clock::time_point encode_start = Clock::now();
+  DEFORM_RETURN_IF_ERROR(Prepare(input));
+  FrameSolver* const self = this;
+  const Deformed deformed = DeformPrepared(factorization, &self, 1, nullptr);
+  Finish(input, deformed, stamp, frame);
+  return Status::Ok();
+}
+
+Status FrameSolver::Prepare(const PoseInput& input) {
+  DEFORM_ASSIGN_OR_RETURN(clamped_, PoseFromInput(model_.skeleton(), input, &pose_));
+  return Status::Ok();
+}
+
+FrameSolver::Deformed FrameSolver::DeformPrepared(const MaterialFactorization& factorization,
+                                                  FrameSolver* const* solvers, int count,
+                                                  const BatchScratchPool* scratches) {
+  Deformed deformed;
+  deformed.start = Clock::now();
+  if (count <= 0) return deformed;
+  const DeformationModel& model = solvers[0]->model_;
+  const BatchScratchPool::Lease lease =
+      count > 1 && scratches != nullptr ? scratches->TryAcquire() : BatchScratchPool::Lease();
+  if (!lease) {
+    for (int i = 0; i < count; ++i) {
+      DeformTimings one;
+      model.Deform(factorization, solvers[i]->pose_, &solvers[i]->scratch_, &one);
+      deformed.timings.right_hand_side += one.right_hand_side;
+      deformed.timings.solve += one.solve;
+    }
+    return deformed;
+  }
+  const int max_frames = lease.get()->max_frames;
+  std::array<const Pose*, DeformationModel::kMaxBatchFrames> poses;
+  std::array<DeformScratch*, DeformationModel::kMaxBatchFrames> buffers;
+  for (int first = 0; first < count; first += max_frames) {
+    const int frames = std::min(max_frames, count - first);
+    for (int f = 0; f < frames; ++f) {
+      poses[f] = &solvers[first + f]->pose_;
+      buffers[f] = &solvers[first + f]->scratch_;
+    }
+    DeformTimings pass;
+    model.DeformBatch(factorization, poses.data(), buffers.data(), frames, lease.get(), &pass);
+    deformed.timings.right_hand_side += pass.right_hand_side;
+    deformed.timings.solve += pass.solve;
+    deformed.batch_frames = std::max(deformed.batch_frames, frames);
+  }
+  return deformed;
+}
+
+void FrameSolver::Finish(const PoseInput& input, const Deformed& deformed, const FrameStamp& stamp,
+                         v1::DeformFrame* frame) {
+  const Clock::time_point solved =
+      deformed.start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
+                           deformed.timings.right_hand_side + deformed.timings.solve));
   const std::size_t client_vertices = client_order_.empty()
                                           ? static_cast<std::size_t>(scratch_.num_vertices)
                                           : client_order_.size();
@@ -78,14 +127,14 @@ Status FrameSolver::Solve(const PoseInput& input, const MaterialFactorization& f
   frame->set_client_timestamp_ns(input.client_timestamp_ns);
   frame->set_stiffness_version(stamp.stiffness_version);
   frame->set_skipped_poses(stamp.skipped_poses);
-  frame->set_clamped_angles(static_cast<std::uint32_t>(clamped));
+  frame->set_clamped_angles(static_cast<std::uint32_t>(clamped_));
   frame->set_mesh_unloaded(stamp.mesh_unloaded);
   v1::FrameTimings* frame_timings = frame->mutable_timings();
-  frame_timings->set_queue_ms(Milliseconds(solve_start - input.arrival));
-  frame_timings->set_rhs_ms(timings.right_hand_side * 1e3);
-  frame_timings->set_solve_ms(timings.solve * 1e3);
-  frame_timings->set_encode_ms(Milliseconds(Clock::now() - encode_start));
-  return Status::Ok();
+  frame_timings->set_queue_ms(Milliseconds(deformed.start - input.arrival));
+  frame_timings->set_rhs_ms(deformed.timings.right_hand_side * 1e3);
+  frame_timings->set_solve_ms(deformed.timings.solve * 1e3);
+  frame_timings->set_encode_ms(std::max(0.0, Milliseconds(Clock::now() - solved)));
+  frame_timings->set_batch_frames(static_cast<std::uint32_t>(deformed.batch_frames));
 }
 
 }  // namespace deform::service

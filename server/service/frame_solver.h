@@ -5,10 +5,14 @@
 // little-endian float32, the pose's sequence and timestamp, the stamp (stiffness version, skipped
 // poses, mesh_unloaded), the clamped angles and the timings (queue time from the pose's arrival).
 //
+// A solve is Prepare (the pose), the deformation (alone, or batched with other streams' solvers on
+// the same factorisation: DeformPrepared), then Finish (the frame); Solve does all three alone.
+//
 // Thread safety: one solve at a time (the stream's solve task owns the solver); no lock is taken
 // or needed. The model must outlive the solver.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <memory>
 
@@ -17,6 +21,7 @@
 #include "core/geometry/pose.h"
 #include "core/model/deformation_model.h"
 #include "deform/v1/deform.pb.h"
+#include "service/batch_scratch_pool.h"
 #include "service/pose_input.h"
 
 namespace deform::service {
@@ -38,12 +43,32 @@ class FrameSolver {
   // Frames in the solved order.
   explicit FrameSolver(const DeformationModel& model);
 
-  // Solves `input` with `factorization` (one of the model's) into `frame`: its positions, or with an
-  // encoder its `encoded` positions. Sized by FrameSlots::Allocate, a frame allocates nothing;
+  // Solves `input` with `factorization` (one of the model's) into `frame`: its positions, or with
+  // an encoder its `encoded` positions. Sized by FrameSlots::Allocate, a frame allocates nothing;
   // otherwise it is resized (allocating).
   // INVALID_ARGUMENT naming the problem when the pose cannot be built; `frame` is then untouched.
   Status Solve(const PoseInput& input, const MaterialFactorization& factorization,
                const FrameStamp& stamp, v1::DeformFrame* frame);
+
+  // Solve's first step: builds the pose of `input` (INVALID_ARGUMENT as Solve).
+  Status Prepare(const PoseInput& input);
+  // Deforms the prepared poses of `solvers` (distinct, all of one model, prepared) with
+  // `factorization`: together in passes of up to scratches->max_frames() over the factor when
+  // `scratches` lends a batch scratch and count > 1, else one by one. No allocation.
+  struct Deformed {
+    std::chrono::steady_clock::time_point start;  // when the deformation began
+    DeformTimings timings;                        // all of the solvers' together
+    int batch_frames = 1;                         // the largest pass's frames
+  };
+  static Deformed DeformPrepared(const MaterialFactorization& factorization,
+                                 FrameSolver* const* solvers, int count,
+                                 const BatchScratchPool* scratches);
+  // Solve's last step, after DeformPrepared: the frame of `input` from this solver's solution.
+  // Its timings: queue_ms up to `deformed.start`, rhs_ms and solve_ms the deformation's (a
+  // batch's, for each of its frames), encode_ms from the deformation's end to this frame's
+  // encoding's end (a batch encodes its frames one after the other).
+  void Finish(const PoseInput& input, const Deformed& deformed, const FrameStamp& stamp,
+              v1::DeformFrame* frame);
 
  private:
   const DeformationModel& model_;
@@ -51,6 +76,7 @@ class FrameSolver {
   void Encode(v1::DeformFrame* frame);
 
   Pose pose_;
+  int clamped_ = 0;  // angles clamped by the last Prepare
   DeformScratch scratch_;
   std::unique_ptr<codec::FrameEncoder> encoder_;
   std::vector<float> bone_transforms_;  // 12 per bone, for predicted frames

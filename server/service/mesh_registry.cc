@@ -78,7 +78,8 @@ Status MeshRegistry::MemoryHold::Resize(std::size_t bytes, const std::string& wh
   return Status::Ok();
 }
 
-MeshRegistry::MeshRegistry(const ServiceLimits& limits) : limits_(limits) {}
+MeshRegistry::MeshRegistry(const ServiceLimits& limits, SolveBatching batching)
+    : limits_(limits), batching_(batching) {}
 
 MeshRegistry::MemoryHold MeshRegistry::HoldMemory(const std::string& tenant) {
   return MemoryHold(this, tenant);
@@ -128,12 +129,11 @@ Status MeshRegistry::CheckMemoryLocked(std::size_t bytes, std::size_t held,
   }
   if (limits_.tenant_max_memory_bytes > 0) {
     const auto it = tenants_.find(tenant);
-    const std::size_t used =
-        it == tenants_.end() ? 0
-                             : it->second.memory_bytes + it->second.reserved_memory_bytes +
-                                   it->second.stream_memory_bytes - held;
-    if (bytes > limits_.tenant_max_memory_bytes ||
-        used > limits_.tenant_max_memory_bytes - bytes) {
+    const std::size_t used = it == tenants_.end()
+                                 ? 0
+                                 : it->second.memory_bytes + it->second.reserved_memory_bytes +
+                                       it->second.stream_memory_bytes - held;
+    if (bytes > limits_.tenant_max_memory_bytes || used > limits_.tenant_max_memory_bytes - bytes) {
       return Status::ResourceExhausted(
           "tenant memory budget exceeded (--tenant-max-memory-mb): " + what + " needs about " +
           MebiBytes(bytes) + ", " + MebiBytes(used) + " of the tenant's " +
@@ -165,6 +165,14 @@ StatusOr<std::shared_ptr<const MeshEntry>> MeshRegistry::Register(
   entry->factor_ms = model->default_factorization()->factor_seconds() * 1e3;
   entry->factor_bytes = model->default_factorization()->factor().bytes();
   entry->memory_bytes = model->EstimatedBytes();
+  // Allocated before the budget check below (which then counts it): for a moment the mesh's
+  // memory may exceed its reservation by these buffers, a few right-hand sides per worker.
+  if (batching_.max_frames >= 2 && batching_.slots > 0 &&
+      model->default_factorization()->linear_response() == nullptr) {
+    entry->batch_scratches =
+        std::make_unique<BatchScratchPool>(*model, batching_.slots, batching_.max_frames);
+    entry->memory_bytes += BatchScratchPool::Bytes(*model, batching_.slots, batching_.max_frames);
+  }
   entry->model = std::move(model);
   entry->presentation = std::move(presentation);
 

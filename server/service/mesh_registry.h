@@ -10,9 +10,9 @@
 // reservation (ReserveMemory: an upload's declared bytes while they arrive, then the model's
 // estimate before anything is built, DeformationModel::EstimateBytesBeforeBuild), so what does not
 // fit is refused before it is allocated and two loads cannot both take the last of the budget; a
-// registered mesh counts DeformationModel::EstimatedBytes() instead, until it is unloaded and the
-// last stream using it has ended (AttachStream / DetachStream): a model kept alive by streams
-// after UnloadMesh still counts.
+// registered mesh counts DeformationModel::EstimatedBytes() and its batch scratches instead, until
+// it is unloaded and the last stream using it has ended (AttachStream / DetachStream): a model kept
+// alive by streams after UnloadMesh still counts.
 //
 // Tenancy: every mesh belongs to the tenant that loaded it. The lookups that take a caller
 // (Identity) answer another tenant's id exactly as an unknown id (NOT_FOUND, same message), so a
@@ -33,6 +33,7 @@
 #include "core/base/status.h"
 #include "core/model/deformation_model.h"
 #include "service/annotated_mutex.h"
+#include "service/batch_scratch_pool.h"
 #include "service/identity.h"
 #include "service/service_options.h"
 #include "service/thread_annotations.h"
@@ -50,15 +51,18 @@ struct MeshPresentation {
 };
 
 struct MeshEntry {
-  std::string id;    // NewMeshId(): "mesh-" and 128 random bits in hex (mesh_id.h)
-  std::string name;  // the client's label
+  std::string id;      // NewMeshId(): "mesh-" and 128 random bits in hex (mesh_id.h)
+  std::string name;    // the client's label
   std::string tenant;  // the owner: the tenant that loaded it
   std::shared_ptr<const DeformationModel> model;
   double precompute_ms = 0;
   double factor_ms = 0;
   std::size_t factor_bytes = 0;
-  std::size_t memory_bytes = 0;  // model->EstimatedBytes()
+  std::size_t memory_bytes = 0;  // model->EstimatedBytes() and batch_scratches
   MeshPresentation presentation;
+  // The buffers of batched solves of the mesh's frames (in memory_bytes); null when its frames
+  // are solved one by one (batching off, or a linear response: nothing to share).
+  std::unique_ptr<BatchScratchPool> batch_scratches;
 
   // Vertices of frames and rest positions as clients see them (the file's).
   int client_vertex_count() const {
@@ -69,6 +73,13 @@ struct MeshEntry {
 
   mutable std::atomic<bool> unloaded{false};
   mutable std::atomic<int> open_streams{0};
+};
+
+// How registered meshes are prepared for batched solves: `slots` batch scratches of `max_frames`
+// frames each (one per worker), none when max_frames < 2.
+struct SolveBatching {
+  int slots = 0;
+  int max_frames = 1;
 };
 
 class MeshRegistry {
@@ -119,7 +130,7 @@ class MeshRegistry {
     std::size_t bytes_ = 0;
   };
 
-  explicit MeshRegistry(const ServiceLimits& limits);
+  explicit MeshRegistry(const ServiceLimits& limits, SolveBatching batching = {});
   MeshRegistry(const MeshRegistry&) = delete;
   MeshRegistry& operator=(const MeshRegistry&) = delete;
 
@@ -135,9 +146,10 @@ class MeshRegistry {
   // it held.
   Status ReserveMemory(Reservation* reservation, std::size_t bytes, const std::string& what);
 
-  // Registers a built model using `reservation`'s slot, owned by the reservation's tenant, under `id` if given (a mesh restored from
-  // a store keeps its id; an id already loaded is INVALID_ARGUMENT), else under a new NewMeshId().
-  // RESOURCE_EXHAUSTED (the slot is released) when the model does not fit in the memory budget.
+  // Registers a built model using `reservation`'s slot, owned by the reservation's tenant, under
+  // `id` if given (a mesh restored from a store keeps its id; an id already loaded is
+  // INVALID_ARGUMENT), else under a new NewMeshId(). RESOURCE_EXHAUSTED (the slot is released) when
+  // the model does not fit in the memory budget.
   StatusOr<std::shared_ptr<const MeshEntry>> Register(Reservation reservation, std::string name,
                                                       std::shared_ptr<const DeformationModel> model,
                                                       MeshPresentation presentation = {},
@@ -191,17 +203,18 @@ class MeshRegistry {
                            const std::string& what) const DEFORM_REQUIRES(mutex_);
 
   const ServiceLimits limits_;
+  const SolveBatching batching_;
   mutable Mutex mutex_;
   // By load order (a sequence number), and the sequence number of each id.
   std::map<std::uint64_t, std::shared_ptr<MeshEntry>> meshes_ DEFORM_GUARDED_BY(mutex_);
   std::unordered_map<std::string, std::uint64_t> order_of_id_ DEFORM_GUARDED_BY(mutex_);
-  int reserved_ DEFORM_GUARDED_BY(mutex_) = 0;             // slots held by loads in progress
+  int reserved_ DEFORM_GUARDED_BY(mutex_) = 0;  // slots held by loads in progress
   // memory_bytes of loaded meshes, and of unloaded meshes whose streams have not all ended
   std::size_t memory_used_ DEFORM_GUARDED_BY(mutex_) = 0;
   std::size_t memory_retained_ DEFORM_GUARDED_BY(mutex_) = 0;  // of the latter alone
   std::size_t memory_reserved_ DEFORM_GUARDED_BY(mutex_) = 0;  // held by reservations
   std::size_t memory_streams_ DEFORM_GUARDED_BY(mutex_) = 0;   // held by MemoryHolds
-  std::uint64_t next_order_ DEFORM_GUARDED_BY(mutex_) = 1;  // also counts registrations
+  std::uint64_t next_order_ DEFORM_GUARDED_BY(mutex_) = 1;     // also counts registrations
   std::map<std::string, TenantUsage> tenants_ DEFORM_GUARDED_BY(mutex_);
 };
 

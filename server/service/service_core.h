@@ -78,8 +78,9 @@ class TenantStreamQuota {
 struct ServiceCore {
   explicit ServiceCore(const ServerOptions& options)
       : limits(options.limits),
-        registry(options.limits),
-        pool(options.workers),
+        registry(options.limits,
+                 {WorkerPool::ResolveThreads(options.workers), options.batch_frames}),
+        pool(options.workers, options.batch_frames),
         uploads(std::chrono::milliseconds(options.limits.upload_idle_timeout_ms),
                 std::chrono::milliseconds(options.limits.upload_time_limit_ms)),
         tenant_streams(options.limits.tenant_max_streams, options.limits.max_streams) {}

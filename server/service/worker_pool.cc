@@ -1,12 +1,23 @@
 #include "service/worker_pool.h"
 
 #include <algorithm>
+#include <array>
 
 namespace deform::service {
 
-WorkerPool::WorkerPool(int threads) {
+void UrgentTask::RunUrgentBatch(UrgentTask* const* others, int count) {
+  RunUrgent();
+  for (int i = 0; i < count; ++i) others[i]->RunUrgent();
+}
+
+int WorkerPool::ResolveThreads(int threads) {
   if (threads <= 0) threads = static_cast<int>(std::thread::hardware_concurrency());
-  threads = std::max(threads, 1);
+  return std::max(threads, 1);
+}
+
+WorkerPool::WorkerPool(int threads, int max_batch) {
+  max_batch_ = std::clamp(max_batch, 1, kMaxBatch);
+  threads = ResolveThreads(threads);
   max_background_ = std::max(1, threads - 1);
   thread_count_ = threads;
   threads_.reserve(threads);
@@ -62,6 +73,32 @@ void WorkerPool::Shutdown() {
   }
 }
 
+std::shared_ptr<UrgentTask> WorkerPool::TakeUrgentLocked(std::shared_ptr<UrgentTask>* others,
+                                                         int* count) {
+  std::shared_ptr<UrgentTask> head = std::move(urgent_head_);
+  urgent_head_ = std::move(head->next_urgent_);
+  if (urgent_head_ == nullptr) urgent_tail_ = nullptr;
+  *count = 0;
+  const void* key = max_batch_ > 1 ? head->BatchKey() : nullptr;
+  if (key == nullptr) return head;
+  // Walk the queue through the links that own each task, unlinking the matches in place.
+  std::shared_ptr<UrgentTask>* link = &urgent_head_;
+  UrgentTask* previous = nullptr;
+  for (int scanned = 0; *link != nullptr && scanned < kBatchScanLimit && *count < max_batch_ - 1;
+       ++scanned) {
+    if ((*link)->BatchKey() != key) {
+      previous = link->get();
+      link = &(*link)->next_urgent_;
+      continue;
+    }
+    std::shared_ptr<UrgentTask> taken = std::move(*link);
+    *link = std::move(taken->next_urgent_);
+    if (urgent_tail_ == taken.get()) urgent_tail_ = previous;
+    others[(*count)++] = std::move(taken);
+  }
+  return head;
+}
+
 void WorkerPool::WorkerLoop() {
   MutexLock lock(&mutex_);
   while (true) {
@@ -70,12 +107,20 @@ void WorkerPool::WorkerLoop() {
     const bool background_owed =
         can_run_background && running_background_ == 0 && thread_count_ > 1;
     if (urgent_head_ != nullptr && !background_owed) {
-      std::shared_ptr<UrgentTask> task = std::move(urgent_head_);
-      urgent_head_ = std::move(task->next_urgent_);
-      if (urgent_head_ == nullptr) urgent_tail_ = nullptr;
+      std::array<std::shared_ptr<UrgentTask>, kMaxBatch - 1> others;
+      int count = 0;
+      std::shared_ptr<UrgentTask> task = TakeUrgentLocked(others.data(), &count);
       lock.Unlock();
-      task->RunUrgent();
-      task = nullptr;  // the queue's reference goes outside the lock
+      if (count == 0) {
+        task->RunUrgent();
+      } else {
+        std::array<UrgentTask*, kMaxBatch - 1> members;
+        for (int i = 0; i < count; ++i) members[i] = others[i].get();
+        task->RunUrgentBatch(members.data(), count);
+      }
+      // The queue's references go outside the lock.
+      task = nullptr;
+      for (int i = 0; i < count; ++i) others[i] = nullptr;
       lock.Lock();
       continue;
     }

@@ -8,6 +8,12 @@
 // it before the next urgent task, so builds and refactorisations progress however busy the frames
 // keep the pool (a guaranteed share of one worker). With one worker urgent tasks always go first.
 //
+// Batches: an urgent task may name a batch key (UrgentTask::BatchKey). A worker that takes such a
+// task from the head of the queue also takes the queued tasks with the same key (up to the pool's
+// max_batch in all, looking at most kBatchScanLimit tasks deep) and hands them to the first task's
+// RunUrgentBatch, which runs them all. Nothing waits for a batch to fill: a batch is only what is
+// already queued, so a lone task runs as soon as a worker is free, as before.
+//
 // Ownership: the pool holds a reference to every task it has been given (the urgent task's
 // shared_ptr, the background task's function and its captures) until the task has run, and drops
 // it outside its lock, so a task's reference can be the last one to its owner (a stream reactor).
@@ -33,6 +39,15 @@ class UrgentTask {
  public:
   virtual void RunUrgent() = 0;
 
+  // Tasks with the same non-null key may run as one batch (see the pool's header). The key is
+  // read under the pool's lock when the batch is formed, so it must be cheap and thread-safe (an
+  // atomic); it may be stale, and RunUrgentBatch must cope with a member whose key has changed
+  // since. Tasks that share a key must be of one type (RunUrgentBatch may downcast them).
+  virtual const void* BatchKey() const { return nullptr; }
+  // Runs this task and `others` (`count` tasks taken from the queue with this task's key): each
+  // must get what its own RunUrgent() would give it. The default runs them one after the other.
+  virtual void RunUrgentBatch(UrgentTask* const* others, int count);
+
  protected:
   ~UrgentTask() = default;
 
@@ -43,14 +58,24 @@ class UrgentTask {
 
 class WorkerPool {
  public:
-  // `threads` <= 0 means std::thread::hardware_concurrency() (at least 1).
-  explicit WorkerPool(int threads);
+  // Tasks a batch may look past at the queue's head when it gathers tasks with its key.
+  static constexpr int kBatchScanLimit = 64;
+  // Largest batch a pool forms.
+  static constexpr int kMaxBatch = 16;
+
+  // `threads` <= 0 means std::thread::hardware_concurrency() (at least 1). `max_batch`: tasks run
+  // together at most, clamped to [1, kMaxBatch]; 1 never batches.
+  explicit WorkerPool(int threads, int max_batch = 1);
   // Calls Shutdown(), then drops the tasks posted after it (they never run).
   ~WorkerPool();
   WorkerPool(const WorkerPool&) = delete;
   WorkerPool& operator=(const WorkerPool&) = delete;
 
+  // The threads a pool of `threads` runs: `threads`, or the number of cores when <= 0 (>= 1).
+  static int ResolveThreads(int threads);
+
   int size() const { return thread_count_; }
+  int max_batch() const { return max_batch_; }
 
   // Queues `task` at urgent priority; the pool keeps it alive until RunUrgent() has returned.
   // Allocation-free. After Shutdown() has finished the task is kept but never runs.
@@ -63,6 +88,10 @@ class WorkerPool {
 
  private:
   void WorkerLoop() DEFORM_EXCLUDES(mutex_);
+  // Unlinks the urgent queue's head and, when it has a batch key, the queued tasks with the same
+  // key (at most max_batch_ - 1, within kBatchScanLimit) into `others`; returns the head.
+  std::shared_ptr<UrgentTask> TakeUrgentLocked(std::shared_ptr<UrgentTask>* others, int* count)
+      DEFORM_REQUIRES(mutex_);
 
   Mutex mutex_;
   CondVar wake_;
@@ -74,6 +103,7 @@ class WorkerPool {
   bool stopping_ DEFORM_GUARDED_BY(mutex_) = false;
 
   int thread_count_ = 0;  // set by the constructor, then read-only
+  int max_batch_ = 1;     // set by the constructor, then read-only
   Mutex join_mutex_;      // serialises Shutdown()
   std::vector<std::thread> threads_ DEFORM_GUARDED_BY(join_mutex_);
 };

@@ -318,7 +318,8 @@ DeformBatchScratch DeformationModel::MakeBatchScratch(int max_frames) const {
 
 bool DeformationModel::DeformBatch(const MaterialFactorization& factorization,
                                    const Pose* const* poses, DeformScratch* const* scratches,
-                                   int count, DeformBatchScratch* batch) const {
+                                   int count, DeformBatchScratch* batch,
+                                   DeformTimings* timings) const {
   const bool valid = count >= 1 && count <= batch->max_frames && batch->model_id_ == id_;
   assert(valid && "a batch of another model or of a size its scratch does not hold");
   if (!valid) return false;
@@ -326,9 +327,17 @@ bool DeformationModel::DeformBatch(const MaterialFactorization& factorization,
     if (RefusesForeign(factorization, *scratches[f])) return false;
   }
   if (factorization.linear_response() != nullptr || count == 1) {
-    for (int f = 0; f < count; ++f) Deform(factorization, *poses[f], scratches[f]);
+    DeformTimings sum;
+    for (int f = 0; f < count; ++f) {
+      DeformTimings one;
+      Deform(factorization, *poses[f], scratches[f], &one);
+      sum.right_hand_side += one.right_hand_side;
+      sum.solve += one.solve;
+    }
+    if (timings != nullptr) *timings = sum;
     return true;
   }
+  const auto start = Clock::now();
   const Eigen::Index rows = mesh_.num_vertices() + system_.num_nodes;
   const int columns = 3 * count;
   double* packed = batch->columns.data();
@@ -339,6 +348,7 @@ bool DeformationModel::DeformBatch(const MaterialFactorization& factorization,
       for (int c = 0; c < 3; ++c) packed[i * columns + 3 * f + c] = rhs[3 * i + c];
     }
   }
+  const auto solve_start = Clock::now();
   const Status solved =
       factorization.factor().SolveMany(packed, packed, columns, batch->solve_work.data());
   assert(solved.ok());
@@ -349,7 +359,18 @@ bool DeformationModel::DeformBatch(const MaterialFactorization& factorization,
       for (int c = 0; c < 3; ++c) x[3 * i + c] = packed[i * columns + 3 * f + c];
     }
   }
+  if (timings != nullptr) {
+    timings->right_hand_side = std::chrono::duration<double>(solve_start - start).count();
+    timings->solve = SecondsSince(solve_start);
+  }
   return true;
+}
+
+std::size_t DeformationModel::BatchScratchBytes(int max_frames) const {
+  const auto columns = static_cast<std::size_t>(3 * std::clamp(max_frames, 1, kMaxBatchFrames));
+  const auto rows = static_cast<std::size_t>(mesh_.num_vertices() + system_.num_nodes);
+  return sizeof(double) * (rows * columns + default_factorization_->factor().WorkSizeMany(
+                                                static_cast<int>(columns)));
 }
 
 bool DeformationModel::AssembleRightHandSide(const MaterialFactorization& factorization,

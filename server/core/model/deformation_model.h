@@ -187,9 +187,13 @@ class DeformationModel {
   // Deform()'s to round-off (1e-12 of the diagonal, tested). With a linear response there is no
   // solve to share and each frame is evaluated alone. No allocation. Refuses (false, nothing
   // written) a count outside [1, batch->max_frames], another model's factorisation, scratch or
-  // batch scratch, as Deform() does.
+  // batch scratch, as Deform() does. `timings`, when given, are the whole batch's: every
+  // right-hand side (and packing them side by side), then the one solve (and unpacking it).
   bool DeformBatch(const MaterialFactorization& factorization, const Pose* const* poses,
-                   DeformScratch* const* scratches, int count, DeformBatchScratch* batch) const;
+                   DeformScratch* const* scratches, int count, DeformBatchScratch* batch,
+                   DeformTimings* timings = nullptr) const;
+  // The bytes MakeBatchScratch(max_frames) allocates.
+  std::size_t BatchScratchBytes(int max_frames) const;
 
   // The two halves of the solving path of Deform(), for tests and diagnostics (they never use the
   // linear response). AssembleRightHandSide writes A^T b ((n + m) by 3) into scratch->solution;
