@@ -457,6 +457,84 @@ TEST_F(DeformStreamTest, ManyStreamsOnOneMeshAllReceiveFrames) {
   ExpectBackgroundStreamAlive();
 }
 
+// Streams on one mesh whose poses queue together are solved in one pass over the factor
+// (FrameTimings.batch_frames > 1), and each stream's frame is still its own pose's core result.
+// One worker, so poses sent while it solves queue behind it and form the batch.
+TEST_F(DeformStreamTest, StreamsSolvedInOneBatchEachGetTheirOwnPosesFrame) {
+  service::ServerOptions options = TestServerOptions();
+  options.workers = 1;
+  options.batch_frames = 8;
+  StartServer(options);
+  constexpr int kVertices = 6000;
+  constexpr int kStreams = 6;
+  const std::string mesh_id = LoadPhantom(kVertices);
+  std::vector<std::unique_ptr<StreamRecorder>> recorders;
+  std::vector<std::unique_ptr<client::DeformStream>> streams;
+  for (int s = 0; s < kStreams; ++s) {
+    recorders.push_back(std::make_unique<StreamRecorder>(/*keep_positions=*/true));
+    streams.push_back(client_->OpenStream(mesh_id, recorders.back()->Callbacks()));
+  }
+  std::vector<CoreResult> expected;  // per stream: the knee at 15 * (s + 1) degrees
+  for (int s = 0; s < kStreams; ++s) {
+    expected.push_back(CoreDeform(kVertices, "knee:flexion:" + std::to_string(15 * (s + 1))));
+  }
+  std::uint32_t largest_batch = 0;
+  for (std::uint64_t round = 1; round <= 30 && largest_batch < 2; ++round) {
+    for (int s = 0; s < kStreams; ++s) {
+      ASSERT_TRUE(streams[s]->SendPose(KneePose(round, 15.0 * (s + 1))));
+    }
+    for (int s = 0; s < kStreams; ++s) {
+      ASSERT_TRUE(recorders[s]->WaitForFrameWithSequence(round)) << s;
+      const v1::DeformFrame frame = recorders[s]->last_frame();
+      largest_batch = std::max(largest_batch, frame.timings().batch_frames());
+      const std::vector<float> positions = client::DecodePositions(frame.positions());
+      const CoreResult& core = expected[s];
+      ASSERT_EQ(positions.size(), static_cast<std::size_t>(core.positions.size()));
+      double worst = 0;
+      for (Eigen::Index i = 0; i < core.positions.rows(); ++i) {
+        for (int c = 0; c < 3; ++c) {
+          worst = std::max(worst, std::abs(positions[3 * i + c] - core.positions(i, c)));
+        }
+      }
+      EXPECT_LE(worst, 1e-6 * core.diagonal)
+          << "stream " << s << " round " << round << " batch " << frame.timings().batch_frames();
+    }
+  }
+  EXPECT_GE(largest_batch, 2u) << "no two streams' poses were ever solved together";
+  for (auto& stream : streams) {
+    stream->Close();
+    EXPECT_TRUE(stream->Wait().ok());
+  }
+  ExpectBackgroundStreamAlive();
+}
+
+// With --batch-frames 1 every frame is solved alone.
+TEST_F(DeformStreamTest, ABatchLimitOfOneSolvesEveryFrameAlone) {
+  service::ServerOptions options = TestServerOptions();
+  options.workers = 1;
+  options.batch_frames = 1;
+  StartServer(options);
+  const std::string mesh_id = LoadPhantom(3000);
+  constexpr int kStreams = 4;
+  std::vector<std::unique_ptr<StreamRecorder>> recorders;
+  std::vector<std::unique_ptr<client::DeformStream>> streams;
+  for (int s = 0; s < kStreams; ++s) {
+    recorders.push_back(std::make_unique<StreamRecorder>());
+    streams.push_back(client_->OpenStream(mesh_id, recorders.back()->Callbacks()));
+  }
+  for (std::uint64_t round = 1; round <= 10; ++round) {
+    for (auto& stream : streams) ASSERT_TRUE(stream->SendPose(KneePose(round, 5.0 * round)));
+  }
+  for (int s = 0; s < kStreams; ++s) {
+    ASSERT_TRUE(recorders[s]->WaitForFrameWithSequence(10)) << s;
+    for (const RecordedEvent& event : recorders[s]->events()) {
+      if (event.is_frame) EXPECT_EQ(event.frame.timings().batch_frames(), 1u);
+    }
+    streams[s]->Close();
+  }
+  for (auto& stream : streams) EXPECT_TRUE(stream->Wait().ok());
+}
+
 TEST(DeformServerShutdownTest, ShutdownEndsOpenStreamsPromptly) {
   TestServer server;
   auto client = server.NewClient();
