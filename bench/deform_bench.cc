@@ -183,6 +183,42 @@ void BM_BatchedSolve(benchmark::State& state, BenchMesh mesh, int frames_per_bat
   state.counters["frame_cache_bound_ms"] = state.counters["cache_bound_ms"] / frames_per_batch;
 }
 
+// One frame's two triangular passes split over `parts` threads (CholeskyFactor::Solve3Parallel on a
+// ThreadTeam of `parts` threads). Besides the usual counters: serial_ms, Solve3's median on the
+// same right-hand side timed in the same benchmark; x_serial, their ratio; top_share, the share of
+// the factor solved on one thread; predicted_x_serial, the ratio if time followed the bytes read.
+void BM_ParallelSolve(benchmark::State& state, BenchMesh mesh, int parts) {
+  auto frames = SetUpFrames(state, mesh);
+  if (!frames) return;
+  const CholeskyFactor& factor = frames->factorization->factor();
+  DeformScratch& scratch = frames->scratch;
+  const auto rhs = AssembledRightHandSide(frames.get());
+  const ParallelSolvePlan plan = factor.PlanParallel(parts);
+  if (plan.parts == 0) return state.SkipWithError("the elimination tree does not split");
+  std::vector<double> work(factor.WorkSizeParallel(plan));
+  ThreadTeam team(parts);
+  const auto seconds = TimeEach(state, [&] {
+    benchmark::DoNotOptimize(
+        factor.Solve3Parallel(plan, rhs.data(), scratch.solution.data(), work.data(), &team));
+  });
+  const Eigen::MatrixXd parallel_result = scratch.solution;  // (the last timed run's)
+  std::vector<double> serial;
+  for (std::size_t run = 0; run < std::max<std::size_t>(seconds.size(), 20); ++run) {
+    const auto start = Clock::now();
+    benchmark::DoNotOptimize(
+        factor.Solve3(rhs.data(), scratch.solution.data(), scratch.solve_work.data()));
+    serial.push_back(std::chrono::duration<double>(Clock::now() - start).count());
+  }
+  ReportAgainstBound(state, factor.bytes(), seconds);
+  // The parallel solve's difference from Solve3's, relative to the solution's norm.
+  state.counters["relative_difference"] =
+      (parallel_result - scratch.solution).norm() / scratch.solution.norm();
+  state.counters["serial_ms"] = Median(serial) * 1e3;
+  state.counters["x_serial"] = Median(seconds) / Median(serial);
+  state.counters["top_share"] = plan.top_share;
+  state.counters["predicted_x_serial"] = plan.predicted_time_ratio;
+}
+
 // The right-hand side alone: kinematics, rotation blend and the product with L'^T.
 void BM_RightHandSide(benchmark::State& state, BenchMesh mesh) {
   auto frames = SetUpFrames(state, mesh);
@@ -267,6 +303,7 @@ void RegisterBenchmarks(const BenchMesh& mesh) {
     RegisterFor(mesh, "BatchedSolve/frames:" + std::to_string(frames), BM_BatchedSolve, frames)
         ->MinTime(1.0);
   }
+  RegisterFor(mesh, "ParallelSolve/parts:2", BM_ParallelSolve, 2)->MinTime(1.0);
   RegisterFor(mesh, "EigenBaselineSolve", BM_EigenBaselineSolve)->MinTime(1.0);
 }
 

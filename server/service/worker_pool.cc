@@ -81,11 +81,20 @@ std::shared_ptr<UrgentTask> WorkerPool::TakeUrgentLocked(std::shared_ptr<UrgentT
   *count = 0;
   const void* key = max_batch_ > 1 ? head->BatchKey() : nullptr;
   if (key == nullptr) return head;
-  // Walk the queue through the links that own each task, unlinking the matches in place.
+  // The batch's share of the queued tasks with its key: the workers now idle will take the rest,
+  // so a few tasks are spread over the free workers rather than solved by one while others wait.
+  int matching = 0;
+  int scanned = 0;
+  for (const UrgentTask* task = urgent_head_.get(); task != nullptr && scanned < kBatchScanLimit;
+       task = task->next_urgent_.get(), ++scanned) {
+    if (task->BatchKey() == key) ++matching;
+  }
+  const int workers = 1 + idle_workers_;
+  const int take = std::min(max_batch_ - 1, (1 + matching + workers - 1) / workers - 1);
+  // Walk the queue through the links that own each task, unlinking the first `take` matches.
   std::shared_ptr<UrgentTask>* link = &urgent_head_;
   UrgentTask* previous = nullptr;
-  for (int scanned = 0; *link != nullptr && scanned < kBatchScanLimit && *count < max_batch_ - 1;
-       ++scanned) {
+  for (scanned = 0; *link != nullptr && scanned < kBatchScanLimit && *count < take; ++scanned) {
     if ((*link)->BatchKey() != key) {
       previous = link->get();
       link = &(*link)->next_urgent_;
@@ -142,7 +151,9 @@ void WorkerPool::WorkerLoop() {
       wake_.NotifyAll();
       return;
     }
+    ++idle_workers_;
     wake_.Wait(&mutex_);
+    --idle_workers_;
   }
 }
 

@@ -9,9 +9,10 @@
 // keep the pool (a guaranteed share of one worker). With one worker urgent tasks always go first.
 //
 // Batches: an urgent task may name a batch key (UrgentTask::BatchKey). A worker that takes such a
-// task from the head of the queue also takes the queued tasks with the same key (up to the pool's
-// max_batch in all, looking at most kBatchScanLimit tasks deep) and hands them to the first task's
-// RunUrgentBatch, which runs them all. Nothing waits for a batch to fill: a batch is only what is
+// task from the head of the queue also takes queued tasks with the same key and hands them to the
+// first task's RunUrgentBatch, which runs them all: its share of them when other workers are idle
+// (those take the rest, so a few tasks are spread over the free workers), up to the pool's
+// max_batch in all, looking at most kBatchScanLimit tasks deep. Nothing waits for a batch to fill: a batch is only what is
 // already queued, so a lone task runs as soon as a worker is free, as before.
 //
 // Ownership: the pool holds a reference to every task it has been given (the urgent task's
@@ -99,6 +100,7 @@ class WorkerPool {
   UrgentTask* urgent_tail_ DEFORM_GUARDED_BY(mutex_) = nullptr;
   std::deque<std::function<void()>> background_ DEFORM_GUARDED_BY(mutex_);
   int running_background_ DEFORM_GUARDED_BY(mutex_) = 0;
+  int idle_workers_ DEFORM_GUARDED_BY(mutex_) = 0;  // waiting for work
   int max_background_ = 1;  // set by the constructor, then read-only
   bool stopping_ DEFORM_GUARDED_BY(mutex_) = false;
 

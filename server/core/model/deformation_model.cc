@@ -399,20 +399,31 @@ void DeformationModel::AssembleOwnedRightHandSide(const MaterialFactorization& f
 // Rotated, weighted differential coordinates r_i = w_i^2 T_i delta_i, T_i the rotation blend.
 void DeformationModel::RotateDeltas(const MaterialFactorization& factorization,
                                     DeformScratch* scratch) const {
+  PrepareSlotRotations(scratch);
+  RotateDeltasOf(factorization, scratch, 0, mesh_.num_vertices());
+}
+
+void DeformationModel::PrepareSlotRotations(DeformScratch* scratch) const {
   const auto& bones = scratch->bone_transforms;
-  const auto& bw = bone_weights_;
-  const auto& w2 = factorization.row_weights_squared_;
-  auto& r = scratch->rotated_deltas;
   auto& rotations = scratch->slot_rotations;
   if (linear_blend_plan_) {
     linear_blend_plan_->SlotRotations(bones, rotations.data());
   } else {
     for (size_t k = 0; k < bones.size(); ++k) rotations[k] = bones[k].rotation.toRotationMatrix();
   }
-  for (int i = 0; i < mesh_.num_vertices(); ++i) {
-    const int begin = bw.offsets[i], end = bw.offsets[i + 1];
+}
+
+void DeformationModel::RotateDeltasOf(const MaterialFactorization& factorization,
+                                      DeformScratch* scratch, int first, int end) const {
+  const auto& bones = scratch->bone_transforms;
+  const auto& bw = bone_weights_;
+  const auto& w2 = factorization.row_weights_squared_;
+  auto& r = scratch->rotated_deltas;
+  const auto& rotations = scratch->slot_rotations;
+  for (int i = first; i < end; ++i) {
+    const int begin = bw.offsets[i], stop = bw.offsets[i + 1];
     const Eigen::Vector3d delta = system_.rest_deltas.row(i).transpose();
-    if (end - begin == 1) {  // most vertices: wholly one bone's
+    if (stop - begin == 1) {  // most vertices: wholly one bone's
       r.row(i) = w2[i] * (rotations[bw.bones[begin]] * delta).transpose();
     } else if (linear_blend_plan_) {
       r.row(i) = w2[i] * (linear_blend_plan_->Blend(i, rotations.data()) * delta).transpose();
@@ -420,6 +431,65 @@ void DeformationModel::RotateDeltas(const MaterialFactorization& factorization,
       r.row(i) = w2[i] * (QuaternionBlend(bw, i, bones) * delta).transpose();
     }
   }
+}
+
+namespace {
+
+// Part `index` of `parts` equal ranges of [0, count).
+std::pair<int, int> RangeOfPart(int count, int parts, int index) {
+  const auto at = [&](int i) {
+    return static_cast<int>(static_cast<std::int64_t>(count) * i / parts);
+  };
+  return {at(index), at(index + 1)};
+}
+
+}  // namespace
+
+struct DeformationModel::ParallelAssembly {
+  const DeformationModel* model;
+  const MaterialFactorization* factorization;
+  DeformScratch* scratch;
+  int parts;
+
+  static void Rotate(void* context, int index) {
+    const auto& a = *static_cast<const ParallelAssembly*>(context);
+    const auto [first, end] = RangeOfPart(a.model->mesh_.num_vertices(), a.parts, index);
+    a.model->RotateDeltasOf(*a.factorization, a.scratch, first, end);
+  }
+  static void Multiply(void* context, int index) {
+    const auto& a = *static_cast<const ParallelAssembly*>(context);
+    const int rows = static_cast<int>(a.model->system_.laplacian_transpose.outerSize());
+    const auto [first, end] = RangeOfPart(rows, a.parts, index);
+    MultiplyLaplacianTransposeRows(a.model->system_, a.scratch->rotated_deltas.data(),
+                                   a.scratch->solution.data(), first, end);
+  }
+};
+
+bool DeformationModel::DeformParallel(const MaterialFactorization& factorization, const Pose& pose,
+                                      DeformScratch* scratch, const ParallelSolvePlan& plan,
+                                      double* work, ParallelRunner* runner,
+                                      DeformTimings* timings) const {
+  if (factorization.linear_response() != nullptr || plan.parts < 2) {
+    return Deform(factorization, pose, scratch, timings);
+  }
+  if (RefusesForeign(factorization, *scratch)) return false;
+  const auto start = Clock::now();
+  ForwardKinematics(skeleton_, pose, &scratch->bone_transforms);
+  PrepareSlotRotations(scratch);
+  ParallelAssembly assembly{this, &factorization, scratch, plan.parts};
+  runner->Run(plan.parts, &ParallelAssembly::Rotate, &assembly);
+  runner->Run(plan.parts, &ParallelAssembly::Multiply, &assembly);
+  AddConstraintTargets(pose, scratch);
+  const auto solve_start = Clock::now();
+  const Status solved = factorization.factor().Solve3Parallel(
+      plan, scratch->solution.data(), scratch->solution.data(), work, runner);
+  assert(solved.ok());
+  (void)solved;
+  if (timings != nullptr) {
+    timings->right_hand_side = std::chrono::duration<double>(solve_start - start).count();
+    timings->solve = SecondsSince(solve_start);
+  }
+  return true;
 }
 
 // scratch->solution's anchor and joint-node rows += weight^2 * their posed targets.

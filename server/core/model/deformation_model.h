@@ -192,6 +192,15 @@ class DeformationModel {
   bool DeformBatch(const MaterialFactorization& factorization, const Pose* const* poses,
                    DeformScratch* const* scratches, int count, DeformBatchScratch* batch,
                    DeformTimings* timings = nullptr) const;
+  // Deform() on several threads: the rotation blend and A^T b split by vertex and row ranges, and
+  // the solve by subtrees (CholeskyFactor::Solve3Parallel), each step's parts run through
+  // `runner`. `plan` from factor().PlanParallel of any of this model's factorisations (they share
+  // the analysis); `work` holds factor().WorkSizeParallel(plan) doubles. The frame equals
+  // Deform()'s to round-off (1e-12 of the diagonal, tested). With a linear response or a plan
+  // without parts it is Deform(). Allocation-free; refuses another model's arguments as Deform().
+  bool DeformParallel(const MaterialFactorization& factorization, const Pose& pose,
+                      DeformScratch* scratch, const ParallelSolvePlan& plan, double* work,
+                      ParallelRunner* runner, DeformTimings* timings = nullptr) const;
   // The bytes MakeBatchScratch(max_frames) allocates.
   std::size_t BatchScratchBytes(int max_frames) const;
 
@@ -285,6 +294,11 @@ class DeformationModel {
   // The steps of AssembleRightHandSide: r = w^2 T delta into scratch->rotated_deltas (after the
   // forward kinematics), then the anchors' and joint nodes' targets into scratch->solution.
   void RotateDeltas(const MaterialFactorization& factorization, DeformScratch* scratch) const;
+  // RotateDeltas in two steps, the second by vertex range (a parallel assembly splits it).
+  void PrepareSlotRotations(DeformScratch* scratch) const;
+  void RotateDeltasOf(const MaterialFactorization& factorization, DeformScratch* scratch, int first,
+                      int end) const;
+  struct ParallelAssembly;  // DeformParallel's parts
   void AddConstraintTargets(const Pose& pose, DeformScratch* scratch) const;
 
   std::uint64_t id_ = 0;  // unique within the process, never 0 (Owns)

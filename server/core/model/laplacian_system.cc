@@ -53,11 +53,12 @@ Positions RestDeltas(const TriangleMesh& mesh, const JointRegions& regions,
 // out = m r for a row-major sparse m and n by 3 row-major r and out. Two partial sums per row, so
 // consecutive entries do not wait on each other's adds.
 void MultiplySparseBy3(const Eigen::SparseMatrix<double, Eigen::RowMajor, int>& m,
-                       const double* __restrict r, double* __restrict out) {
+                       const double* __restrict r, double* __restrict out, int first_row,
+                       int end_row) {
   const int* columns = m.innerIndexPtr();
   const double* values = m.valuePtr();
   const int* row_begin = m.outerIndexPtr();
-  for (int row = 0; row < m.outerSize(); ++row) {
+  for (int row = first_row; row < end_row; ++row) {
     double a0 = 0, a1 = 0, a2 = 0, b0 = 0, b1 = 0, b2 = 0;
     int p = row_begin[row];
     const int end = row_begin[row + 1];
@@ -148,7 +149,13 @@ Eigen::SparseMatrix<double> NormalMatrixPattern(const LaplacianSystem& system) {
 }
 
 void MultiplyLaplacianTranspose(const LaplacianSystem& system, const double* r, double* out) {
-  MultiplySparseBy3(system.laplacian_transpose, r, out);
+  MultiplySparseBy3(system.laplacian_transpose, r, out, 0,
+                    static_cast<int>(system.laplacian_transpose.outerSize()));
+}
+
+void MultiplyLaplacianTransposeRows(const LaplacianSystem& system, const double* r, double* out,
+                                    int first_row, int end_row) {
+  MultiplySparseBy3(system.laplacian_transpose, r, out, first_row, end_row);
 }
 
 }  // namespace deform

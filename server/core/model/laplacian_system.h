@@ -66,5 +66,9 @@ Eigen::SparseMatrix<double> NormalMatrixPattern(const LaplacianSystem& system);
 
 // out = L'^T r: `r` is n by 3 and `out` (n + m) by 3, both row-major. No allocation.
 void MultiplyLaplacianTranspose(const LaplacianSystem& system, const double* r, double* out);
+// Rows [first_row, end_row) of the same product (the rows are independent: a parallel assembly
+// gives each thread its own range).
+void MultiplyLaplacianTransposeRows(const LaplacianSystem& system, const double* r, double* out,
+                                    int first_row, int end_row);
 
 }  // namespace deform

@@ -152,6 +152,28 @@ Status CholeskyFactor::SolveMany(const double* b, double* x, int columns, double
   return Status::Ok();
 }
 
+ParallelSolvePlan CholeskyFactor::PlanParallel(int parts) const {
+  return symbolic_ ? PlanParallelSolve(View(), parts) : ParallelSolvePlan();
+}
+
+std::size_t CholeskyFactor::WorkSizeParallel(const ParallelSolvePlan& plan) const {
+  return symbolic_ ? static_cast<std::size_t>(ParallelSolveWorkSize(symbolic_->n_, plan)) : 0;
+}
+
+Status CholeskyFactor::Solve3Parallel(const ParallelSolvePlan& plan, const double* b, double* x,
+                                      double* work, ParallelRunner* runner) const {
+  return Solve3Parallel(plan, b, x, work, runner, BestSolveKernel());
+}
+
+Status CholeskyFactor::Solve3Parallel(const ParallelSolvePlan& plan, const double* b, double* x,
+                                      double* work, ParallelRunner* runner,
+                                      SolveKernel kernel) const {
+  if (!symbolic_) return Status::FailedPrecondition("solve with an empty factor");
+  if (plan.parts < 2) return Status::InvalidArgument("a parallel solve needs a plan with parts");
+  ParallelSolve3(View(), plan, kernel, b, x, work, runner);
+  return Status::Ok();
+}
+
 SupernodalFactorView CholeskyFactor::View() const {
   const SymbolicCholesky& s = *symbolic_;
   SupernodalFactorView view;

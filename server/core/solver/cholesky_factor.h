@@ -10,6 +10,7 @@
 
 #include "core/base/cancel_token.h"
 #include "core/base/status.h"
+#include "core/solver/parallel_solve.h"
 #include "core/solver/supernodal_solve.h"
 #include "core/solver/symbolic_cholesky.h"
 
@@ -48,6 +49,16 @@ class CholeskyFactor {
   Status SolveMany(const double* b, double* x, int columns, double* work) const;
   Status SolveMany(const double* b, double* x, int columns, double* work, SolveKernel kernel) const;
   std::size_t WorkSizeMany(int columns) const;
+  // Solve3 on several threads (parallel_solve.h): `plan` from PlanParallel (of this factor or one
+  // of the same analysis), its parts run through `runner`; `work` holds WorkSizeParallel(plan)
+  // doubles. Matches Solve3 to round-off. Allocation-free; const and thread-safe.
+  // FAILED_PRECONDITION for an empty factor, INVALID_ARGUMENT for a plan without parts.
+  ParallelSolvePlan PlanParallel(int parts) const;
+  std::size_t WorkSizeParallel(const ParallelSolvePlan& plan) const;
+  Status Solve3Parallel(const ParallelSolvePlan& plan, const double* b, double* x, double* work,
+                        ParallelRunner* runner) const;
+  Status Solve3Parallel(const ParallelSolvePlan& plan, const double* b, double* x, double* work,
+                        ParallelRunner* runner, SolveKernel kernel) const;
   // Doubles of scratch Solve3 needs (SolveWorkSize: a four-double row per unknown plus room for
   // the widest supernode). The same for every factor of one symbolic analysis.
   std::size_t WorkSize() const;

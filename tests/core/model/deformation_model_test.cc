@@ -232,6 +232,53 @@ TEST(DeformationModel, ABatchOnTheSharedLegEqualsTheFramesSolvedOneByOne) {
   }
 }
 
+// A frame solved on several threads (DeformParallel: the right-hand side by ranges, the solve by
+// subtrees) equals Deform()'s to 1e-12 of the diagonal for 2 to 4 parts, on a team of threads and
+// on one thread, and allocates nothing on the calling thread.
+TEST(DeformationModel, AFrameSolvedOnSeveralThreadsEqualsTheSerialFrame) {
+  auto model = BuildPhantomModel();
+  const MaterialFactorization& factorization = *model->default_factorization();
+  for (const char* spec : {"knee:flexion:70", "knee:flexion:20,knee:rotation:10"}) {
+    const Pose pose = PoseFromSpec(model->skeleton(), spec);
+    const Positions expected = DeformOnce(*model, pose);
+    for (const int parts : {2, 3, 4}) {
+      const ParallelSolvePlan plan = factorization.factor().PlanParallel(parts);
+      ASSERT_EQ(plan.parts, parts);
+      std::vector<double> work(factorization.factor().WorkSizeParallel(plan));
+      ThreadTeam team(parts);
+      SerialRunner serial;
+      for (ParallelRunner* runner :
+           {static_cast<ParallelRunner*>(&team), static_cast<ParallelRunner*>(&serial)}) {
+        DeformScratch scratch = model->MakeScratch();
+        const long before = test_support::AllocationCount();
+        ASSERT_TRUE(
+            model->DeformParallel(factorization, pose, &scratch, plan, work.data(), runner));
+        if (runner == &serial) EXPECT_EQ(test_support::AllocationCount() - before, 0);
+        EXPECT_LE(MaxDistance(scratch.positions(), expected),
+                  1e-12 * model->bounding_box_diagonal())
+            << spec << ", " << parts << " parts";
+      }
+    }
+  }
+}
+
+TEST(DeformationModel, AFrameOfTheSharedLegSolvedOnTwoThreadsEqualsTheSerialFrame) {
+  DEFORM_SHARED_LEG_MODEL(model);
+  const MaterialFactorization& factorization = *model->default_factorization();
+  const ParallelSolvePlan plan = factorization.factor().PlanParallel(2);
+  ASSERT_EQ(plan.parts, 2);
+  std::vector<double> work(factorization.factor().WorkSizeParallel(plan));
+  ThreadTeam team(2);
+  DeformScratch scratch = model->MakeScratch();
+  for (const int degrees : {0, 45, 110}) {
+    const Pose pose = PoseFromSpec(model->skeleton(), "1:x:" + std::to_string(degrees));
+    ASSERT_TRUE(model->DeformParallel(factorization, pose, &scratch, plan, work.data(), &team));
+    EXPECT_LE(MaxDistance(scratch.positions(), DeformOnce(*model, pose)),
+              1e-12 * model->bounding_box_diagonal())
+        << degrees;
+  }
+}
+
 TEST(DeformationModel, ThreadsShareOneModelAndFactorisation) {
   auto model = BuildPhantomModel();
   const Pose pose = PoseFromSpec(model->skeleton(), "knee:flexion:60");

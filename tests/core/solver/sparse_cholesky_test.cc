@@ -6,6 +6,9 @@
 #include <cmath>
 #include <random>
 #include <string>
+#include <thread>
+#include <utility>
+#include <vector>
 
 #include "core/base/cancel_token.h"
 
@@ -234,6 +237,101 @@ TEST_P(SolveKernelTest, ManyColumnsMatchThreeAtATime) {
   }
   std::vector<double> b(3), work(8);
   EXPECT_EQ(CholeskyFactor().SolveMany(b.data(), b.data(), 3, work.data()).code(),
+            StatusCode::kFailedPrecondition);
+}
+
+// Runs every part on its own thread (a thread per part per call: tests only), so the parts of a
+// parallel solve really run side by side (and under TSan, any shared write is reported).
+class ThreadPerPartRunner final : public ParallelRunner {
+ public:
+  void Run(int count, void (*part)(void* context, int index), void* context) override {
+    std::vector<std::thread> threads;
+    for (int i = 1; i < count; ++i) threads.emplace_back([=] { part(context, i); });
+    part(context, 0);
+    for (std::thread& thread : threads) thread.join();
+  }
+};
+
+// A square grid's Laplacian plus a small diagonal: a mesh-like matrix whose nested dissection has
+// a deep tree of separators.
+ColMajorMatrix GridMatrix(int side) {
+  std::vector<Eigen::Triplet<double>> entries;
+  const auto at = [side](int i, int j) { return i * side + j; };
+  for (int i = 0; i < side; ++i) {
+    for (int j = 0; j < side; ++j) {
+      double degree = 0.01;
+      for (const auto& [di, dj] :
+           {std::pair{1, 0}, std::pair{-1, 0}, std::pair{0, 1}, std::pair{0, -1}}) {
+        if (i + di < 0 || i + di >= side || j + dj < 0 || j + dj >= side) continue;
+        entries.emplace_back(at(i, j), at(i + di, j + dj), -1.0);
+        degree += 1;
+      }
+      entries.emplace_back(at(i, j), at(i, j), degree);
+    }
+  }
+  ColMajorMatrix a(side * side, side * side);
+  a.setFromTriplets(entries.begin(), entries.end());
+  a.makeCompressed();
+  return a;
+}
+
+// The parallel solve, its parts on their own threads or on one, equals Solve3 to 1e-12 of the
+// solution's norm for every number of parts, in place too; the plan puts most of a mesh-like
+// matrix's factor in the parts.
+TEST_P(SolveKernelTest, ParallelSolveMatchesSolve3) {
+  if (!SolveKernelAvailable(GetParam())) {
+    GTEST_SKIP() << SolveKernelName(GetParam()) << " is not available on this build or CPU";
+  }
+  using Rhs = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+  ThreadPerPartRunner threads;
+  SerialRunner serial;
+  struct Case {
+    std::string name;
+    ColMajorMatrix a;
+  };
+  std::vector<Case> cases;
+  for (const int n : {2, 37, 303, 2000})
+    cases.push_back({"random " + std::to_string(n), RandomSpdMatrix(n, 4, 300 + n)});
+  cases.push_back({"grid 70", GridMatrix(70)});
+  for (const Case& c : cases) {
+    auto symbolic = SymbolicCholesky::Analyze(c.a, Ordering::kMetis);
+    ASSERT_TRUE(symbolic.ok()) << symbolic.status().ToString();
+    auto factor = CholeskyFactor::Factorize(*symbolic, c.a);
+    ASSERT_TRUE(factor.ok()) << factor.status().ToString();
+    const int n = static_cast<int>(c.a.rows());
+    const Rhs b = Rhs::Random(n, 3);
+    Rhs expected(n, 3);
+    std::vector<double> work3(factor->WorkSize());
+    ASSERT_TRUE(factor->Solve3(b.data(), expected.data(), work3.data(), GetParam()).ok());
+    for (const int parts : {2, 3, 4}) {
+      const ParallelSolvePlan plan = factor->PlanParallel(parts);
+      if (plan.parts == 0) continue;  // too small to split (the 2-unknown case)
+      EXPECT_EQ(plan.parts, parts);
+      if (c.name == "grid 70" && parts == 2) {
+        EXPECT_LT(plan.top_share, 0.3) << parts;
+        EXPECT_LT(plan.predicted_time_ratio, 0.8) << parts;
+      }
+      std::vector<double> work(factor->WorkSizeParallel(plan), std::nan(""));
+      for (ParallelRunner* runner :
+           {static_cast<ParallelRunner*>(&threads), static_cast<ParallelRunner*>(&serial)}) {
+        Rhs x(n, 3);
+        ASSERT_TRUE(
+            factor->Solve3Parallel(plan, b.data(), x.data(), work.data(), runner, GetParam()).ok());
+        EXPECT_LE((x - expected).norm(), 1e-12 * expected.norm()) << c.name << ", " << parts;
+        Rhs in_place = b;
+        ASSERT_TRUE(factor
+                        ->Solve3Parallel(plan, in_place.data(), in_place.data(), work.data(),
+                                         runner, GetParam())
+                        .ok());
+        EXPECT_LE((in_place - expected).norm(), 1e-12 * expected.norm()) << c.name;
+      }
+    }
+    EXPECT_EQ(factor->PlanParallel(1).parts, 0);
+  }
+  std::vector<double> b(3), work(8);
+  EXPECT_EQ(CholeskyFactor()
+                .Solve3Parallel(ParallelSolvePlan(), b.data(), b.data(), work.data(), &serial)
+                .code(),
             StatusCode::kFailedPrecondition);
 }
 

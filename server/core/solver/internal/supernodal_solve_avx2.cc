@@ -13,4 +13,14 @@ void SolveManyAvx2Fma(const SupernodalFactorView& factor, const double* b, doubl
   SolveManyImpl(factor, b, x, columns, work);
 }
 
+void ForwardListAvx2Fma(const SupernodalFactorView& factor, const int* supernodes, int count,
+                        double* y, double* planar_buffer) {
+  ForwardListImpl(factor, supernodes, count, y, planar_buffer);
+}
+
+void BackwardListAvx2Fma(const SupernodalFactorView& factor, const int* supernodes, int count,
+                         double* y, double* planar_buffer) {
+  BackwardListImpl(factor, supernodes, count, y, planar_buffer);
+}
+
 }  // namespace deform

@@ -12,4 +12,14 @@ void SolveManyBaseline(const SupernodalFactorView& factor, const double* b, doub
   SolveManyImpl(factor, b, x, columns, work);
 }
 
+void ForwardListBaseline(const SupernodalFactorView& factor, const int* supernodes, int count,
+                         double* y, double* planar_buffer) {
+  ForwardListImpl(factor, supernodes, count, y, planar_buffer);
+}
+
+void BackwardListBaseline(const SupernodalFactorView& factor, const int* supernodes, int count,
+                          double* y, double* planar_buffer) {
+  BackwardListImpl(factor, supernodes, count, y, planar_buffer);
+}
+
 }  // namespace deform

@@ -490,6 +490,48 @@ inline void BackwardPass(const SupernodalFactorView& f, double* __restrict y,
   }
 }
 
+// The forward pass over the listed supernodes only (ascending), on solution rows `y` (aligned
+// as Solve3Impl's); the parallel solve's part (supernodal_solve.h, ParallelSolve).
+void ForwardListImpl(const SupernodalFactorView& f, const int* supernodes, int count, double* y,
+                     double* planar_buffer) {
+  for (int i = 0; i < count; ++i) {
+    const SupernodeBlock s = BlockOf(f, supernodes[i]);
+    const Planar p = PlanarOf(planar_buffer, s.width);
+    ForwardDiagonal(s.values, s.width, Row(y, s.first), p);
+    if (s.width > 4) {
+      ForwardUpdate(s.values, s.rows, s.width, s.num_rows, p, y);
+    } else {
+      DispatchNarrow(s.width, [&](auto w) {
+        ForwardUpdateNarrow<decltype(w)::value>(s.values, s.rows, s.num_rows, p, y);
+      });
+    }
+  }
+}
+
+// The backward pass over the listed supernodes only (taken in descending order).
+void BackwardListImpl(const SupernodalFactorView& f, const int* supernodes, int count, double* y,
+                      double* planar_buffer) {
+  for (int i = count - 1; i >= 0; --i) {
+    const SupernodeBlock s = BlockOf(f, supernodes[i]);
+    const Planar p = PlanarOf(planar_buffer, s.width);
+    double* ys = Row(y, s.first);
+    for (int k = 0; k < s.width; ++k) {
+      const double* t = Row(ys, k);
+      p.x[k] = t[0];
+      p.y[k] = t[1];
+      p.z[k] = t[2];
+    }
+    if (s.width > 4) {
+      BackwardUpdate(s.values, s.rows, s.width, s.num_rows, p, y);
+    } else {
+      DispatchNarrow(s.width, [&](auto w) {
+        BackwardUpdateNarrow<decltype(w)::value>(s.values, s.rows, s.num_rows, p, y);
+      });
+    }
+    BackwardDiagonal(s.values, s.width, ys, p);
+  }
+}
+
 void Solve3Impl(const SupernodalFactorView& f, const double* b, double* x, double* work) {
   const int n = f.size;
   // The solution rows start at the first 32-byte boundary of `work`.

@@ -1,0 +1,315 @@
+#include "core/solver/parallel_solve.h"
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <numeric>
+
+namespace deform {
+
+// Defined in supernodal_solve_baseline.cc and, where built, supernodal_solve_avx2.cc.
+void ForwardListBaseline(const SupernodalFactorView& factor, const int* supernodes, int count,
+                         double* y, double* planar_buffer);
+void BackwardListBaseline(const SupernodalFactorView& factor, const int* supernodes, int count,
+                          double* y, double* planar_buffer);
+#if defined(DEFORM_HAVE_AVX2_KERNEL)
+void ForwardListAvx2Fma(const SupernodalFactorView& factor, const int* supernodes, int count,
+                        double* y, double* planar_buffer);
+void BackwardListAvx2Fma(const SupernodalFactorView& factor, const int* supernodes, int count,
+                         double* y, double* planar_buffer);
+#endif
+
+namespace {
+
+using ListPass = void (*)(const SupernodalFactorView&, const int*, int, double*, double*);
+
+ListPass ForwardListFor(SolveKernel kernel) {
+#if defined(DEFORM_HAVE_AVX2_KERNEL)
+  if (kernel == SolveKernel::kAvx2Fma) return &ForwardListAvx2Fma;
+#endif
+  (void)kernel;
+  return &ForwardListBaseline;
+}
+
+ListPass BackwardListFor(SolveKernel kernel) {
+#if defined(DEFORM_HAVE_AVX2_KERNEL)
+  if (kernel == SolveKernel::kAvx2Fma) return &BackwardListAvx2Fma;
+#endif
+  (void)kernel;
+  return &BackwardListBaseline;
+}
+
+constexpr int kRowStride = 4;  // the kernels' solution rows: x, y, z and a zero
+
+std::int64_t PartDoubles(int size, int widest) {
+  return kRowStride * static_cast<std::int64_t>(size) + 3 * ((widest + 3) & ~3);
+}
+
+// Part p's solution rows and planar buffer in the aligned work.
+struct PartBuffers {
+  double* y;
+  double* planar;
+};
+
+struct SolveContext {
+  const SupernodalFactorView* factor;
+  const ParallelSolvePlan* plan;
+  ListPass forward;
+  ListPass backward;
+  const double* b;
+  double* x;
+  double* work;  // aligned to 32 bytes
+  std::int64_t part_doubles;
+
+  PartBuffers Buffers(int part) const {
+    double* base = work + part * part_doubles;
+    return {base, base + kRowStride * static_cast<std::int64_t>(factor->size)};
+  }
+  double* Solution() const { return work; }
+  const int* Supernodes(int part) const {
+    return plan->part_supernodes.data() + plan->part_offsets[part];
+  }
+  int Count(int part) const { return plan->part_offsets[part + 1] - plan->part_offsets[part]; }
+};
+
+template <typename Body>
+void ForEachColumn(const SolveContext& c, int part, Body&& body) {
+  const int* ids = c.Supernodes(part);
+  for (int i = 0; i < c.Count(part); ++i) {
+    for (int col = c.factor->supernode_columns[ids[i]];
+         col < c.factor->supernode_columns[ids[i] + 1]; ++col) {
+      body(col);
+    }
+  }
+}
+
+void Gather(const SupernodalFactorView& f, const double* b, int row, double* y) {
+  const double* source = b + 3 * static_cast<std::ptrdiff_t>(f.permutation[row]);
+  double* t = y + kRowStride * static_cast<std::ptrdiff_t>(row);
+  t[0] = source[0];
+  t[1] = source[1];
+  t[2] = source[2];
+  t[3] = 0;
+}
+
+void Scatter(const SupernodalFactorView& f, const double* y, int row, double* x) {
+  double* target = x + 3 * static_cast<std::ptrdiff_t>(f.permutation[row]);
+  const double* t = y + kRowStride * static_cast<std::ptrdiff_t>(row);
+  target[0] = t[0];
+  target[1] = t[1];
+  target[2] = t[2];
+}
+
+// A part's forward pass: its rows gathered into its buffer (part 0: the solution), the top rows of
+// another part's buffer zeroed, its supernodes eliminated, its rows copied to the solution.
+void ForwardPart(void* context, int part) {
+  const SolveContext& c = *static_cast<const SolveContext*>(context);
+  const SupernodalFactorView& f = *c.factor;
+  const PartBuffers own = c.Buffers(part);
+  ForEachColumn(c, part, [&](int col) { Gather(f, c.b, col, own.y); });
+  if (part > 0) {
+    for (const int col : c.plan->top_columns) {
+      double* t = own.y + kRowStride * static_cast<std::ptrdiff_t>(col);
+      t[0] = t[1] = t[2] = t[3] = 0;
+    }
+  }
+  c.forward(f, c.Supernodes(part), c.Count(part), own.y, own.planar);
+  if (part > 0) {
+    double* solution = c.Solution();
+    ForEachColumn(c, part, [&](int col) {
+      const std::ptrdiff_t at = kRowStride * static_cast<std::ptrdiff_t>(col);
+      std::copy(own.y + at, own.y + at + kRowStride, solution + at);
+    });
+  }
+}
+
+// A part's backward pass on the solution, its rows then written to x.
+void BackwardPart(void* context, int part) {
+  const SolveContext& c = *static_cast<const SolveContext*>(context);
+  const SupernodalFactorView& f = *c.factor;
+  c.backward(f, c.Supernodes(part), c.Count(part), c.Solution(), c.Buffers(part).planar);
+  ForEachColumn(c, part, [&](int col) { Scatter(f, c.Solution(), col, c.x); });
+}
+
+}  // namespace
+
+ThreadTeam::ThreadTeam(int threads) {
+  for (int i = 1; i < threads; ++i) helpers_.emplace_back([this] { Help(); });
+}
+
+ThreadTeam::~ThreadTeam() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stopping_ = true;
+  }
+  wake_.notify_all();
+  for (std::thread& helper : helpers_) helper.join();
+}
+
+void ThreadTeam::RunParts(std::unique_lock<std::mutex>& lock) {
+  while (next_ < count_) {
+    const int index = next_++;
+    void (*part)(void*, int) = part_;
+    void* context = context_;
+    lock.unlock();
+    part(context, index);
+    lock.lock();
+    ++finished_;
+    done_.notify_all();
+  }
+}
+
+void ThreadTeam::Run(int count, void (*part)(void* context, int index), void* context) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  part_ = part;
+  context_ = context;
+  count_ = count;
+  next_ = 0;
+  finished_ = 0;
+  ++job_;
+  wake_.notify_all();
+  RunParts(lock);
+  done_.wait(lock, [this] { return finished_ == count_; });
+  part_ = nullptr;
+  context_ = nullptr;
+  count_ = 0;
+}
+
+void ThreadTeam::Help() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  std::uint64_t seen = 0;
+  while (true) {
+    wake_.wait(lock, [&] { return stopping_ || job_ != seen; });
+    if (stopping_) return;
+    seen = job_;
+    RunParts(lock);
+  }
+}
+
+ParallelSolvePlan PlanParallelSolve(const SupernodalFactorView& f, int parts) {
+  ParallelSolvePlan plan;
+  const int count = f.num_supernodes;
+  if (parts < 2 || count < 2) return plan;
+  // The supernodal elimination tree: a supernode's parent holds its first row below its block.
+  std::vector<int> supernode_of(static_cast<std::size_t>(f.size));
+  int widest = 0;
+  for (int s = 0; s < count; ++s) {
+    widest = std::max(widest, f.supernode_columns[s + 1] - f.supernode_columns[s]);
+    for (int col = f.supernode_columns[s]; col < f.supernode_columns[s + 1]; ++col) {
+      supernode_of[col] = s;
+    }
+  }
+  std::vector<int> parent(count, -1);
+  std::vector<double> subtree(count, 0);
+  std::vector<std::vector<int>> children(count);
+  std::vector<int> roots;
+  for (int s = 0; s < count; ++s) {
+    const int width = f.supernode_columns[s + 1] - f.supernode_columns[s];
+    const std::int64_t rows = f.row_pointers[s + 1] - f.row_pointers[s];
+    subtree[s] += static_cast<double>(rows) * width;  // children come first: theirs added already
+    if (rows > width) {
+      parent[s] = supernode_of[f.row_indices[f.row_pointers[s] + width]];
+      subtree[parent[s]] += subtree[s];
+      children[parent[s]].push_back(s);
+    } else {
+      roots.push_back(s);
+    }
+  }
+  double total = 0;
+  for (const int r : roots) total += subtree[r];
+  // Split the largest subtree until the subtrees fill `parts` bins evenly (greedy, largest first).
+  std::vector<int> candidates = roots;
+  std::vector<int> top;
+  std::vector<std::vector<int>> bins;
+  std::vector<double> load;
+  const auto by_cost = [&](int a, int b) { return subtree[a] > subtree[b]; };
+  for (int iteration = 0; iteration < 4 * count; ++iteration) {
+    std::sort(candidates.begin(), candidates.end(), by_cost);
+    bins.assign(parts, {});
+    load.assign(parts, 0);
+    for (const int c : candidates) {
+      const int lightest =
+          static_cast<int>(std::min_element(load.begin(), load.end()) - load.begin());
+      bins[lightest].push_back(c);
+      load[lightest] += subtree[c];
+    }
+    const double largest = *std::max_element(load.begin(), load.end());
+    const double sum = std::accumulate(load.begin(), load.end(), 0.0);
+    if (largest <= 1.05 * sum / parts || children[candidates.front()].empty()) break;
+    const int split = candidates.front();
+    candidates.erase(candidates.begin());
+    top.push_back(split);
+    candidates.insert(candidates.end(), children[split].begin(), children[split].end());
+  }
+  if (*std::min_element(load.begin(), load.end()) <= 0) return plan;  // nothing to run alongside
+  // Each bin's subtrees, whole, ascending.
+  plan.parts = parts;
+  plan.part_offsets.push_back(0);
+  std::vector<int> stack;
+  for (const std::vector<int>& bin : bins) {
+    const std::size_t first = plan.part_supernodes.size();
+    for (const int root : bin) {
+      stack.assign(1, root);
+      while (!stack.empty()) {
+        const int s = stack.back();
+        stack.pop_back();
+        plan.part_supernodes.push_back(s);
+        stack.insert(stack.end(), children[s].begin(), children[s].end());
+      }
+    }
+    std::sort(plan.part_supernodes.begin() + static_cast<std::ptrdiff_t>(first),
+              plan.part_supernodes.end());
+    plan.part_offsets.push_back(static_cast<int>(plan.part_supernodes.size()));
+  }
+  std::sort(top.begin(), top.end());
+  plan.top = top;
+  double top_cost = 0;
+  for (const int s : top) {
+    const int width = f.supernode_columns[s + 1] - f.supernode_columns[s];
+    top_cost += static_cast<double>(f.row_pointers[s + 1] - f.row_pointers[s]) * width;
+    for (int col = f.supernode_columns[s]; col < f.supernode_columns[s + 1]; ++col) {
+      plan.top_columns.push_back(col);
+    }
+  }
+  plan.widest_supernode = widest;
+  plan.top_share = total > 0 ? top_cost / total : 0;
+  plan.predicted_time_ratio =
+      total > 0 ? (top_cost + *std::max_element(load.begin(), load.end())) / total : 1;
+  return plan;
+}
+
+std::int64_t ParallelSolveWorkSize(int size, const ParallelSolvePlan& plan) {
+  return plan.parts * PartDoubles(size, plan.widest_supernode) + kRowStride;
+}
+
+void ParallelSolve3(const SupernodalFactorView& f, const ParallelSolvePlan& plan,
+                    SolveKernel kernel, const double* b, double* x, double* work,
+                    ParallelRunner* runner) {
+  const std::uintptr_t misalignment = reinterpret_cast<std::uintptr_t>(work) % 32;
+  SolveContext c{&f,
+                 &plan,
+                 ForwardListFor(kernel),
+                 BackwardListFor(kernel),
+                 b,
+                 x,
+                 work + (misalignment ? (32 - misalignment) / sizeof(double) : 0),
+                 PartDoubles(f.size, plan.widest_supernode)};
+  double* solution = c.Solution();
+  double* planar = c.Buffers(0).planar;
+  for (const int col : plan.top_columns) Gather(f, b, col, solution);
+  runner->Run(plan.parts, &ForwardPart, &c);
+  for (int part = 1; part < plan.parts; ++part) {
+    const double* other = c.Buffers(part).y;
+    for (const int col : plan.top_columns) {
+      const std::ptrdiff_t at = kRowStride * static_cast<std::ptrdiff_t>(col);
+      for (int k = 0; k < 3; ++k) solution[at + k] += other[at + k];
+    }
+  }
+  const int top = static_cast<int>(plan.top.size());
+  c.forward(f, plan.top.data(), top, solution, planar);
+  c.backward(f, plan.top.data(), top, solution, planar);
+  for (const int col : plan.top_columns) Scatter(f, solution, col, x);
+  runner->Run(plan.parts, &BackwardPart, &c);
+}
+
+}  // namespace deform

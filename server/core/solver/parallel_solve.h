@@ -1,0 +1,106 @@
+// The three-column triangular solve of one right-hand side on several threads.
+//
+// The supernodal elimination tree's disjoint subtrees are independent: in the forward pass
+// (L y = b) a supernode updates only its ancestors' rows, in the backward pass (L^T x = y) it reads
+// only theirs. A plan (PlanParallelSolve) splits the tree into `parts` groups of whole subtrees of
+// about equal cost (the factor's values they hold) and the top: every supernode above them, the
+// top separators of the nested-dissection ordering. The solve runs the parts' forward passes
+// concurrently (part 0 on the solution, each other part on its own copy whose top rows start at
+// zero, added into the solution's top rows afterwards, so no two threads write one row), then the
+// top's forward and backward passes on the calling thread, then the parts' backward passes
+// concurrently (each writes only its own rows). The sums run in another order than Solve3's, so
+// the result equals Solve3's to round-off (1e-12 of the solution's norm, tested).
+//
+// Who runs the parts is the caller's ParallelRunner: the service's runs them on idle workers of
+// its pool and the rest on the calling thread; SerialRunner runs them all on the calling thread.
+#pragma once
+
+#include <condition_variable>
+#include <cstdint>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "core/solver/supernodal_solve.h"
+
+namespace deform {
+
+// Runs the parts of one computation, possibly on other threads.
+class ParallelRunner {
+ public:
+  // Calls part(context, i) exactly once for every i in [0, count), on the calling thread or
+  // others, and returns once every call has returned. Allocation-free in the implementations here.
+  virtual void Run(int count, void (*part)(void* context, int index), void* context) = 0;
+
+ protected:
+  ~ParallelRunner() = default;
+};
+
+// Every part on the calling thread, in order.
+class SerialRunner final : public ParallelRunner {
+ public:
+  void Run(int count, void (*part)(void* context, int index), void* context) override {
+    for (int i = 0; i < count; ++i) part(context, i);
+  }
+};
+
+// A team of threads of its own (for benchmarks and tools; the service runs parts on its worker
+// pool instead): the caller and `threads - 1` helpers take the parts in turn. Run is called from
+// one thread at a time.
+class ThreadTeam final : public ParallelRunner {
+ public:
+  explicit ThreadTeam(int threads);
+  ~ThreadTeam();
+  ThreadTeam(const ThreadTeam&) = delete;
+  ThreadTeam& operator=(const ThreadTeam&) = delete;
+  void Run(int count, void (*part)(void* context, int index), void* context) override;
+
+ private:
+  void Help();
+  // Takes and runs parts of the current job until none is left; called with `lock` held.
+  void RunParts(std::unique_lock<std::mutex>& lock);
+
+  std::mutex mutex_;
+  std::condition_variable wake_;  // a new job, or stopping
+  std::condition_variable done_;  // a part finished
+  void (*part_)(void*, int) = nullptr;
+  void* context_ = nullptr;
+  int count_ = 0;
+  int next_ = 0;
+  int finished_ = 0;
+  std::uint64_t job_ = 0;
+  bool stopping_ = false;
+  std::vector<std::thread> helpers_;
+};
+
+// A split of one factor's supernodes (of its symbolic analysis: the same for every factor of it).
+struct ParallelSolvePlan {
+  int parts = 0;
+  // Part p's supernodes, ascending: part_supernodes[part_offsets[p] .. part_offsets[p + 1]).
+  std::vector<int> part_offsets;
+  std::vector<int> part_supernodes;
+  std::vector<int> top;          // the other supernodes, ascending
+  std::vector<int> top_columns;  // the top's unknowns (permuted order)
+  int widest_supernode = 0;
+  // The factor's values in the top (solved on one thread), and the time predicted against Solve3
+  // ((top + largest part) / whole), both by the values read.
+  double top_share = 0;
+  double predicted_time_ratio = 1;
+};
+
+// The plan for `parts` (>= 2) parts, or a plan of 0 parts when the tree has no two subtrees to run
+// side by side.
+ParallelSolvePlan PlanParallelSolve(const SupernodalFactorView& factor, int parts);
+
+// Doubles of work ParallelSolve3 needs: per part a four-double row per unknown and room for the
+// widest supernode, and slack to align the rows.
+std::int64_t ParallelSolveWorkSize(int size, const ParallelSolvePlan& plan);
+
+// Solves P^T L L^T P x = b for three interleaved right-hand sides as Solve3 does, the parts of
+// `plan` (made for this factor's analysis, parts >= 2) through `runner`. `x` may equal `b`.
+// Allocation-free.
+void ParallelSolve3(const SupernodalFactorView& factor, const ParallelSolvePlan& plan,
+                    SolveKernel kernel, const double* b, double* x, double* work,
+                    ParallelRunner* runner);
+
+}  // namespace deform
