@@ -1,8 +1,8 @@
 // deformd: the real-time deformation server.
 //
-//   deformd [--listen ADDR] [--workers N] [--batch-frames N] [--max-vertices N] [--max-meshes N]
-//   [--max-memory-mb N]
-//           [--max-message-mb N] [--max-upload-mb N] [--log-level LEVEL]
+//   deformd [--listen ADDR] [--workers N] [--batch-frames N] [--parallel-solve-min-mb N]
+//           [--max-vertices N] [--max-meshes N] [--max-memory-mb N] [--max-message-mb N]
+//           [--max-upload-mb N] [--log-level LEVEL]
 //           [--preload MESH:SKELETON]... [--preload-phantom N]... [--shutdown-grace-s S]
 //           [--keepalive-s S] [--keepalive-timeout-s S] [--idle-timeout-s S]
 //           [--tls-cert PEM --tls-key PEM [--tls-client-ca PEM]] [--plaintext]
@@ -62,6 +62,7 @@ using deform::service::ServerOptions;
 struct Args {
   ServerOptions server;
   std::size_t max_memory_mb = 4096;
+  double parallel_solve_min_mb = 8;
   int max_message_mb = 64;
   std::size_t max_upload_mb = 256;
   double upload_idle_timeout_s = 30;
@@ -192,6 +193,11 @@ int main(int argc, char** argv) {
                  "each alone")
       ->capture_default_str()
       ->check(CLI::Range(1, 16));
+  app.add_option("--parallel-solve-min-mb", args.parallel_solve_min_mb,
+                 "A lone stream's frames of a mesh whose factor holds this many MiB or more are "
+                 "split over the idle workers")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1e9));
   app.add_option("--max-vertices", args.server.limits.max_vertices, "Largest mesh, in vertices")
       ->capture_default_str();
   app.add_option("--max-meshes", args.server.limits.max_meshes, "Meshes loaded at once")
@@ -300,6 +306,8 @@ int main(int argc, char** argv) {
   spdlog::set_level(spdlog::level::from_str(args.log_level));
   spdlog::set_pattern("[%Y-%m-%d %H:%M:%S.%e] [%^%l%$] %v");
   args.server.limits.max_memory_bytes = args.max_memory_mb << 20;
+  args.server.parallel_solve_min_factor_bytes =
+      static_cast<std::size_t>(args.parallel_solve_min_mb * 1024 * 1024);
   args.server.limits.max_upload_bytes = args.max_upload_mb << 20;
   args.server.limits.upload_idle_timeout_ms =
       static_cast<long long>(args.upload_idle_timeout_s * 1000);

@@ -19,6 +19,7 @@
 #include "service/frame_solver.h"
 #include "service/log_text.h"
 #include "service/pending_pose_slot.h"
+#include "service/pool_runner.h"
 #include "service/pose_input.h"
 #include "service/proto_conversion.h"
 #include "service/request_limits.h"
@@ -145,7 +146,8 @@ class DeformStreamReactor final : public StreamHandler,
   std::uint64_t last_stiffness_version_ = 0;
 
   // Solve-task-owned (between PendingPoseSlot::BeginRun and EndRun).
-  std::optional<FrameSolver> solver_;  // emplaced by HandleStart
+  std::optional<FrameSolver> solver_;          // emplaced by HandleStart
+  std::optional<PoolRunner> parallel_runner_;  // for a mesh with a parallel plan
   PoseInput solving_;
   std::shared_ptr<const MaterialFactorization> solve_factorization_;
   FrameStamp solve_stamp_;
@@ -260,7 +262,10 @@ void DeformStreamReactor::HandleStart() {
                                         : vertices * 3 * sizeof(float);
     MutexLock lock(&mutex_);
     buffer_bytes_ = model_->ScratchBytes() + 3 * frame_bytes +
-                    (encoded_bytes > 0 ? encoded_bytes + vertices * 8 : 0);
+                    (encoded_bytes > 0 ? encoded_bytes + vertices * 8 : 0) +
+                    (entry_->parallel_plan != nullptr
+                         ? FrameSolver::ParallelWorkBytes(*model_, *entry_->parallel_plan)
+                         : 0);
     memory_ = core_->registry.HoldMemory(caller_.tenant);
     const Status held = memory_.Resize(buffer_bytes_, "a Deform stream's buffers");
     if (!held.ok()) {
@@ -270,6 +275,10 @@ void DeformStreamReactor::HandleStart() {
   }
   // Everything a solve needs, sized once; frames in the client's vertex order.
   solver_.emplace(*model_, entry_->presentation.file_vertex_to_mesh, std::move(*encoder));
+  if (entry_->parallel_plan != nullptr) {
+    parallel_runner_.emplace(&core_->pool);
+    solver_->EnableParallel(entry_->parallel_plan.get(), &*parallel_runner_);
+  }
   spdlog::info("{} opened", log_context_);
 
   MutexLock lock(&mutex_);

@@ -35,6 +35,17 @@ FrameSolver::FrameSolver(const DeformationModel& model, const std::vector<int>& 
       bone_transforms_(static_cast<std::size_t>(codec::kFloatsPerBoneTransform) *
                        model.skeleton().num_bones()) {}
 
+void FrameSolver::EnableParallel(const ParallelSolvePlan* plan, ParallelRunner* runner) {
+  parallel_plan_ = plan;
+  parallel_runner_ = runner;
+  parallel_work_.assign(model_.default_factorization()->factor().WorkSizeParallel(*plan), 0.0);
+}
+
+std::size_t FrameSolver::ParallelWorkBytes(const DeformationModel& model,
+                                           const ParallelSolvePlan& plan) {
+  return sizeof(double) * model.default_factorization()->factor().WorkSizeParallel(plan);
+}
+
 void FrameSolver::Encode(v1::DeformFrame* frame) {
   v1::EncodedPositions* encoded = frame->mutable_encoded();
   std::string* data = encoded->mutable_data();
@@ -81,6 +92,13 @@ FrameSolver::Deformed FrameSolver::DeformPrepared(const MaterialFactorization& f
   const DeformationModel& model = solvers[0]->model_;
   const BatchScratchPool::Lease lease =
       count > 1 && scratches != nullptr ? scratches->TryAcquire() : BatchScratchPool::Lease();
+  if (count == 1 && solvers[0]->parallel_plan_ != nullptr) {
+    FrameSolver& solver = *solvers[0];
+    model.DeformParallel(factorization, solver.pose_, &solver.scratch_, *solver.parallel_plan_,
+                         solver.parallel_work_.data(), solver.parallel_runner_, &deformed.timings);
+    deformed.solve_parts = solver.parallel_plan_->parts;
+    return deformed;
+  }
   if (!lease) {
     for (int i = 0; i < count; ++i) {
       DeformTimings one;
@@ -135,6 +153,7 @@ void FrameSolver::Finish(const PoseInput& input, const Deformed& deformed, const
   frame_timings->set_solve_ms(deformed.timings.solve * 1e3);
   frame_timings->set_encode_ms(std::max(0.0, Milliseconds(Clock::now() - solved)));
   frame_timings->set_batch_frames(static_cast<std::uint32_t>(deformed.batch_frames));
+  frame_timings->set_solve_parts(static_cast<std::uint32_t>(deformed.solve_parts));
 }
 
 }  // namespace deform::service

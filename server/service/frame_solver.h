@@ -43,6 +43,13 @@ class FrameSolver {
   // Frames in the solved order.
   explicit FrameSolver(const DeformationModel& model);
 
+  // Lets a frame solved alone run on several threads: `plan` (of the model's factor analysis) and
+  // `runner` (both must outlive the solver). Allocates the parallel solve's work:
+  // ParallelWorkBytes.
+  void EnableParallel(const ParallelSolvePlan* plan, ParallelRunner* runner);
+  static std::size_t ParallelWorkBytes(const DeformationModel& model,
+                                       const ParallelSolvePlan& plan);
+
   // Solves `input` with `factorization` (one of the model's) into `frame`: its positions, or with
   // an encoder its `encoded` positions. Sized by FrameSlots::Allocate, a frame allocates nothing;
   // otherwise it is resized (allocating).
@@ -54,11 +61,13 @@ class FrameSolver {
   Status Prepare(const PoseInput& input);
   // Deforms the prepared poses of `solvers` (distinct, all of one model, prepared) with
   // `factorization`: together in passes of up to scratches->max_frames() over the factor when
-  // `scratches` lends a batch scratch and count > 1, else one by one. No allocation.
+  // `scratches` lends a batch scratch and count > 1, a lone frame on several threads when its
+  // solver has EnableParallel, else one by one. No allocation.
   struct Deformed {
     std::chrono::steady_clock::time_point start;  // when the deformation began
     DeformTimings timings;                        // all of the solvers' together
     int batch_frames = 1;                         // the largest pass's frames
+    int solve_parts = 1;                          // a lone frame split for several threads
   };
   static Deformed DeformPrepared(const MaterialFactorization& factorization,
                                  FrameSolver* const* solvers, int count,
@@ -80,6 +89,9 @@ class FrameSolver {
   DeformScratch scratch_;
   std::unique_ptr<codec::FrameEncoder> encoder_;
   std::vector<float> bone_transforms_;  // 12 per bone, for predicted frames
+  const ParallelSolvePlan* parallel_plan_ = nullptr;
+  ParallelRunner* parallel_runner_ = nullptr;
+  std::vector<double> parallel_work_;
 };
 
 }  // namespace deform::service

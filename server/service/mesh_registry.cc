@@ -173,6 +173,12 @@ StatusOr<std::shared_ptr<const MeshEntry>> MeshRegistry::Register(
         std::make_unique<BatchScratchPool>(*model, batching_.slots, batching_.max_frames);
     entry->memory_bytes += BatchScratchPool::Bytes(*model, batching_.slots, batching_.max_frames);
   }
+  if (batching_.slots >= 2 && entry->factor_bytes >= batching_.parallel_min_factor_bytes &&
+      model->default_factorization()->linear_response() == nullptr) {
+    auto plan = std::make_unique<ParallelSolvePlan>(
+        model->default_factorization()->factor().PlanParallel(batching_.slots));
+    if (plan->parts >= 2) entry->parallel_plan = std::move(plan);
+  }
   entry->model = std::move(model);
   entry->presentation = std::move(presentation);
 

@@ -63,6 +63,10 @@ struct MeshEntry {
   // The buffers of batched solves of the mesh's frames (in memory_bytes); null when its frames
   // are solved one by one (batching off, or a linear response: nothing to share).
   std::unique_ptr<BatchScratchPool> batch_scratches;
+  // The split of the mesh's solve over the workers (one part each) for a lone stream's frames;
+  // null when the mesh is too small for it to pay (SolveBatching::parallel_min_factor_bytes) or
+  // there is one worker. Streams size their parallel work for it.
+  std::unique_ptr<const ParallelSolvePlan> parallel_plan;
 
   // Vertices of frames and rest positions as clients see them (the file's).
   int client_vertex_count() const {
@@ -75,11 +79,13 @@ struct MeshEntry {
   mutable std::atomic<int> open_streams{0};
 };
 
-// How registered meshes are prepared for batched solves: `slots` batch scratches of `max_frames`
-// frames each (one per worker), none when max_frames < 2.
+// How registered meshes are prepared for the workers: `slots` batch scratches of `max_frames`
+// frames each (one per worker; none when max_frames < 2), and a parallel solve plan of `slots`
+// parts for a mesh whose factor holds at least parallel_min_factor_bytes (slots >= 2).
 struct SolveBatching {
   int slots = 0;
   int max_frames = 1;
+  std::size_t parallel_min_factor_bytes = std::size_t{8} << 20;
 };
 
 class MeshRegistry {

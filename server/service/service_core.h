@@ -79,7 +79,8 @@ struct ServiceCore {
   explicit ServiceCore(const ServerOptions& options)
       : limits(options.limits),
         registry(options.limits,
-                 {WorkerPool::ResolveThreads(options.workers), options.batch_frames}),
+                 {WorkerPool::ResolveThreads(options.workers), options.batch_frames,
+                  options.parallel_solve_min_factor_bytes}),
         pool(options.workers, options.batch_frames),
         uploads(std::chrono::milliseconds(options.limits.upload_idle_timeout_ms),
                 std::chrono::milliseconds(options.limits.upload_time_limit_ms)),

@@ -71,6 +71,10 @@ struct ServerOptions {
   // (the worker pool's batches, worker_pool.h); 1 solves every frame alone. Default: 8, where the
   // batched solve's time per frame levels off on the meshes measured (README, "Batched solves").
   int batch_frames = 8;
+  // A mesh whose factor holds at least this many bytes has its lone streams' frames split over
+  // the idle workers (parallel_solve.h; with two or more workers). Default: 8 MiB, below which the
+  // hand-over between threads costs more than it saves (README, "One big mesh on every core").
+  std::size_t parallel_solve_min_factor_bytes = std::size_t{8} << 20;
   // Largest gRPC message received or sent. Default: 64 MiB.
   int max_message_bytes = 64 << 20;
   // Where GET /metrics is served (metrics_endpoint.h), "host:port"; empty: not served. Default:

@@ -39,6 +39,11 @@ WorkerPool::~WorkerPool() {
   while (head != nullptr) head = std::move(head->next_urgent_);
 }
 
+int WorkerPool::idle_workers() {
+  MutexLock lock(&mutex_);
+  return idle_workers_;
+}
+
 void WorkerPool::PostUrgent(std::shared_ptr<UrgentTask> task) {
   {
     MutexLock lock(&mutex_);

@@ -12,8 +12,9 @@
 // task from the head of the queue also takes queued tasks with the same key and hands them to the
 // first task's RunUrgentBatch, which runs them all: its share of them when other workers are idle
 // (those take the rest, so a few tasks are spread over the free workers), up to the pool's
-// max_batch in all, looking at most kBatchScanLimit tasks deep. Nothing waits for a batch to fill: a batch is only what is
-// already queued, so a lone task runs as soon as a worker is free, as before.
+// max_batch in all, looking at most kBatchScanLimit tasks deep. Nothing waits for a batch to fill:
+// a batch is only what is already queued, so a lone task runs as soon as a worker is free, as
+// before.
 //
 // Ownership: the pool holds a reference to every task it has been given (the urgent task's
 // shared_ptr, the background task's function and its captures) until the task has run, and drops
@@ -77,6 +78,8 @@ class WorkerPool {
 
   int size() const { return thread_count_; }
   int max_batch() const { return max_batch_; }
+  // Workers waiting for work at this moment (a hint: it may change as soon as it is read).
+  int idle_workers() DEFORM_EXCLUDES(mutex_);
 
   // Queues `task` at urgent priority; the pool keeps it alive until RunUrgent() has returned.
   // Allocation-free. After Shutdown() has finished the task is kept but never runs.
@@ -101,7 +104,7 @@ class WorkerPool {
   std::deque<std::function<void()>> background_ DEFORM_GUARDED_BY(mutex_);
   int running_background_ DEFORM_GUARDED_BY(mutex_) = 0;
   int idle_workers_ DEFORM_GUARDED_BY(mutex_) = 0;  // waiting for work
-  int max_background_ = 1;  // set by the constructor, then read-only
+  int max_background_ = 1;                          // set by the constructor, then read-only
   bool stopping_ DEFORM_GUARDED_BY(mutex_) = false;
 
   int thread_count_ = 0;  // set by the constructor, then read-only

@@ -535,6 +535,39 @@ TEST_F(DeformStreamTest, ABatchLimitOfOneSolvesEveryFrameAlone) {
   for (auto& stream : streams) EXPECT_TRUE(stream->Wait().ok());
 }
 
+// A lone stream's frames of a mesh with a parallel plan (the threshold lowered to every mesh) are
+// split over the workers (FrameTimings.solve_parts) and are still the core's frames.
+TEST_F(DeformStreamTest, ALoneStreamsFramesSplitOverTheWorkersEqualTheCoreResult) {
+  service::ServerOptions options = TestServerOptions();
+  options.workers = 2;
+  options.parallel_solve_min_factor_bytes = 0;
+  StartServer(options);
+  constexpr int kVertices = 4000;
+  const std::string mesh_id = LoadPhantom(kVertices);
+  StreamRecorder recorder(/*keep_positions=*/true);
+  auto stream = client_->OpenStream(mesh_id, recorder.Callbacks());
+  std::uint64_t sequence = 0;
+  for (const int degrees : {30, 75, 120}) {
+    ASSERT_TRUE(stream->SendPose(KneePose(++sequence, degrees)));
+    ASSERT_TRUE(recorder.WaitForFrameWithSequence(sequence));
+    const v1::DeformFrame frame = recorder.last_frame();
+    EXPECT_EQ(frame.timings().solve_parts(), 2u);
+    const CoreResult core = CoreDeform(kVertices, "knee:flexion:" + std::to_string(degrees));
+    const std::vector<float> positions = client::DecodePositions(frame.positions());
+    ASSERT_EQ(positions.size(), static_cast<std::size_t>(core.positions.size()));
+    double worst = 0;
+    for (Eigen::Index i = 0; i < core.positions.rows(); ++i) {
+      for (int c = 0; c < 3; ++c) {
+        worst = std::max(worst, std::abs(positions[3 * i + c] - core.positions(i, c)));
+      }
+    }
+    EXPECT_LE(worst, 1e-6 * core.diagonal) << degrees;
+  }
+  stream->Close();
+  EXPECT_TRUE(stream->Wait().ok());
+  ExpectBackgroundStreamAlive();
+}
+
 TEST(DeformServerShutdownTest, ShutdownEndsOpenStreamsPromptly) {
   TestServer server;
   auto client = server.NewClient();

@@ -1,0 +1,41 @@
+// A ParallelRunner (core/solver/parallel_solve.h) on the service's worker pool: the parts of one
+// computation (a big mesh's frame: its right-hand side and solve) are taken by the calling worker
+// and by helper tasks posted for the workers idle at that moment, so a lone stream of a large mesh
+// gets every free core and a busy pool costs nothing: with no worker idle the caller runs every
+// part itself, and a helper that starts late finds the parts taken.
+//
+// One runner per stream (its helpers are its own tasks, posted at most once at a time, allocated
+// with the runner). Run is called by one thread at a time (the stream's solve task) and allocates
+// nothing; it returns once every part has run. The pool must outlive the runner's posted helpers
+// (the pool keeps them alive until they have run).
+#pragma once
+
+#include <condition_variable>
+#include <memory>
+#include <mutex>
+#include <vector>
+
+#include "core/solver/parallel_solve.h"
+#include "service/worker_pool.h"
+
+namespace deform::service {
+
+class PoolRunner final : public ParallelRunner {
+ public:
+  explicit PoolRunner(WorkerPool* pool);
+  ~PoolRunner();
+  PoolRunner(const PoolRunner&) = delete;
+  PoolRunner& operator=(const PoolRunner&) = delete;
+
+  void Run(int count, void (*part)(void* context, int index), void* context) override;
+
+ private:
+  struct Job;
+  class Helper;
+
+  WorkerPool* const pool_;
+  std::shared_ptr<Job> job_;                      // shared with the helpers
+  std::vector<std::shared_ptr<Helper>> helpers_;  // pool size - 1
+};
+
+}  // namespace deform::service

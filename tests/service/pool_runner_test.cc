@@ -1,0 +1,124 @@
+#include "service/pool_runner.h"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <set>
+#include <thread>
+#include <vector>
+
+#include "service/worker_pool.h"
+
+namespace deform::service {
+namespace {
+
+class FunctionTask final : public UrgentTask {
+ public:
+  explicit FunctionTask(std::function<void()> body) : body_(std::move(body)) {}
+  void RunUrgent() override { body_(); }
+
+ private:
+  std::function<void()> body_;
+};
+
+// Runs `body` on one of `pool`'s workers (as a stream's solve task does) and waits for it.
+void RunOnWorker(WorkerPool* pool, const std::function<void()>& body) {
+  std::mutex mutex;
+  std::condition_variable cv;
+  bool done = false;
+  pool->PostUrgent(std::make_shared<FunctionTask>([&] {
+    body();
+    std::lock_guard<std::mutex> lock(mutex);
+    done = true;
+    cv.notify_all();
+  }));
+  std::unique_lock<std::mutex> lock(mutex);
+  ASSERT_TRUE(cv.wait_for(lock, std::chrono::seconds(60), [&] { return done; }));
+}
+
+struct Parts {
+  std::vector<std::atomic<int>> runs = std::vector<std::atomic<int>>(16);
+  std::mutex mutex;
+  std::set<std::thread::id> threads;
+  static void Run(void* context, int index) {
+    auto* parts = static_cast<Parts*>(context);
+    parts->runs[index].fetch_add(1);
+    std::lock_guard<std::mutex> lock(parts->mutex);
+    parts->threads.insert(std::this_thread::get_id());
+  }
+};
+
+TEST(PoolRunnerTest, EveryPartRunsExactlyOnceRunAfterRun) {
+  WorkerPool pool(2);
+  PoolRunner runner(&pool);
+  RunOnWorker(&pool, [&] {
+    for (int round = 0; round < 200; ++round) {
+      Parts parts;
+      runner.Run(5, &Parts::Run, &parts);
+      for (int i = 0; i < 5; ++i) ASSERT_EQ(parts.runs[i].load(), 1) << round << " " << i;
+      for (int i = 5; i < 16; ++i) ASSERT_EQ(parts.runs[i].load(), 0);
+    }
+  });
+  pool.Shutdown();
+}
+
+// With an idle worker the parts run side by side: the first part waits until another has started
+// elsewhere (it would wait forever on one thread; the test then fails on the timeout).
+TEST(PoolRunnerTest, AnIdleWorkerTakesPartsAlongsideTheCaller) {
+  WorkerPool pool(2);
+  PoolRunner runner(&pool);
+  struct Rendezvous {
+    std::mutex mutex;
+    std::condition_variable cv;
+    std::set<std::thread::id> threads;
+    bool met = false;
+    static void Run(void* context, int) {
+      auto* r = static_cast<Rendezvous*>(context);
+      std::unique_lock<std::mutex> lock(r->mutex);
+      r->threads.insert(std::this_thread::get_id());
+      if (r->threads.size() >= 2) r->met = true;
+      r->cv.notify_all();
+      r->cv.wait_for(lock, std::chrono::seconds(10), [&] { return r->met; });
+    }
+  } rendezvous;
+  RunOnWorker(&pool, [&] { runner.Run(2, &Rendezvous::Run, &rendezvous); });
+  EXPECT_TRUE(rendezvous.met) << "the second part never ran beside the first";
+  pool.Shutdown();
+}
+
+// With every other worker busy the caller runs every part itself and does not wait for them.
+TEST(PoolRunnerTest, ABusyPoolLeavesEveryPartToTheCaller) {
+  WorkerPool pool(2);
+  PoolRunner runner(&pool);
+  std::mutex mutex;
+  std::condition_variable cv;
+  bool busy = false, release = false;
+  pool.PostUrgent(std::make_shared<FunctionTask>([&] {
+    std::unique_lock<std::mutex> lock(mutex);
+    busy = true;
+    cv.notify_all();
+    cv.wait(lock, [&] { return release; });
+  }));
+  {
+    std::unique_lock<std::mutex> lock(mutex);
+    ASSERT_TRUE(cv.wait_for(lock, std::chrono::seconds(60), [&] { return busy; }));
+  }
+  Parts parts;
+  RunOnWorker(&pool, [&] { runner.Run(4, &Parts::Run, &parts); });
+  for (int i = 0; i < 4; ++i) EXPECT_EQ(parts.runs[i].load(), 1);
+  EXPECT_EQ(parts.threads.size(), 1u);
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    release = true;
+  }
+  cv.notify_all();
+  pool.Shutdown();
+}
+
+}  // namespace
+}  // namespace deform::service
