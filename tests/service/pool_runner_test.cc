@@ -86,6 +86,12 @@ TEST(PoolRunnerTest, AnIdleWorkerTakesPartsAlongsideTheCaller) {
       r->cv.wait_for(lock, std::chrono::seconds(10), [&] { return r->met; });
     }
   } rendezvous;
+  // Both workers waiting first (a worker not yet started is not idle, and gets no helper).
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (pool.idle_workers() < 2 && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  ASSERT_EQ(pool.idle_workers(), 2);
   RunOnWorker(&pool, [&] { runner.Run(2, &Rendezvous::Run, &rendezvous); });
   EXPECT_TRUE(rendezvous.met) << "the second part never ran beside the first";
   pool.Shutdown();
