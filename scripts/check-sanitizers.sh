@@ -12,7 +12,7 @@
 #               Leaks: scripts/sanitizers/lsan.supp lists OpenMesh's one-time registry only.
 #   TSan:       build-tsan ($DEFORM_TSAN_BUILD_DIR), deform_service_tests, run on the suites in
 #               TSAN_SUITES: the frame slots, outbox, pending pose, write pump, shared reactor,
-#               stiffness switch, worker pool, registry, token table and the allocation-free
+#               stiffness switch, worker pool and its parallel runner, registry, token table and the allocation-free
 #               frame paths, where threads meet through our mutexes, condition variables and
 #               atomics, which TSan sees. The tests that start gRPC servers or channels (and
 #               deform_hostile_client_tests, deformd) are not run under TSan: Debian's gRPC,
@@ -36,7 +36,7 @@ only="${1:-all}"  # all, asan or tsan
 # What ctest runs in build-asan: every test program, and what the process tests execute.
 TSAN_SUITES=(AnnotatedMutexTest DeformOutboxTest FrameSlotsTest FrameSolverTest PendingPoseSlotTest
   PoseInputTest SharedReactorTest StiffnessSwitchTest StreamWritePumpTest WorkerPoolTest
-  MeshRegistryTest StatusMappingTest TokenTableTest)
+  MeshRegistryTest StatusMappingTest TokenTableTest PoolRunnerTest)
 
 scripts/install-deps.sh scripts/packages/build.txt scripts/packages/checks.txt
 launcher=()
