@@ -89,29 +89,39 @@ StatusOr<CholeskyFactor::ColumnFactor> CholeskyFactor::UpLookingCholesky(
 // Packs `l` into supernodal blocks (the layout in the class comment).
 void CholeskyFactor::PackSupernodes(const SymbolicCholesky& s, const ColumnFactor& l) {
   const int num_supernodes = static_cast<int>(s.supernode_columns_.size()) - 1;
+  // Supernode sn's rows: its own columns, then its last column's pattern below that column (every
+  // member column's pattern lies in them: symbolic_cholesky.cc, SupernodeColumns).
+  const auto rows_of = [&](int sn) {
+    const int first = s.supernode_columns_[sn], last = s.supernode_columns_[sn + 1] - 1;
+    return static_cast<std::int64_t>(last - first) + s.column_pointers_[last + 1] -
+           s.column_pointers_[last];
+  };
   row_pointers_.assign(num_supernodes + 1, 0);
   value_pointers_.assign(num_supernodes + 1, 0);
   for (int sn = 0; sn < num_supernodes; ++sn) {
-    const int first = s.supernode_columns_[sn];
-    const int width = s.supernode_columns_[sn + 1] - first;
-    const std::int64_t rows = s.column_pointers_[first + 1] - s.column_pointers_[first];
-    row_pointers_[sn + 1] = row_pointers_[sn] + rows;
-    value_pointers_[sn + 1] = value_pointers_[sn] + rows * width;
+    const int width = s.supernode_columns_[sn + 1] - s.supernode_columns_[sn];
+    row_pointers_[sn + 1] = row_pointers_[sn] + rows_of(sn);
+    value_pointers_[sn + 1] = value_pointers_[sn] + rows_of(sn) * width;
   }
   row_indices_.resize(row_pointers_.back());
   values_.assign(value_pointers_.back() + kSolveValuePadding, 0.0);
+  std::vector<std::int64_t> position(static_cast<std::size_t>(s.n_), -1);  // row -> block row
   for (int sn = 0; sn < num_supernodes; ++sn) {
     const int first = s.supernode_columns_[sn];
-    const int width = s.supernode_columns_[sn + 1] - first;
-    const std::int64_t rows = row_pointers_[sn + 1] - row_pointers_[sn];
-    std::copy(l.rows.begin() + s.column_pointers_[first],
-              l.rows.begin() + s.column_pointers_[first + 1],
-              row_indices_.begin() + row_pointers_[sn]);
+    const int last = s.supernode_columns_[sn + 1] - 1;
+    const int width = last - first + 1;
+    int* rows = row_indices_.data() + row_pointers_[sn];
+    for (int c = 0; c < width - 1; ++c) rows[c] = first + c;
+    std::copy(l.rows.begin() + s.column_pointers_[last],
+              l.rows.begin() + s.column_pointers_[last + 1], rows + (width - 1));
+    const std::int64_t count = row_pointers_[sn + 1] - row_pointers_[sn];
+    for (std::int64_t k = 0; k < count; ++k) position[rows[k]] = k;
     double* block = values_.data() + value_pointers_[sn];
     for (int c = 0; c < width; ++c) {
-      // Column first + c holds the block's rows c.. (its pattern is the supernode's minus c rows).
-      const std::int64_t begin = s.column_pointers_[first + c];
-      for (std::int64_t k = c; k < rows; ++k) block[k * width + c] = l.values[begin + (k - c)];
+      for (std::int64_t p = s.column_pointers_[first + c]; p < s.column_pointers_[first + c + 1];
+           ++p) {
+        block[position[l.rows[p]] * width + c] = l.values[p];
+      }
     }
   }
 }

@@ -563,6 +563,11 @@ void Solve3Impl(const SupernodalFactorView& f, const double* b, double* x, doubl
 // rows are kVecs four-double vectors wide (columns padded with zeros to a multiple of four), and
 // each factor value multiplies a whole row of them.
 
+// Widest solution rows (in four-double vectors) whose updates are register-blocked two at a time:
+// two rows' (or columns') sums of kVecs vectors each, the broadcasts and a load fit the sixteen
+// AVX registers.
+constexpr int kMaxBlockedVecs = 6;
+
 // Forward pass of one supernode: its diagonal block solves its own rows (contiguous in y), then
 // every row below subtracts its block row times them.
 template <int kVecs>
@@ -583,7 +588,36 @@ inline void ForwardSupernodeMany(const SupernodeBlock& s, double* __restrict y) 
     const Vec4 pivot = Splat4(row[c]);
     for (int j = 0; j < kVecs; ++j) Store4(target + 4 * j, sum[j] / pivot);
   }
-  for (std::int64_t r = width; r < s.num_rows; ++r) {
+  std::int64_t r = width;
+  if constexpr (kVecs <= kMaxBlockedVecs) {
+    // Two rows at a time: each load of the solved rows serves both (register blocking).
+    for (; r + 2 <= s.num_rows; r += 2) {
+      const double* row0 = s.values + r * width;
+      const double* row1 = row0 + width;
+      double* target0 = y + kStride * static_cast<std::ptrdiff_t>(s.rows[r]);
+      double* target1 = y + kStride * static_cast<std::ptrdiff_t>(s.rows[r + 1]);
+      Vec4 sum0[kVecs], sum1[kVecs];
+      for (int j = 0; j < kVecs; ++j) {
+        sum0[j] = Load4(target0 + 4 * j);
+        sum1[j] = Load4(target1 + 4 * j);
+      }
+      for (int k = 0; k < width; ++k) {
+        const Vec4 l0 = Splat4(row0[k]);
+        const Vec4 l1 = Splat4(row1[k]);
+        const double* known = own + kStride * k;
+        for (int j = 0; j < kVecs; ++j) {
+          const Vec4 v = Load4(known + 4 * j);
+          sum0[j] -= l0 * v;
+          sum1[j] -= l1 * v;
+        }
+      }
+      for (int j = 0; j < kVecs; ++j) {
+        Store4(target0 + 4 * j, sum0[j]);
+        Store4(target1 + 4 * j, sum1[j]);
+      }
+    }
+  }
+  for (; r < s.num_rows; ++r) {
     const double* row = s.values + r * width;
     double* target = y + kStride * static_cast<std::ptrdiff_t>(s.rows[r]);
     Vec4 sum[kVecs];
@@ -605,7 +639,31 @@ inline void BackwardSupernodeMany(const SupernodeBlock& s, double* __restrict y)
   constexpr int kStride = 4 * kVecs;
   double* __restrict own = y + kStride * static_cast<std::ptrdiff_t>(s.first);
   const int width = s.width;
-  for (int k = 0; k < width; ++k) {
+  int k = 0;
+  if constexpr (kVecs <= kMaxBlockedVecs) {
+    // Two columns of the block at a time: each load of a solved row serves both.
+    for (; k + 2 <= width; k += 2) {
+      Vec4 sum0[kVecs], sum1[kVecs];
+      for (int j = 0; j < kVecs; ++j) sum0[j] = sum1[j] = Splat4(0);
+      for (std::int64_t r = width; r < s.num_rows; ++r) {
+        const Vec4 l0 = Splat4(s.values[r * width + k]);
+        const Vec4 l1 = Splat4(s.values[r * width + k + 1]);
+        const double* solved = y + kStride * static_cast<std::ptrdiff_t>(s.rows[r]);
+        for (int j = 0; j < kVecs; ++j) {
+          const Vec4 v = Load4(solved + 4 * j);
+          sum0[j] += l0 * v;
+          sum1[j] += l1 * v;
+        }
+      }
+      double* target0 = own + kStride * k;
+      double* target1 = target0 + kStride;
+      for (int j = 0; j < kVecs; ++j) {
+        Store4(target0 + 4 * j, Load4(target0 + 4 * j) - sum0[j]);
+        Store4(target1 + 4 * j, Load4(target1 + 4 * j) - sum1[j]);
+      }
+    }
+  }
+  for (; k < width; ++k) {
     Vec4 sum[kVecs];
     for (int j = 0; j < kVecs; ++j) sum[j] = Splat4(0);
     for (std::int64_t r = width; r < s.num_rows; ++r) {
