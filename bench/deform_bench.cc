@@ -145,6 +145,21 @@ void BM_TriangularSolve(benchmark::State& state, BenchMesh mesh, SolveKernel ker
   ReportAgainstBound(state, factor.bytes(), seconds);
 }
 
+// Solve3 on `rhs`, timed max(runs, 20) times after another benchmark's timed loop, for the
+// comparisons made in one benchmark (each run's wall time in seconds).
+template <typename Rhs>
+std::vector<double> TimeSolve3(const CholeskyFactor& factor, const Rhs& rhs, DeformScratch* scratch,
+                               std::size_t runs) {
+  std::vector<double> seconds;
+  for (std::size_t run = 0; run < std::max<std::size_t>(runs, 20); ++run) {
+    const auto start = Clock::now();
+    benchmark::DoNotOptimize(
+        factor.Solve3(rhs.data(), scratch->solution.data(), scratch->solve_work.data()));
+    seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
+  }
+  return seconds;
+}
+
 // `frames` frames' two triangular passes in one batch (CholeskyFactor::SolveMany over 3 * frames
 // columns), the right-hand sides those of the benchmark pose. Besides the counters of the other
 // solves (median_ms and the bounds are per batch): frame_ms, the median per frame;
@@ -166,13 +181,7 @@ void BM_BatchedSolve(benchmark::State& state, BenchMesh mesh, int frames_per_bat
   const auto seconds = TimeEach(state, [&] {
     benchmark::DoNotOptimize(factor.SolveMany(batch.data(), solved.data(), columns, work.data()));
   });
-  std::vector<double> unbatched;
-  for (std::size_t run = 0; run < std::max<std::size_t>(seconds.size(), 20); ++run) {
-    const auto start = Clock::now();
-    benchmark::DoNotOptimize(
-        factor.Solve3(rhs.data(), scratch.solution.data(), scratch.solve_work.data()));
-    unbatched.push_back(std::chrono::duration<double>(Clock::now() - start).count());
-  }
+  const std::vector<double> unbatched = TimeSolve3(factor, rhs, &scratch, seconds.size());
   ReportAgainstBound(state, factor.bytes(), seconds);
   const double frame_ms = Median(seconds) * 1e3 / frames_per_batch;
   state.counters["frames"] = frames_per_batch;
@@ -202,13 +211,7 @@ void BM_ParallelSolve(benchmark::State& state, BenchMesh mesh, int parts) {
         factor.Solve3Parallel(plan, rhs.data(), scratch.solution.data(), work.data(), &team));
   });
   const Eigen::MatrixXd parallel_result = scratch.solution;  // (the last timed run's)
-  std::vector<double> serial;
-  for (std::size_t run = 0; run < std::max<std::size_t>(seconds.size(), 20); ++run) {
-    const auto start = Clock::now();
-    benchmark::DoNotOptimize(
-        factor.Solve3(rhs.data(), scratch.solution.data(), scratch.solve_work.data()));
-    serial.push_back(std::chrono::duration<double>(Clock::now() - start).count());
-  }
+  const std::vector<double> serial = TimeSolve3(factor, rhs, &scratch, seconds.size());
   ReportAgainstBound(state, factor.bytes(), seconds);
   // The parallel solve's difference from Solve3's, relative to the solution's norm.
   state.counters["relative_difference"] =

@@ -57,6 +57,28 @@ double MaxDifference(const std::vector<float>& a, const std::vector<float>& b) {
   return worst;
 }
 
+// The largest coordinate difference between a frame's float32 positions and the core's result.
+double DistanceFromCore(const std::vector<float>& positions, const CoreResult& core) {
+  EXPECT_EQ(positions.size(), static_cast<std::size_t>(core.positions.size()));
+  double worst = 0;
+  for (Eigen::Index i = 0; i < core.positions.rows(); ++i) {
+    for (int c = 0; c < 3 && static_cast<std::size_t>(3 * i + c) < positions.size(); ++c) {
+      worst = std::max(worst, std::abs(positions[3 * i + c] - core.positions(i, c)));
+    }
+  }
+  return worst;
+}
+
+// Opens `count` streams on `mesh_id` through `client`, each with its own recorder.
+void OpenStreams(client::DeformClient* client, const std::string& mesh_id, int count,
+                 bool keep_positions, std::vector<std::unique_ptr<StreamRecorder>>* recorders,
+                 std::vector<std::unique_ptr<client::DeformStream>>* streams) {
+  for (int s = 0; s < count; ++s) {
+    recorders->push_back(std::make_unique<StreamRecorder>(keep_positions));
+    streams->push_back(client->OpenStream(mesh_id, recorders->back()->Callbacks()));
+  }
+}
+
 class DeformStreamTest : public ServiceTest {};
 
 TEST_F(DeformStreamTest, FrameEqualsTheCoreResultForTheSamePose) {
@@ -470,10 +492,7 @@ TEST_F(DeformStreamTest, StreamsSolvedInOneBatchEachGetTheirOwnPosesFrame) {
   const std::string mesh_id = LoadPhantom(kVertices);
   std::vector<std::unique_ptr<StreamRecorder>> recorders;
   std::vector<std::unique_ptr<client::DeformStream>> streams;
-  for (int s = 0; s < kStreams; ++s) {
-    recorders.push_back(std::make_unique<StreamRecorder>(/*keep_positions=*/true));
-    streams.push_back(client_->OpenStream(mesh_id, recorders.back()->Callbacks()));
-  }
+  OpenStreams(client_.get(), mesh_id, kStreams, /*keep_positions=*/true, &recorders, &streams);
   std::vector<CoreResult> expected;  // per stream: the knee at 15 * (s + 1) degrees
   for (int s = 0; s < kStreams; ++s) {
     expected.push_back(CoreDeform(kVertices, "knee:flexion:" + std::to_string(15 * (s + 1))));
@@ -487,16 +506,9 @@ TEST_F(DeformStreamTest, StreamsSolvedInOneBatchEachGetTheirOwnPosesFrame) {
       ASSERT_TRUE(recorders[s]->WaitForFrameWithSequence(round)) << s;
       const v1::DeformFrame frame = recorders[s]->last_frame();
       largest_batch = std::max(largest_batch, frame.timings().batch_frames());
-      const std::vector<float> positions = client::DecodePositions(frame.positions());
       const CoreResult& core = expected[s];
-      ASSERT_EQ(positions.size(), static_cast<std::size_t>(core.positions.size()));
-      double worst = 0;
-      for (Eigen::Index i = 0; i < core.positions.rows(); ++i) {
-        for (int c = 0; c < 3; ++c) {
-          worst = std::max(worst, std::abs(positions[3 * i + c] - core.positions(i, c)));
-        }
-      }
-      EXPECT_LE(worst, 1e-6 * core.diagonal)
+      EXPECT_LE(DistanceFromCore(client::DecodePositions(frame.positions()), core),
+                1e-6 * core.diagonal)
           << "stream " << s << " round " << round << " batch " << frame.timings().batch_frames();
     }
   }
@@ -518,10 +530,7 @@ TEST_F(DeformStreamTest, ABatchLimitOfOneSolvesEveryFrameAlone) {
   constexpr int kStreams = 4;
   std::vector<std::unique_ptr<StreamRecorder>> recorders;
   std::vector<std::unique_ptr<client::DeformStream>> streams;
-  for (int s = 0; s < kStreams; ++s) {
-    recorders.push_back(std::make_unique<StreamRecorder>());
-    streams.push_back(client_->OpenStream(mesh_id, recorders.back()->Callbacks()));
-  }
+  OpenStreams(client_.get(), mesh_id, kStreams, /*keep_positions=*/false, &recorders, &streams);
   for (std::uint64_t round = 1; round <= 10; ++round) {
     for (auto& stream : streams) ASSERT_TRUE(stream->SendPose(KneePose(round, 5.0 * round)));
   }
@@ -553,15 +562,9 @@ TEST_F(DeformStreamTest, ALoneStreamsFramesSplitOverTheWorkersEqualTheCoreResult
     const v1::DeformFrame frame = recorder.last_frame();
     EXPECT_EQ(frame.timings().solve_parts(), 2u);
     const CoreResult core = CoreDeform(kVertices, "knee:flexion:" + std::to_string(degrees));
-    const std::vector<float> positions = client::DecodePositions(frame.positions());
-    ASSERT_EQ(positions.size(), static_cast<std::size_t>(core.positions.size()));
-    double worst = 0;
-    for (Eigen::Index i = 0; i < core.positions.rows(); ++i) {
-      for (int c = 0; c < 3; ++c) {
-        worst = std::max(worst, std::abs(positions[3 * i + c] - core.positions(i, c)));
-      }
-    }
-    EXPECT_LE(worst, 1e-6 * core.diagonal) << degrees;
+    EXPECT_LE(DistanceFromCore(client::DecodePositions(frame.positions()), core),
+              1e-6 * core.diagonal)
+        << degrees;
   }
   stream->Close();
   EXPECT_TRUE(stream->Wait().ok());

@@ -13,18 +13,10 @@
 #include <vector>
 
 #include "service/worker_pool.h"
+#include "tests/service/function_task.h"
 
 namespace deform::service {
 namespace {
-
-class FunctionTask final : public UrgentTask {
- public:
-  explicit FunctionTask(std::function<void()> body) : body_(std::move(body)) {}
-  void RunUrgent() override { body_(); }
-
- private:
-  std::function<void()> body_;
-};
 
 // Runs `body` on one of `pool`'s workers (as a stream's solve task does) and waits for it.
 void RunOnWorker(WorkerPool* pool, const std::function<void()>& body) {

@@ -12,6 +12,10 @@
 #include <thread>
 #include <vector>
 
+#include "tests/service/function_task.h"
+
+#include "tests/service/function_task.h"
+
 namespace deform::service {
 namespace {
 
@@ -32,15 +36,6 @@ class Gate {
   std::mutex mutex_;
   std::condition_variable cv_;
   bool open_ = false;
-};
-
-class FunctionTask final : public UrgentTask {
- public:
-  explicit FunctionTask(std::function<void()> body) : body_(std::move(body)) {}
-  void RunUrgent() override { body_(); }
-
- private:
-  std::function<void()> body_;
 };
 
 class EventLog {

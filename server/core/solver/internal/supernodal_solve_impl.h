@@ -449,87 +449,56 @@ inline SupernodeBlock BlockOf(const SupernodalFactorView& f, int sn) {
       f.row_pointers[sn + 1] - f.row_pointers[sn], f.values + f.value_pointers[sn]};
 }
 
-// L y = P b, one pass over the factor (y holds P b on entry).
-inline void ForwardPass(const SupernodalFactorView& f, double* __restrict y,
-                        double* planar_buffer) {
-  for (int sn = 0; sn < f.num_supernodes; ++sn) {
-    const SupernodeBlock s = BlockOf(f, sn);
-    const Planar p = PlanarOf(planar_buffer, s.width);
-    ForwardDiagonal(s.values, s.width, Row(y, s.first), p);
-    if (s.width > 4) {
-      ForwardUpdate(s.values, s.rows, s.width, s.num_rows, p, y);
-    } else {
-      DispatchNarrow(s.width, [&](auto w) {
-        ForwardUpdateNarrow<decltype(w)::value>(s.values, s.rows, s.num_rows, p, y);
-      });
-    }
+// Supernode sn's step of the forward pass (L y = P b): its diagonal block solves its rows of y,
+// which then update the rows below.
+inline void ForwardSupernode(const SupernodalFactorView& f, int sn, double* __restrict y,
+                             double* planar_buffer) {
+  const SupernodeBlock s = BlockOf(f, sn);
+  const Planar p = PlanarOf(planar_buffer, s.width);
+  ForwardDiagonal(s.values, s.width, Row(y, s.first), p);
+  if (s.width > 4) {
+    ForwardUpdate(s.values, s.rows, s.width, s.num_rows, p, y);
+  } else {
+    DispatchNarrow(s.width, [&](auto w) {
+      ForwardUpdateNarrow<decltype(w)::value>(s.values, s.rows, s.num_rows, p, y);
+    });
   }
 }
 
-// L^T z = y in place, one pass over the factor backwards.
-inline void BackwardPass(const SupernodalFactorView& f, double* __restrict y,
-                         double* planar_buffer) {
-  for (int sn = f.num_supernodes - 1; sn >= 0; --sn) {
-    const SupernodeBlock s = BlockOf(f, sn);
-    const Planar p = PlanarOf(planar_buffer, s.width);
-    double* ys = Row(y, s.first);
-    for (int k = 0; k < s.width; ++k) {
-      const double* t = Row(ys, k);
-      p.x[k] = t[0];
-      p.y[k] = t[1];
-      p.z[k] = t[2];
-    }
-    if (s.width > 4) {
-      BackwardUpdate(s.values, s.rows, s.width, s.num_rows, p, y);
-    } else {
-      DispatchNarrow(s.width, [&](auto w) {
-        BackwardUpdateNarrow<decltype(w)::value>(s.values, s.rows, s.num_rows, p, y);
-      });
-    }
-    BackwardDiagonal(s.values, s.width, ys, p);
+// Supernode sn's step of the backward pass (L^T z = y): its rows subtract the rows below times
+// their solved values, then the transposed diagonal block solves them.
+inline void BackwardSupernode(const SupernodalFactorView& f, int sn, double* __restrict y,
+                              double* planar_buffer) {
+  const SupernodeBlock s = BlockOf(f, sn);
+  const Planar p = PlanarOf(planar_buffer, s.width);
+  double* ys = Row(y, s.first);
+  for (int k = 0; k < s.width; ++k) {
+    const double* t = Row(ys, k);
+    p.x[k] = t[0];
+    p.y[k] = t[1];
+    p.z[k] = t[2];
   }
+  if (s.width > 4) {
+    BackwardUpdate(s.values, s.rows, s.width, s.num_rows, p, y);
+  } else {
+    DispatchNarrow(s.width, [&](auto w) {
+      BackwardUpdateNarrow<decltype(w)::value>(s.values, s.rows, s.num_rows, p, y);
+    });
+  }
+  BackwardDiagonal(s.values, s.width, ys, p);
 }
 
 // The forward pass over the listed supernodes only (ascending), on solution rows `y` (aligned
-// as Solve3Impl's); the parallel solve's part (supernodal_solve.h, ParallelSolve).
+// as Solve3Impl's); the parallel solve's part (parallel_solve.h).
 void ForwardListImpl(const SupernodalFactorView& f, const int* supernodes, int count, double* y,
                      double* planar_buffer) {
-  for (int i = 0; i < count; ++i) {
-    const SupernodeBlock s = BlockOf(f, supernodes[i]);
-    const Planar p = PlanarOf(planar_buffer, s.width);
-    ForwardDiagonal(s.values, s.width, Row(y, s.first), p);
-    if (s.width > 4) {
-      ForwardUpdate(s.values, s.rows, s.width, s.num_rows, p, y);
-    } else {
-      DispatchNarrow(s.width, [&](auto w) {
-        ForwardUpdateNarrow<decltype(w)::value>(s.values, s.rows, s.num_rows, p, y);
-      });
-    }
-  }
+  for (int i = 0; i < count; ++i) ForwardSupernode(f, supernodes[i], y, planar_buffer);
 }
 
 // The backward pass over the listed supernodes only (taken in descending order).
 void BackwardListImpl(const SupernodalFactorView& f, const int* supernodes, int count, double* y,
                       double* planar_buffer) {
-  for (int i = count - 1; i >= 0; --i) {
-    const SupernodeBlock s = BlockOf(f, supernodes[i]);
-    const Planar p = PlanarOf(planar_buffer, s.width);
-    double* ys = Row(y, s.first);
-    for (int k = 0; k < s.width; ++k) {
-      const double* t = Row(ys, k);
-      p.x[k] = t[0];
-      p.y[k] = t[1];
-      p.z[k] = t[2];
-    }
-    if (s.width > 4) {
-      BackwardUpdate(s.values, s.rows, s.width, s.num_rows, p, y);
-    } else {
-      DispatchNarrow(s.width, [&](auto w) {
-        BackwardUpdateNarrow<decltype(w)::value>(s.values, s.rows, s.num_rows, p, y);
-      });
-    }
-    BackwardDiagonal(s.values, s.width, ys, p);
-  }
+  for (int i = count - 1; i >= 0; --i) BackwardSupernode(f, supernodes[i], y, planar_buffer);
 }
 
 void Solve3Impl(const SupernodalFactorView& f, const double* b, double* x, double* work) {
@@ -546,8 +515,8 @@ void Solve3Impl(const SupernodalFactorView& f, const double* b, double* x, doubl
     t[2] = source[2];
     t[3] = 0;
   }
-  ForwardPass(f, y, planar_buffer);
-  BackwardPass(f, y, planar_buffer);
+  for (int sn = 0; sn < f.num_supernodes; ++sn) ForwardSupernode(f, sn, y, planar_buffer);
+  for (int sn = f.num_supernodes - 1; sn >= 0; --sn) BackwardSupernode(f, sn, y, planar_buffer);
   for (int i = 0; i < n; ++i) {
     double* target = x + 3 * static_cast<std::ptrdiff_t>(f.permutation[i]);
     const double* t = Row(y, i);
