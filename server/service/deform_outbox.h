@@ -67,7 +67,8 @@ class DeformOutbox {
   }
   // Whether the backlog drained to half its bounds (when a stream that stopped reading resumes).
   bool notice_backlog_drained() const {
-    return notices_.size() <= kMaxNoticeBacklog / 2 && backlog_bytes_ <= kMaxNoticeBacklogBytes / 2;
+    return notices_.size() <= kMaxNoticeBacklog / 2 &&
+           backlog_bytes_ <= kMaxNoticeBacklogBytes / 2;
   }
   // Serialised bytes of the unwritten notices.
   std::size_t notice_backlog_bytes() const { return backlog_bytes_; }

@@ -108,9 +108,10 @@ Status DeformServer::Start() {
   if (!impl_->options.metrics_address.empty()) {
     ServiceCore* core = &impl_->core;
     DEFORM_ASSIGN_OR_RETURN(
-        impl_->metrics, MetricsEndpoint::Start(impl_->options.metrics_address,
-                                               impl_->options.security.allow_plaintext, &core->auth,
-                                               [core] { return RenderMetrics(core); }));
+        impl_->metrics,
+        MetricsEndpoint::Start(impl_->options.metrics_address,
+                               impl_->options.security.allow_plaintext, &core->auth,
+                               [core] { return RenderMetrics(core); }));
   }
   impl_->server = builder.BuildAndStart();
   if (impl_->server == nullptr || impl_->port == 0) {

@@ -31,10 +31,9 @@ class DeformServer {
 
   // Binds options.listen_address and starts serving, with TLS or plaintext as options.security
   // says (transport_security.h), and GET /metrics on options.metrics_address if given (plain HTTP,
-  // loopback unless allow_plaintext: metrics_endpoint.h). FAILED_PRECONDITION if the address cannot
-  // be bound, the server was already started, or the transport policy refuses (plaintext on a
-  // non-loopback address without allow_plaintext); NOT_FOUND for an unreadable certificate or key
-  // file.
+  // loopback unless allow_plaintext: metrics_endpoint.h). FAILED_PRECONDITION if the address cannot be bound, the server
+  // was already started, or the transport policy refuses (plaintext on a non-loopback address
+  // without allow_plaintext); NOT_FOUND for an unreadable certificate or key file.
   Status Start();
   // The bound port (useful with port 0), or 0 before Start().
   int port() const;

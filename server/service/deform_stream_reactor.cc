@@ -47,7 +47,8 @@ void CountWritten(const v1::DeformResponse& message, ServiceMetrics* metrics) {
   const double server_ms = t.queue_ms() + t.rhs_ms() + t.solve_ms() + t.encode_ms();
   const int encoding =
       frame.has_encoded() ? frame.encoded().encoding() : v1::FRAME_ENCODING_FLOAT32;
-  metrics->FrameWritten(encoding, message.ByteSizeLong(), server_ms * 1e-3, frame.skipped_poses());
+  metrics->FrameWritten(encoding, message.ByteSizeLong(), server_ms * 1e-3,
+                        frame.skipped_poses());
 }
 
 // The reactor coordinates the stream's parts; each part states its own contract:
@@ -366,9 +367,9 @@ void DeformStreamReactor::StartRefactorLocked(StiffnessSwitch::Update update) {
   if (!held.ok()) {
     spdlog::info("{} stiffness version {} rejected: {}", log_context_, update.version,
                  held.message());
-    outbox_.AddNotice(
-        v1::Notice::KIND_STIFFNESS_REJECTED, 0, update.version,
-        "stiffness version " + std::to_string(update.version) + ": " + held.message());
+    outbox_.AddNotice(v1::Notice::KIND_STIFFNESS_REJECTED, 0, update.version,
+                      "stiffness version " + std::to_string(update.version) + ": " +
+                          held.message());
     return;
   }
   stiffness_.RefactorStarted();

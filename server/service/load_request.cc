@@ -1,15 +1,16 @@
 #include "service/load_request.h"
 
+#include <utility>
+
 #include <algorithm>
 #include <climits>
-#include <utility>
 
 #include "core/geometry/skeleton.h"
 #include "core/io/declared_mesh_size.h"
+#include "core/model/deformation_model.h"
 #include "core/io/phantom.h"
 #include "core/io/rig_import.h"
 #include "core/io/skeleton_io.h"
-#include "core/model/deformation_model.h"
 #include "service/load_header.h"
 #include "service/proto_conversion.h"
 
@@ -106,8 +107,9 @@ StatusOr<std::size_t> DeclaredLoadBytes(const v1::LoadMeshHeader& header,
   const auto clamp = [](std::size_t count) {
     return static_cast<int>(std::min<std::size_t>(count, INT_MAX));
   };
-  return mesh_bytes.size() + DeformationModel::EstimateBytesBeforeBuild(clamp(declared->vertices),
-                                                                        clamp(declared->faces));
+  return mesh_bytes.size() +
+         DeformationModel::EstimateBytesBeforeBuild(clamp(declared->vertices),
+                                                    clamp(declared->faces));
 }
 
 }  // namespace deform::service

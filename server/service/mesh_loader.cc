@@ -15,8 +15,8 @@ double MillisecondsSince(std::chrono::steady_clock::time_point start) {
 }
 
 StatusOr<std::shared_ptr<const MeshEntry>> Build(MeshRegistry* registry,
-                                                 MeshRegistry::Reservation reservation, LoadJob job,
-                                                 const LoadProgress& progress) {
+                                                 MeshRegistry::Reservation reservation,
+                                                 LoadJob job, const LoadProgress& progress) {
   job.options.limits.max_vertices = registry->limits().max_vertices;
   const std::size_t bytes_before_build =
       DeformationModel::EstimateBytesBeforeBuild(job.mesh.num_vertices(), job.mesh.num_triangles());
@@ -24,7 +24,8 @@ StatusOr<std::shared_ptr<const MeshEntry>> Build(MeshRegistry* registry,
   BuildHooks hooks;
   hooks.validated = [&] {
     DEFORM_RETURN_IF_ERROR(registry->ReserveMemory(
-        &reservation, bytes_before_build, "a mesh of " + std::to_string(vertices) + " vertices"));
+        &reservation, bytes_before_build,
+        "a mesh of " + std::to_string(vertices) + " vertices"));
     if (progress) progress(LoadStage::kValidated, MillisecondsSince(job.start));
     return Status::Ok();
   };
@@ -43,12 +44,12 @@ StatusOr<std::shared_ptr<const MeshEntry>> Build(MeshRegistry* registry,
   spdlog::info(
       "mesh={} tenant={} name='{}' loaded: {} vertices, precompute {:.1f} ms, factor {:.1f} ms, "
       "about {} KiB",
-      entry->id, EscapeForLog(entry->tenant), EscapeForLog(entry->name), vertices,
-      entry->precompute_ms, entry->factor_ms, entry->memory_bytes >> 10);
+      entry->id, EscapeForLog(entry->tenant), EscapeForLog(entry->name), vertices, entry->precompute_ms, entry->factor_ms,
+      entry->memory_bytes >> 10);
   std::string phases;
   for (const DeformationModel::BuildPhase& phase : entry->model->build_phases()) {
-    phases +=
-        fmt::format("{}{} {:.0f} ms", phases.empty() ? "" : ", ", phase.name, phase.seconds * 1e3);
+    phases += fmt::format("{}{} {:.0f} ms", phases.empty() ? "" : ", ", phase.name,
+                          phase.seconds * 1e3);
   }
   spdlog::debug("mesh={} build phases: {}", entry->id, phases);
   for (const std::string& warning : entry->model->binding_report().warnings) {

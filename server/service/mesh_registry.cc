@@ -129,11 +129,12 @@ Status MeshRegistry::CheckMemoryLocked(std::size_t bytes, std::size_t held,
   }
   if (limits_.tenant_max_memory_bytes > 0) {
     const auto it = tenants_.find(tenant);
-    const std::size_t used = it == tenants_.end()
-                                 ? 0
-                                 : it->second.memory_bytes + it->second.reserved_memory_bytes +
-                                       it->second.stream_memory_bytes - held;
-    if (bytes > limits_.tenant_max_memory_bytes || used > limits_.tenant_max_memory_bytes - bytes) {
+    const std::size_t used =
+        it == tenants_.end() ? 0
+                             : it->second.memory_bytes + it->second.reserved_memory_bytes +
+                                   it->second.stream_memory_bytes - held;
+    if (bytes > limits_.tenant_max_memory_bytes ||
+        used > limits_.tenant_max_memory_bytes - bytes) {
       return Status::ResourceExhausted(
           "tenant memory budget exceeded (--tenant-max-memory-mb): " + what + " needs about " +
           MebiBytes(bytes) + ", " + MebiBytes(used) + " of the tenant's " +

@@ -68,10 +68,9 @@ Status PoseInputFromProto(const v1::PoseUpdate& update, const Skeleton& skeleton
   for (const v1::JointRotation& rotation : update.rotations()) {
     auto joint = skeleton.FindJoint(rotation.joint());
     if (!joint.ok()) return Status::InvalidArgument("rotation: " + joint.status().message());
-    DEFORM_ASSIGN_OR_RETURN(
-        const Eigen::Quaterniond q,
-        UnitQuaternion(rotation.w(), rotation.x(), rotation.y(), rotation.z(),
-                       "rotation of joint '" + EchoForClient(rotation.joint()) + "'"));
+    DEFORM_ASSIGN_OR_RETURN(const Eigen::Quaterniond q,
+                            UnitQuaternion(rotation.w(), rotation.x(), rotation.y(), rotation.z(),
+                                           "rotation of joint '" + EchoForClient(rotation.joint()) + "'"));
     input->rotations.emplace_back(*joint, q);
   }
   for (const v1::JointAngle& angle : update.angles()) {

@@ -28,15 +28,15 @@ int ActiveStreams::count() const {
 Status TenantStreamQuota::Acquire(const std::string& tenant) {
   MutexLock lock(&mutex_);
   if (max_total_ > 0 && total_ >= max_total_) {
-    return Status::ResourceExhausted(
-        "server stream limit reached (--max-streams): " + std::to_string(total_) +
-        " streams open, of at most " + std::to_string(max_total_));
+    return Status::ResourceExhausted("server stream limit reached (--max-streams): " +
+                                     std::to_string(total_) + " streams open, of at most " +
+                                     std::to_string(max_total_));
   }
   int& open = open_[tenant];
   if (max_per_tenant_ > 0 && open >= max_per_tenant_) {
-    return Status::ResourceExhausted(
-        "tenant stream limit reached (--tenant-max-streams): " + std::to_string(open) +
-        " streams open, of at most " + std::to_string(max_per_tenant_) + " per tenant");
+    return Status::ResourceExhausted("tenant stream limit reached (--tenant-max-streams): " +
+                                     std::to_string(open) + " streams open, of at most " +
+                                     std::to_string(max_per_tenant_) + " per tenant");
   }
   ++open;
   ++total_;

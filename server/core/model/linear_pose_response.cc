@@ -5,6 +5,7 @@
 #include <memory>
 #include <utility>
 
+
 namespace deform {
 namespace {
 

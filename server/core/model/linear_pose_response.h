@@ -28,8 +28,8 @@
 
 #include "core/geometry/pose.h"
 #include "core/geometry/skeleton.h"
-#include "core/model/laplacian_system.h"
 #include "core/model/linear_blend_plan.h"
+#include "core/model/laplacian_system.h"
 #include "core/solver/cholesky_factor.h"
 
 namespace deform {
