@@ -6,44 +6,7 @@
 #include <numeric>
 
 namespace deform {
-
-// Defined in supernodal_solve_baseline.cc and, where built, supernodal_solve_avx2.cc.
-void ForwardListBaseline(const SupernodalFactorView& factor, const int* supernodes, int count,
-                         double* y, double* planar_buffer);
-void BackwardListBaseline(const SupernodalFactorView& factor, const int* supernodes, int count,
-                          double* y, double* planar_buffer);
-#if defined(DEFORM_HAVE_AVX2_KERNEL)
-void ForwardListAvx2Fma(const SupernodalFactorView& factor, const int* supernodes, int count,
-                        double* y, double* planar_buffer);
-void BackwardListAvx2Fma(const SupernodalFactorView& factor, const int* supernodes, int count,
-                         double* y, double* planar_buffer);
-#endif
-
 namespace {
-
-using ListPass = void (*)(const SupernodalFactorView&, const int*, int, double*, double*);
-
-ListPass ForwardListFor(SolveKernel kernel) {
-#if defined(DEFORM_HAVE_AVX2_KERNEL)
-  if (kernel == SolveKernel::kAvx2Fma) return &ForwardListAvx2Fma;
-#endif
-  (void)kernel;
-  return &ForwardListBaseline;
-}
-
-ListPass BackwardListFor(SolveKernel kernel) {
-#if defined(DEFORM_HAVE_AVX2_KERNEL)
-  if (kernel == SolveKernel::kAvx2Fma) return &BackwardListAvx2Fma;
-#endif
-  (void)kernel;
-  return &BackwardListBaseline;
-}
-
-constexpr int kRowStride = 4;  // the kernels' solution rows: x, y, z and a zero
-
-std::int64_t PartDoubles(int size, int widest) {
-  return kRowStride * static_cast<std::int64_t>(size) + 3 * ((widest + 3) & ~3);
-}
 
 // Part p's solution rows and planar buffer in the aligned work.
 struct PartBuffers {
@@ -54,8 +17,8 @@ struct PartBuffers {
 struct SolveContext {
   const SupernodalFactorView* factor;
   const ParallelSolvePlan* plan;
-  ListPass forward;
-  ListPass backward;
+  SupernodeListPass forward;
+  SupernodeListPass backward;
   const double* b;
   double* x;
   double* work;  // aligned to 32 bytes
@@ -63,7 +26,7 @@ struct SolveContext {
 
   PartBuffers Buffers(int part) const {
     double* base = work + part * part_doubles;
-    return {base, base + kRowStride * static_cast<std::int64_t>(factor->size)};
+    return {base, base + kSolveRowStride * static_cast<std::int64_t>(factor->size)};
   }
   double* Solution() const { return work; }
   const int* Supernodes(int part) const {
@@ -85,7 +48,7 @@ void ForEachColumn(const SolveContext& c, int part, Body&& body) {
 
 void Gather(const SupernodalFactorView& f, const double* b, int row, double* y) {
   const double* source = b + 3 * static_cast<std::ptrdiff_t>(f.permutation[row]);
-  double* t = y + kRowStride * static_cast<std::ptrdiff_t>(row);
+  double* t = y + kSolveRowStride * static_cast<std::ptrdiff_t>(row);
   t[0] = source[0];
   t[1] = source[1];
   t[2] = source[2];
@@ -94,7 +57,7 @@ void Gather(const SupernodalFactorView& f, const double* b, int row, double* y) 
 
 void Scatter(const SupernodalFactorView& f, const double* y, int row, double* x) {
   double* target = x + 3 * static_cast<std::ptrdiff_t>(f.permutation[row]);
-  const double* t = y + kRowStride * static_cast<std::ptrdiff_t>(row);
+  const double* t = y + kSolveRowStride * static_cast<std::ptrdiff_t>(row);
   target[0] = t[0];
   target[1] = t[1];
   target[2] = t[2];
@@ -109,7 +72,7 @@ void ForwardPart(void* context, int part) {
   ForEachColumn(c, part, [&](int col) { Gather(f, c.b, col, own.y); });
   if (part > 0) {
     for (const int col : c.plan->top_columns) {
-      double* t = own.y + kRowStride * static_cast<std::ptrdiff_t>(col);
+      double* t = own.y + kSolveRowStride * static_cast<std::ptrdiff_t>(col);
       t[0] = t[1] = t[2] = t[3] = 0;
     }
   }
@@ -117,8 +80,8 @@ void ForwardPart(void* context, int part) {
   if (part > 0) {
     double* solution = c.Solution();
     ForEachColumn(c, part, [&](int col) {
-      const std::ptrdiff_t at = kRowStride * static_cast<std::ptrdiff_t>(col);
-      std::copy(own.y + at, own.y + at + kRowStride, solution + at);
+      const std::ptrdiff_t at = kSolveRowStride * static_cast<std::ptrdiff_t>(col);
+      std::copy(own.y + at, own.y + at + kSolveRowStride, solution + at);
     });
   }
 }
@@ -279,7 +242,7 @@ ParallelSolvePlan PlanParallelSolve(const SupernodalFactorView& f, int parts) {
 }
 
 std::int64_t ParallelSolveWorkSize(int size, const ParallelSolvePlan& plan) {
-  return plan.parts * PartDoubles(size, plan.widest_supernode) + kRowStride;
+  return plan.parts * SolveBuffersSize(size, plan.widest_supernode) + kSolveRowStride;
 }
 
 void ParallelSolve3(const SupernodalFactorView& f, const ParallelSolvePlan& plan,
@@ -293,7 +256,7 @@ void ParallelSolve3(const SupernodalFactorView& f, const ParallelSolvePlan& plan
                  b,
                  x,
                  work + (misalignment ? (32 - misalignment) / sizeof(double) : 0),
-                 PartDoubles(f.size, plan.widest_supernode)};
+                 SolveBuffersSize(f.size, plan.widest_supernode)};
   double* solution = c.Solution();
   double* planar = c.Buffers(0).planar;
   for (const int col : plan.top_columns) Gather(f, b, col, solution);
@@ -301,7 +264,7 @@ void ParallelSolve3(const SupernodalFactorView& f, const ParallelSolvePlan& plan
   for (int part = 1; part < plan.parts; ++part) {
     const double* other = c.Buffers(part).y;
     for (const int col : plan.top_columns) {
-      const std::ptrdiff_t at = kRowStride * static_cast<std::ptrdiff_t>(col);
+      const std::ptrdiff_t at = kSolveRowStride * static_cast<std::ptrdiff_t>(col);
       for (int k = 0; k < 3; ++k) solution[at + k] += other[at + k];
     }
   }

@@ -6,7 +6,15 @@ namespace deform {
 void Solve3Baseline(const SupernodalFactorView& factor, const double* b, double* x, double* work);
 void SolveManyBaseline(const SupernodalFactorView& factor, const double* b, double* x, int columns,
                        double* work);
+void ForwardListBaseline(const SupernodalFactorView& factor, const int* supernodes, int count,
+                         double* y, double* planar_buffer);
+void BackwardListBaseline(const SupernodalFactorView& factor, const int* supernodes, int count,
+                          double* y, double* planar_buffer);
 #if defined(DEFORM_HAVE_AVX2_KERNEL)
+void ForwardListAvx2Fma(const SupernodalFactorView& factor, const int* supernodes, int count,
+                        double* y, double* planar_buffer);
+void BackwardListAvx2Fma(const SupernodalFactorView& factor, const int* supernodes, int count,
+                         double* y, double* planar_buffer);
 void Solve3Avx2Fma(const SupernodalFactorView& factor, const double* b, double* x, double* work);
 void SolveManyAvx2Fma(const SupernodalFactorView& factor, const double* b, double* x, int columns,
                       double* work);
@@ -58,6 +66,22 @@ SolveManyFunction SolveManyFor(SolveKernel kernel) {
 #endif
   (void)kernel;
   return &SolveManyBaseline;
+}
+
+SupernodeListPass ForwardListFor(SolveKernel kernel) {
+#if defined(DEFORM_HAVE_AVX2_KERNEL)
+  if (kernel == SolveKernel::kAvx2Fma) return &ForwardListAvx2Fma;
+#endif
+  (void)kernel;
+  return &ForwardListBaseline;
+}
+
+SupernodeListPass BackwardListFor(SolveKernel kernel) {
+#if defined(DEFORM_HAVE_AVX2_KERNEL)
+  if (kernel == SolveKernel::kAvx2Fma) return &BackwardListAvx2Fma;
+#endif
+  (void)kernel;
+  return &BackwardListBaseline;
 }
 
 }  // namespace deform

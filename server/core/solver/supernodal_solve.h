@@ -27,12 +27,22 @@ struct SupernodalFactorView {
   const double* values = nullptr;
 };
 
+// The solution during a three-column solve: one row of four doubles per unknown (x, y, z and a
+// zero), so a row is one aligned four-wide load or store wherever the narrow supernodes scatter or
+// gather.
+inline constexpr int kSolveRowStride = 4;
+
+// Doubles of one solve's buffers: its solution rows and three padded columns for the widest
+// supernode (its unknowns kept planar while its block is applied).
+inline std::int64_t SolveBuffersSize(int size, int widest_supernode) {
+  return kSolveRowStride * static_cast<std::int64_t>(size) + 3 * ((widest_supernode + 3) & ~3);
+}
+
 // Solves P^T L L^T P x = b for three right-hand sides stored interleaved (b[3 i + c]). `x` may
 // equal `b`; `work` holds SolveWorkSize() doubles. Reads the factor once per pass and allocates
-// nothing. Doubles of `work` a solve needs: a four-double row per unknown, three padded columns for
-// the widest supernode, and slack to align the rows to 32 bytes.
+// nothing. Doubles of `work` a solve needs: its buffers, and slack to align the rows to 32 bytes.
 inline std::int64_t SolveWorkSize(int size, int widest_supernode) {
-  return 4 * static_cast<std::int64_t>(size) + 3 * ((widest_supernode + 3) & ~3) + 4;
+  return SolveBuffersSize(size, widest_supernode) + kSolveRowStride;
 }
 
 using Solve3Function = void (*)(const SupernodalFactorView& factor, const double* b, double* x,
@@ -62,5 +72,12 @@ SolveKernel BestSolveKernel();
 // The kernel's function; it must be available.
 Solve3Function Solve3For(SolveKernel kernel);
 SolveManyFunction SolveManyFor(SolveKernel kernel);
+// One direction's pass over the listed supernodes only (forward: ascending, backward: taken in
+// descending order), on solution rows `y` aligned to 32 bytes and a planar buffer for the widest
+// supernode; the parts of the parallel solve (parallel_solve.h).
+using SupernodeListPass = void (*)(const SupernodalFactorView& factor, const int* supernodes,
+                                   int count, double* y, double* planar_buffer);
+SupernodeListPass ForwardListFor(SolveKernel kernel);
+SupernodeListPass BackwardListFor(SolveKernel kernel);
 
 }  // namespace deform

@@ -221,9 +221,8 @@ inline void SubtractRow1x3(const double* __restrict row, const double* __restric
   }
 }
 
-// The solution during the solve: one row of four doubles per unknown (x, y, z and a zero), so a
-// row is one aligned four-wide load or store wherever the narrow supernodes scatter or gather.
-constexpr int kRowStride = 4;
+// The solution rows during the solve (supernodal_solve.h).
+constexpr int kRowStride = kSolveRowStride;
 
 inline double* Row(double* y, int row) { return y + kRowStride * static_cast<std::ptrdiff_t>(row); }
 inline const double* Row(const double* y, int row) {
