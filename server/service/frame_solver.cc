@@ -88,25 +88,32 @@ FrameSolver::Deformed FrameSolver::DeformPrepared(const MaterialFactorization& f
                                                   const BatchScratchPool* scratches) {
   Deformed deformed;
   deformed.start = Clock::now();
-  if (count <= 0) return deformed;
+  if (count > 0) DeformTogether(factorization, solvers, count, scratches, &deformed);
+  deformed.end = Clock::now();
+  return deformed;
+}
+
+void FrameSolver::DeformTogether(const MaterialFactorization& factorization,
+                                 FrameSolver* const* solvers, int count,
+                                 const BatchScratchPool* scratches, Deformed* deformed) {
   const DeformationModel& model = solvers[0]->model_;
-  const BatchScratchPool::Lease lease =
-      count > 1 && scratches != nullptr ? scratches->TryAcquire() : BatchScratchPool::Lease();
   if (count == 1 && solvers[0]->parallel_plan_ != nullptr) {
     FrameSolver& solver = *solvers[0];
     model.DeformParallel(factorization, solver.pose_, &solver.scratch_, *solver.parallel_plan_,
-                         solver.parallel_work_.data(), solver.parallel_runner_, &deformed.timings);
-    deformed.solve_parts = solver.parallel_plan_->parts;
-    return deformed;
+                         solver.parallel_work_.data(), solver.parallel_runner_, &deformed->timings);
+    deformed->solve_parts = solver.parallel_plan_->parts;
+    return;
   }
+  const BatchScratchPool::Lease lease =
+      count > 1 && scratches != nullptr ? scratches->TryAcquire() : BatchScratchPool::Lease();
   if (!lease) {
     for (int i = 0; i < count; ++i) {
       DeformTimings one;
       model.Deform(factorization, solvers[i]->pose_, &solvers[i]->scratch_, &one);
-      deformed.timings.right_hand_side += one.right_hand_side;
-      deformed.timings.solve += one.solve;
+      deformed->timings.right_hand_side += one.right_hand_side;
+      deformed->timings.solve += one.solve;
     }
-    return deformed;
+    return;
   }
   const int max_frames = lease.get()->max_frames;
   std::array<const Pose*, DeformationModel::kMaxBatchFrames> poses;
@@ -119,18 +126,14 @@ FrameSolver::Deformed FrameSolver::DeformPrepared(const MaterialFactorization& f
     }
     DeformTimings pass;
     model.DeformBatch(factorization, poses.data(), buffers.data(), frames, lease.get(), &pass);
-    deformed.timings.right_hand_side += pass.right_hand_side;
-    deformed.timings.solve += pass.solve;
-    deformed.batch_frames = std::max(deformed.batch_frames, frames);
+    deformed->timings.right_hand_side += pass.right_hand_side;
+    deformed->timings.solve += pass.solve;
+    deformed->batch_frames = std::max(deformed->batch_frames, frames);
   }
-  return deformed;
 }
 
 void FrameSolver::Finish(const PoseInput& input, const Deformed& deformed, const FrameStamp& stamp,
                          v1::DeformFrame* frame) {
-  const Clock::time_point solved =
-      deformed.start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
-                           deformed.timings.right_hand_side + deformed.timings.solve));
   const std::size_t client_vertices = client_order_.empty()
                                           ? static_cast<std::size_t>(scratch_.num_vertices)
                                           : client_order_.size();
@@ -151,7 +154,7 @@ void FrameSolver::Finish(const PoseInput& input, const Deformed& deformed, const
   frame_timings->set_queue_ms(Milliseconds(deformed.start - input.arrival));
   frame_timings->set_rhs_ms(deformed.timings.right_hand_side * 1e3);
   frame_timings->set_solve_ms(deformed.timings.solve * 1e3);
-  frame_timings->set_encode_ms(std::max(0.0, Milliseconds(Clock::now() - solved)));
+  frame_timings->set_encode_ms(Milliseconds(Clock::now() - deformed.end));
   frame_timings->set_batch_frames(static_cast<std::uint32_t>(deformed.batch_frames));
   frame_timings->set_solve_parts(static_cast<std::uint32_t>(deformed.solve_parts));
 }

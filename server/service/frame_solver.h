@@ -65,6 +65,7 @@ class FrameSolver {
   // solver has EnableParallel, else one by one. No allocation.
   struct Deformed {
     std::chrono::steady_clock::time_point start;  // when the deformation began
+    std::chrono::steady_clock::time_point end;    // when it ended
     DeformTimings timings;                        // all of the solvers' together
     int batch_frames = 1;                         // the largest pass's frames
     int solve_parts = 1;                          // a lone frame split for several threads
@@ -83,6 +84,10 @@ class FrameSolver {
   const DeformationModel& model_;
   const std::vector<int>& client_order_;
   void Encode(v1::DeformFrame* frame);
+  // DeformPrepared's work, without its start and end times.
+  static void DeformTogether(const MaterialFactorization& factorization,
+                             FrameSolver* const* solvers, int count,
+                             const BatchScratchPool* scratches, Deformed* deformed);
 
   Pose pose_;
   int clamped_ = 0;  // angles clamped by the last Prepare

@@ -168,14 +168,15 @@ StatusOr<std::shared_ptr<const MeshEntry>> MeshRegistry::Register(
   entry->memory_bytes = model->EstimatedBytes();
   // Allocated before the budget check below (which then counts it): for a moment the mesh's
   // memory may exceed its reservation by these buffers, a few right-hand sides per worker.
-  if (batching_.max_frames >= 2 && batching_.slots > 0 &&
-      model->default_factorization()->linear_response() == nullptr) {
+  // A linear response evaluates each frame alone: nothing to batch or split.
+  const bool solves = model->default_factorization()->linear_response() == nullptr;
+  if (solves && batching_.max_frames >= 2 && batching_.slots > 0) {
     entry->batch_scratches =
         std::make_unique<BatchScratchPool>(*model, batching_.slots, batching_.max_frames);
     entry->memory_bytes += BatchScratchPool::Bytes(*model, batching_.slots, batching_.max_frames);
   }
-  if (batching_.slots >= 2 && entry->factor_bytes >= batching_.parallel_min_factor_bytes &&
-      model->default_factorization()->linear_response() == nullptr) {
+  if (solves && batching_.slots >= 2 &&
+      entry->factor_bytes >= batching_.parallel_min_factor_bytes) {
     auto plan = std::make_unique<ParallelSolvePlan>(
         model->default_factorization()->factor().PlanParallel(batching_.slots));
     if (plan->parts >= 2) entry->parallel_plan = std::move(plan);

@@ -100,8 +100,9 @@ void CholeskyFactor::PackSupernodes(const SymbolicCholesky& s, const ColumnFacto
   value_pointers_.assign(num_supernodes + 1, 0);
   for (int sn = 0; sn < num_supernodes; ++sn) {
     const int width = s.supernode_columns_[sn + 1] - s.supernode_columns_[sn];
-    row_pointers_[sn + 1] = row_pointers_[sn] + rows_of(sn);
-    value_pointers_[sn + 1] = value_pointers_[sn] + rows_of(sn) * width;
+    const std::int64_t rows = rows_of(sn);
+    row_pointers_[sn + 1] = row_pointers_[sn] + rows;
+    value_pointers_[sn + 1] = value_pointers_[sn] + rows * width;
   }
   row_indices_.resize(row_pointers_.back());
   values_.assign(value_pointers_.back() + kSolveValuePadding, 0.0);
