@@ -463,10 +463,7 @@ TEST_F(DeformStreamTest, ManyStreamsOnOneMeshAllReceiveFrames) {
   constexpr int kStreams = 16;
   std::vector<std::unique_ptr<StreamRecorder>> recorders;
   std::vector<std::unique_ptr<client::DeformStream>> streams;
-  for (int s = 0; s < kStreams; ++s) {
-    recorders.push_back(std::make_unique<StreamRecorder>());
-    streams.push_back(client_->OpenStream(mesh_id, recorders.back()->Callbacks()));
-  }
+  OpenStreams(client_.get(), mesh_id, kStreams, /*keep_positions=*/false, &recorders, &streams);
   for (std::uint64_t sequence = 1; sequence <= 20; ++sequence) {
     for (auto& stream : streams) ASSERT_TRUE(stream->SendPose(KneePose(sequence, 3.0 * sequence)));
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
