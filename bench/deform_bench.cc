@@ -222,6 +222,46 @@ void BM_ParallelSolve(benchmark::State& state, BenchMesh mesh, int parts) {
   state.counters["predicted_x_serial"] = plan.predicted_time_ratio;
 }
 
+// The two triangular passes with the factor's values rounded to float32 (CholeskyFactor::
+// RoundedToFloat32; the arithmetic stays double), on one thread (parts 1, Solve3) or split over
+// `parts` threads (Solve3Parallel), against the double factor's same solve timed in the same
+// benchmark. Besides the usual counters (factor_MB and the bounds those of the float32 factor):
+// double_ms, the double solve's median; x_double, their ratio; max_difference, the largest vertex
+// difference between the two solutions relative to the bounding-box diagonal.
+void BM_Float32Solve(benchmark::State& state, BenchMesh mesh, int parts) {
+  auto frames = SetUpFrames(state, mesh);
+  if (!frames) return;
+  const CholeskyFactor& exact = frames->factorization->factor();
+  const CholeskyFactor rounded = exact.RoundedToFloat32();
+  DeformScratch& scratch = frames->scratch;
+  const auto rhs = AssembledRightHandSide(frames.get());
+  const ParallelSolvePlan plan = exact.PlanParallel(parts);
+  if (parts > 1 && plan.parts == 0)
+    return state.SkipWithError("the elimination tree does not split");
+  std::vector<double> work(parts > 1 ? exact.WorkSizeParallel(plan) : exact.WorkSize());
+  ThreadTeam team(parts);
+  const auto solve = [&](const CholeskyFactor& factor) {
+    return parts > 1 ? factor.Solve3Parallel(plan, rhs.data(), scratch.solution.data(), work.data(),
+                                             &team)
+                     : factor.Solve3(rhs.data(), scratch.solution.data(), work.data());
+  };
+  const auto seconds = TimeEach(state, [&] { benchmark::DoNotOptimize(solve(rounded)); });
+  const auto rounded_solution = scratch.solution;
+  std::vector<double> exact_seconds;
+  for (std::size_t run = 0; run < std::max<std::size_t>(seconds.size(), 20); ++run) {
+    const auto start = Clock::now();
+    benchmark::DoNotOptimize(solve(exact));
+    exact_seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
+  }
+  ReportAgainstBound(state, rounded.bytes(), seconds);
+  const int n = frames->model->mesh().num_vertices();
+  state.counters["max_difference"] =
+      (rounded_solution.topRows(n) - scratch.solution.topRows(n)).rowwise().norm().maxCoeff() /
+      frames->model->bounding_box_diagonal();
+  state.counters["double_ms"] = Median(exact_seconds) * 1e3;
+  state.counters["x_double"] = Median(seconds) / Median(exact_seconds);
+}
+
 // The right-hand side alone: kinematics, rotation blend and the product with L'^T.
 void BM_RightHandSide(benchmark::State& state, BenchMesh mesh) {
   auto frames = SetUpFrames(state, mesh);
@@ -307,6 +347,8 @@ void RegisterBenchmarks(const BenchMesh& mesh) {
         ->MinTime(1.0);
   }
   RegisterFor(mesh, "ParallelSolve/parts:2", BM_ParallelSolve, 2)->MinTime(1.0);
+  RegisterFor(mesh, "Float32Solve/parts:1", BM_Float32Solve, 1)->MinTime(1.0);
+  RegisterFor(mesh, "Float32Solve/parts:2", BM_Float32Solve, 2)->MinTime(1.0);
   RegisterFor(mesh, "EigenBaselineSolve", BM_EigenBaselineSolve)->MinTime(1.0);
 }
 

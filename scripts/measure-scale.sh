@@ -9,6 +9,9 @@
 #
 #   scripts/measure-scale.sh [BASELINE_DEFORMD] [ROUNDS] [DURATION_S]   (default: none, 1, 10)
 #
+# DEFORM_SCALE_ONLY=REGEX runs only the scenarios whose "mesh skeleton streams" line matches it
+# (e.g. arm_132946).
+#
 # Uses ports 52000-52999 (random).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -50,6 +53,7 @@ PY
 for round in $(seq "$rounds"); do
   for scenario in "leg/leg_1633.obj leg/leg.tgf 128" "leg/leg_25969.obj leg/leg.tgf 8" \
                   "arm/arm_132946.obj arm/arm.tgf 1" "leg/leg_1633.obj leg/leg.tgf 1"; do
+    [[ $scenario =~ ${DEFORM_SCALE_ONLY:-.} ]] || continue
     read -r mesh skeleton streams <<<"$scenario"
     if [[ -n $baseline ]]; then run baseline "$baseline" "$data/$mesh" "$data/$skeleton" "$streams"; fi
     run current build/server/deformd/deformd "$data/$mesh" "$data/$skeleton" "$streams"

@@ -63,6 +63,7 @@ struct Args {
   ServerOptions server;
   std::size_t max_memory_mb = 4096;
   double parallel_solve_min_mb = 8;
+  double float32_factor_min_mb = 64;
   int max_message_mb = 64;
   std::size_t max_upload_mb = 256;
   double upload_idle_timeout_s = 30;
@@ -198,6 +199,12 @@ int main(int argc, char** argv) {
                  "split over the idle workers")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1e9));
+  app.add_option("--float32-factor-min-mb", args.float32_factor_min_mb,
+                 "A mesh whose factor holds this many MiB or more (in double) stores it in "
+                 "float32, where a probe solve shows its frames within 2.5e-7 of the diagonal; "
+                 "-1 = never")
+      ->capture_default_str()
+      ->check(CLI::Range(-1.0, 1e9));
   app.add_option("--max-vertices", args.server.limits.max_vertices, "Largest mesh, in vertices")
       ->capture_default_str();
   app.add_option("--max-meshes", args.server.limits.max_meshes, "Meshes loaded at once")
@@ -308,6 +315,10 @@ int main(int argc, char** argv) {
   args.server.limits.max_memory_bytes = args.max_memory_mb << 20;
   args.server.parallel_solve_min_factor_bytes =
       static_cast<std::size_t>(args.parallel_solve_min_mb * 1024 * 1024);
+  args.server.float32_factor_min_bytes =
+      args.float32_factor_min_mb < 0
+          ? -1
+          : static_cast<std::int64_t>(args.float32_factor_min_mb * 1024 * 1024);
   args.server.limits.max_upload_bytes = args.max_upload_mb << 20;
   args.server.limits.upload_idle_timeout_ms =
       static_cast<long long>(args.upload_idle_timeout_s * 1000);

@@ -14,18 +14,32 @@ double MillisecondsSince(std::chrono::steady_clock::time_point start) {
       .count();
 }
 
+// "double", "float32, rest pose within 1.4e-07 of the diagonal", or why it stayed double.
+std::string FactorPrecisionText(const DeformationModel& model) {
+  const MaterialFactorization& factorization = *model.default_factorization();
+  if (factorization.factor().stores_float32()) {
+    return fmt::format("float32, rest pose within {:.1e} of the diagonal",
+                       factorization.float32_probe_error());
+  }
+  if (factorization.float32_probe_error() >= 0) {
+    return fmt::format("double: float32 would move the rest pose by {:.1e} of the diagonal",
+                       factorization.float32_probe_error());
+  }
+  return "double";
+}
+
 StatusOr<std::shared_ptr<const MeshEntry>> Build(MeshRegistry* registry,
-                                                 MeshRegistry::Reservation reservation,
-                                                 LoadJob job, const LoadProgress& progress) {
+                                                 MeshRegistry::Reservation reservation, LoadJob job,
+                                                 const LoadProgress& progress) {
   job.options.limits.max_vertices = registry->limits().max_vertices;
+  job.options.float32_factor_min_bytes = registry->solve_settings().float32_factor_min_bytes;
   const std::size_t bytes_before_build =
       DeformationModel::EstimateBytesBeforeBuild(job.mesh.num_vertices(), job.mesh.num_triangles());
   const int vertices = job.mesh.num_vertices();
   BuildHooks hooks;
   hooks.validated = [&] {
     DEFORM_RETURN_IF_ERROR(registry->ReserveMemory(
-        &reservation, bytes_before_build,
-        "a mesh of " + std::to_string(vertices) + " vertices"));
+        &reservation, bytes_before_build, "a mesh of " + std::to_string(vertices) + " vertices"));
     if (progress) progress(LoadStage::kValidated, MillisecondsSince(job.start));
     return Status::Ok();
   };
@@ -42,14 +56,15 @@ StatusOr<std::shared_ptr<const MeshEntry>> Build(MeshRegistry* registry,
                           registry->Register(std::move(reservation), job.name, std::move(model),
                                              std::move(job.presentation), std::move(job.id)));
   spdlog::info(
-      "mesh={} tenant={} name='{}' loaded: {} vertices, precompute {:.1f} ms, factor {:.1f} ms, "
-      "about {} KiB",
-      entry->id, EscapeForLog(entry->tenant), EscapeForLog(entry->name), vertices, entry->precompute_ms, entry->factor_ms,
+      "mesh={} tenant={} name='{}' loaded: {} vertices, precompute {:.1f} ms, factor {:.1f} ms "
+      "({}), about {} KiB",
+      entry->id, EscapeForLog(entry->tenant), EscapeForLog(entry->name), vertices,
+      entry->precompute_ms, entry->factor_ms, FactorPrecisionText(*entry->model),
       entry->memory_bytes >> 10);
   std::string phases;
   for (const DeformationModel::BuildPhase& phase : entry->model->build_phases()) {
-    phases += fmt::format("{}{} {:.0f} ms", phases.empty() ? "" : ", ", phase.name,
-                          phase.seconds * 1e3);
+    phases +=
+        fmt::format("{}{} {:.0f} ms", phases.empty() ? "" : ", ", phase.name, phase.seconds * 1e3);
   }
   spdlog::debug("mesh={} build phases: {}", entry->id, phases);
   for (const std::string& warning : entry->model->binding_report().warnings) {

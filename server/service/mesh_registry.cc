@@ -78,8 +78,8 @@ Status MeshRegistry::MemoryHold::Resize(std::size_t bytes, const std::string& wh
   return Status::Ok();
 }
 
-MeshRegistry::MeshRegistry(const ServiceLimits& limits, SolveBatching batching)
-    : limits_(limits), batching_(batching) {}
+MeshRegistry::MeshRegistry(const ServiceLimits& limits, SolveSettings solve_settings)
+    : limits_(limits), solve_settings_(solve_settings) {}
 
 MeshRegistry::MemoryHold MeshRegistry::HoldMemory(const std::string& tenant) {
   return MemoryHold(this, tenant);
@@ -129,12 +129,11 @@ Status MeshRegistry::CheckMemoryLocked(std::size_t bytes, std::size_t held,
   }
   if (limits_.tenant_max_memory_bytes > 0) {
     const auto it = tenants_.find(tenant);
-    const std::size_t used =
-        it == tenants_.end() ? 0
-                             : it->second.memory_bytes + it->second.reserved_memory_bytes +
-                                   it->second.stream_memory_bytes - held;
-    if (bytes > limits_.tenant_max_memory_bytes ||
-        used > limits_.tenant_max_memory_bytes - bytes) {
+    const std::size_t used = it == tenants_.end()
+                                 ? 0
+                                 : it->second.memory_bytes + it->second.reserved_memory_bytes +
+                                       it->second.stream_memory_bytes - held;
+    if (bytes > limits_.tenant_max_memory_bytes || used > limits_.tenant_max_memory_bytes - bytes) {
       return Status::ResourceExhausted(
           "tenant memory budget exceeded (--tenant-max-memory-mb): " + what + " needs about " +
           MebiBytes(bytes) + ", " + MebiBytes(used) + " of the tenant's " +
@@ -170,15 +169,16 @@ StatusOr<std::shared_ptr<const MeshEntry>> MeshRegistry::Register(
   // memory may exceed its reservation by these buffers, a few right-hand sides per worker.
   // A linear response evaluates each frame alone: nothing to batch or split.
   const bool solves = model->default_factorization()->linear_response() == nullptr;
-  if (solves && batching_.max_frames >= 2 && batching_.slots > 0) {
-    entry->batch_scratches =
-        std::make_unique<BatchScratchPool>(*model, batching_.slots, batching_.max_frames);
-    entry->memory_bytes += BatchScratchPool::Bytes(*model, batching_.slots, batching_.max_frames);
+  if (solves && solve_settings_.max_frames >= 2 && solve_settings_.slots > 0) {
+    entry->batch_scratches = std::make_unique<BatchScratchPool>(*model, solve_settings_.slots,
+                                                                solve_settings_.max_frames);
+    entry->memory_bytes +=
+        BatchScratchPool::Bytes(*model, solve_settings_.slots, solve_settings_.max_frames);
   }
-  if (solves && batching_.slots >= 2 &&
-      entry->factor_bytes >= batching_.parallel_min_factor_bytes) {
+  if (solves && solve_settings_.slots >= 2 &&
+      entry->factor_bytes >= solve_settings_.parallel_min_factor_bytes) {
     auto plan = std::make_unique<ParallelSolvePlan>(
-        model->default_factorization()->factor().PlanParallel(batching_.slots));
+        model->default_factorization()->factor().PlanParallel(solve_settings_.slots));
     if (plan->parts >= 2) entry->parallel_plan = std::move(plan);
   }
   entry->model = std::move(model);

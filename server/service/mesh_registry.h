@@ -64,7 +64,7 @@ struct MeshEntry {
   // are solved one by one (batching off, or a linear response: nothing to share).
   std::unique_ptr<BatchScratchPool> batch_scratches;
   // The split of the mesh's solve over the workers (one part each) for a lone stream's frames;
-  // null when the mesh is too small for it to pay (SolveBatching::parallel_min_factor_bytes) or
+  // null when the mesh is too small for it to pay (SolveSettings::parallel_min_factor_bytes) or
   // there is one worker. Streams size their parallel work for it.
   std::unique_ptr<const ParallelSolvePlan> parallel_plan;
 
@@ -79,13 +79,15 @@ struct MeshEntry {
   mutable std::atomic<int> open_streams{0};
 };
 
-// How registered meshes are prepared for the workers: `slots` batch scratches of `max_frames`
-// frames each (one per worker; none when max_frames < 2), and a parallel solve plan of `slots`
-// parts for a mesh whose factor holds at least parallel_min_factor_bytes (slots >= 2).
-struct SolveBatching {
+// How meshes are prepared for the workers: `slots` batch scratches of `max_frames` frames each
+// (one per worker; none when max_frames < 2), a parallel solve plan of `slots` parts for a mesh
+// whose factor holds at least parallel_min_factor_bytes (slots >= 2), and the loader's
+// ModelOptions::float32_factor_min_bytes (negative: every factor in double).
+struct SolveSettings {
   int slots = 0;
   int max_frames = 1;
   std::size_t parallel_min_factor_bytes = std::size_t{8} << 20;
+  std::int64_t float32_factor_min_bytes = -1;
 };
 
 class MeshRegistry {
@@ -136,11 +138,12 @@ class MeshRegistry {
     std::size_t bytes_ = 0;
   };
 
-  explicit MeshRegistry(const ServiceLimits& limits, SolveBatching batching = {});
+  explicit MeshRegistry(const ServiceLimits& limits, SolveSettings solve_settings = {});
   MeshRegistry(const MeshRegistry&) = delete;
   MeshRegistry& operator=(const MeshRegistry&) = delete;
 
   const ServiceLimits& limits() const { return limits_; }
+  const SolveSettings& solve_settings() const { return solve_settings_; }
 
   // A slot for a mesh `tenant` loads. RESOURCE_EXHAUSTED (naming the limit) when max_meshes are
   // loaded or being loaded, or tenant_max_meshes of `tenant`'s. The registry must outlive it.
@@ -209,7 +212,7 @@ class MeshRegistry {
                            const std::string& what) const DEFORM_REQUIRES(mutex_);
 
   const ServiceLimits limits_;
-  const SolveBatching batching_;
+  const SolveSettings solve_settings_;
   mutable Mutex mutex_;
   // By load order (a sequence number), and the sequence number of each id.
   std::map<std::uint64_t, std::shared_ptr<MeshEntry>> meshes_ DEFORM_GUARDED_BY(mutex_);

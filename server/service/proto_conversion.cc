@@ -152,6 +152,8 @@ void FillMeshSummary(const MeshEntry& entry, v1::MeshSummary* summary) {
   summary->set_triangle_count(static_cast<std::uint32_t>(model.mesh().num_triangles()));
   summary->set_bone_count(static_cast<std::uint32_t>(skeleton.num_bones()));
   summary->set_factor_bytes(entry.factor_bytes);
+  summary->set_factor_float32(model.default_factorization()->factor().stores_float32());
+  summary->set_float32_probe_error(model.default_factorization()->float32_probe_error());
   summary->set_precompute_ms(entry.precompute_ms);
   summary->set_factor_ms(entry.factor_ms);
   summary->set_open_streams(static_cast<std::uint32_t>(entry.open_streams.load()));

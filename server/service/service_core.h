@@ -80,7 +80,7 @@ struct ServiceCore {
       : limits(options.limits),
         registry(options.limits,
                  {WorkerPool::ResolveThreads(options.workers), options.batch_frames,
-                  options.parallel_solve_min_factor_bytes}),
+                  options.parallel_solve_min_factor_bytes, options.float32_factor_min_bytes}),
         pool(options.workers, options.batch_frames),
         uploads(std::chrono::milliseconds(options.limits.upload_idle_timeout_ms),
                 std::chrono::milliseconds(options.limits.upload_time_limit_ms)),

@@ -75,6 +75,12 @@ struct ServerOptions {
   // the idle workers (parallel_solve.h; with two or more workers). Default: 8 MiB, below which the
   // hand-over between threads costs more than it saves (README, "One big mesh on every core").
   std::size_t parallel_solve_min_factor_bytes = std::size_t{8} << 20;
+  // A mesh whose factor holds at least this many bytes (in double) stores it in float32 where the
+  // rounding keeps frames within a quarter of 1e-6 of the diagonal (ModelOptions::
+  // float32_factor_min_bytes; the probe leaves the others in double); negative: never. Default:
+  // 64 MiB, where the solve is bound by memory reads: the shared 133k arm's 146 MB factor solves
+  // in 0.70-0.72x the time, the 26k leg's 25 MB factor gains nothing (README, "A float32 factor").
+  std::int64_t float32_factor_min_bytes = std::int64_t{64} << 20;
   // Largest gRPC message received or sent. Default: 64 MiB.
   int max_message_bytes = 64 << 20;
   // Where GET /metrics is served (metrics_endpoint.h), "host:port"; empty: not served. Default:

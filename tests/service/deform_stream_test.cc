@@ -568,6 +568,54 @@ TEST_F(DeformStreamTest, ALoneStreamsFramesSplitOverTheWorkersEqualTheCoreResult
   ExpectBackgroundStreamAlive();
 }
 
+// With the float32 threshold lowered to every mesh, the phantom's factor is stored in float32 (the
+// summary says so, with the probe's error), and its frames, batched, split over the workers or
+// alone, stay within 1e-6 of the diagonal of the core's double frames.
+TEST_F(DeformStreamTest, AFloat32FactorsFramesStayWithinTheTransportRoundingOfTheCore) {
+  service::ServerOptions options = TestServerOptions();
+  options.workers = 2;
+  options.parallel_solve_min_factor_bytes = 0;
+  options.float32_factor_min_bytes = 0;
+  StartServer(options);
+  constexpr int kVertices = 4000;
+  v1::MeshSummary summary;
+  const std::string mesh_id = LoadPhantom(kVertices, {}, &summary);
+  EXPECT_TRUE(summary.factor_float32());
+  EXPECT_GT(summary.float32_probe_error(), 0);
+  EXPECT_LE(summary.float32_probe_error(), MaterialFactorization::kFloat32ProbeTolerance);
+  std::vector<std::unique_ptr<StreamRecorder>> recorders;
+  std::vector<std::unique_ptr<client::DeformStream>> streams;
+  OpenStreams(client_.get(), mesh_id, 3, /*keep_positions=*/true, &recorders, &streams);
+  std::uint64_t sequence = 0;
+  for (const int degrees : {30, 75, 120}) {
+    ++sequence;
+    for (auto& stream : streams) ASSERT_TRUE(stream->SendPose(KneePose(sequence, degrees)));
+    const CoreResult core = CoreDeform(kVertices, "knee:flexion:" + std::to_string(degrees));
+    for (std::size_t s = 0; s < streams.size(); ++s) {
+      ASSERT_TRUE(recorders[s]->WaitForFrameWithSequence(sequence));
+      const v1::DeformFrame frame = recorders[s]->last_frame();
+      EXPECT_LE(DistanceFromCore(client::DecodePositions(frame.positions()), core),
+                1e-6 * core.diagonal)
+          << degrees << " degrees, stream " << s << ", batch " << frame.timings().batch_frames()
+          << ", parts " << frame.timings().solve_parts();
+    }
+  }
+  for (auto& stream : streams) {
+    stream->Close();
+    EXPECT_TRUE(stream->Wait().ok());
+  }
+  ExpectBackgroundStreamAlive();
+}
+
+// By default (64 MiB) a small mesh keeps its factor in double and no probe runs.
+TEST_F(DeformStreamTest, ASmallMeshKeepsADoubleFactorByDefault) {
+  StartServer();
+  v1::MeshSummary summary;
+  LoadPhantom(2000, {}, &summary);
+  EXPECT_FALSE(summary.factor_float32());
+  EXPECT_LT(summary.float32_probe_error(), 0);
+}
+
 TEST(DeformServerShutdownTest, ShutdownEndsOpenStreamsPromptly) {
   TestServer server;
   auto client = server.NewClient();

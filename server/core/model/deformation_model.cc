@@ -206,6 +206,7 @@ StatusOr<std::shared_ptr<const MaterialFactorization>> DeformationModel::Factori
     result->linear_response_ = BuildLinearPoseResponse(
         system_, skeleton_, linear_blend_plan_, result->row_weights_squared_, result->factor_);
   }
+  RoundFactorToFloat32IfWithinTolerance(result.get());
   result->factor_seconds_ = SecondsSince(start);
   return std::shared_ptr<const MaterialFactorization>(std::move(result));
 }
@@ -252,7 +253,7 @@ std::size_t DeformationModel::EstimatedBytes() const {
 
 std::size_t DeformationModel::FactorizationBytes() const {
   const LinearPoseResponse* response = default_factorization_->linear_response();
-  return default_factorization_->factor().bytes() + (response ? response->bytes() : 0);
+  return default_factorization_->factor().bytes_as_built() + (response ? response->bytes() : 0);
 }
 
 std::size_t DeformationModel::ScratchBytes() const {
@@ -266,7 +267,40 @@ std::size_t DeformationModel::ScratchBytes() const {
          default_factorization_->factor().WorkSize() * sizeof(double);
 }
 
+void DeformationModel::RoundFactorToFloat32IfWithinTolerance(MaterialFactorization* result) const {
+  const CholeskyFactor& exact = result->factor_;
+  const std::int64_t min_bytes = options_.float32_factor_min_bytes;
+  if (min_bytes < 0 || static_cast<std::int64_t>(exact.bytes()) < min_bytes) return;
+  CholeskyFactor rounded = exact.RoundedToFloat32();
+  DeformScratch scratch = MakeScratchWithWork(exact.WorkSize());
+  if (!AssembleRightHandSide(*result, Pose::Rest(skeleton_), &scratch)) return;
+  const auto rhs = scratch.solution;
+  auto exact_solution = rhs, rounded_solution = rhs;
+  if (!exact.Solve3(rhs.data(), exact_solution.data(), scratch.solve_work.data()).ok() ||
+      !rounded.Solve3(rhs.data(), rounded_solution.data(), scratch.solve_work.data()).ok()) {
+    return;
+  }
+  const int n = mesh_.num_vertices();
+  const double largest =
+      (exact_solution.topRows(n) - rounded_solution.topRows(n)).rowwise().norm().maxCoeff();
+  result->float32_probe_error_ = diagonal_ > 0 ? largest / diagonal_ : largest;
+  if (result->float32_probe_error_ <= MaterialFactorization::kFloat32ProbeTolerance) {
+    result->factor_ = std::move(rounded);
+    spdlog::debug("factor stored in float32: {} MB, rest pose within {:.2e} of the diagonal",
+                  result->factor_.bytes() / 1e6, result->float32_probe_error_);
+  } else {
+    spdlog::info(
+        "factor kept in double: its float32 rounding moves the rest pose by {:.2e} of the "
+        "diagonal (tolerance {:.1e})",
+        result->float32_probe_error_, MaterialFactorization::kFloat32ProbeTolerance);
+  }
+}
+
 DeformScratch DeformationModel::MakeScratch() const {
+  return MakeScratchWithWork(default_factorization_->factor().WorkSize());
+}
+
+DeformScratch DeformationModel::MakeScratchWithWork(std::size_t solve_work_doubles) const {
   DeformScratch scratch;
   scratch.model_id_ = id_;
   scratch.num_vertices = mesh_.num_vertices();
@@ -275,7 +309,7 @@ DeformScratch DeformationModel::MakeScratch() const {
                                                    : skeleton_.num_bones());
   scratch.solution.resize(mesh_.num_vertices() + system_.num_nodes, 3);
   scratch.rotated_deltas.resize(mesh_.num_vertices(), 3);
-  scratch.solve_work.resize(default_factorization_->factor().WorkSize());
+  scratch.solve_work.resize(solve_work_doubles);
   return scratch;
 }
 

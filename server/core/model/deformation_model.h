@@ -57,6 +57,15 @@ class MaterialFactorization {
   const LinearPoseResponse* linear_response() const { return linear_response_.get(); }
   // Seconds of the numeric factorisation, including the linear response when there is one.
   double factor_seconds() const { return factor_seconds_; }
+  // The float32 probe (ModelOptions::float32_factor_min_bytes): the largest vertex difference
+  // between the rest pose solved with the double factor and with its float32 rounding, relative
+  // to the bounding-box diagonal; negative where no probe ran. The factor is stored in float32
+  // (factor().stores_float32()) when the probe ran and stayed within kFloat32ProbeTolerance: a
+  // quarter of the 1e-6 of the diagonal that frames may differ by (the float32 transport's own
+  // rounding), the margin for poses away from the rest pose (on the shared meshes the error
+  // varies by less than 50% across poses: 1.4e-7 to 2.0e-7 of the diagonal).
+  double float32_probe_error() const { return float32_probe_error_; }
+  static constexpr double kFloat32ProbeTolerance = 2.5e-7;
 
  private:
   friend class DeformationModel;
@@ -64,6 +73,7 @@ class MaterialFactorization {
   CholeskyFactor factor_;
   std::unique_ptr<const LinearPoseResponse> linear_response_;
   double factor_seconds_ = 0;
+  double float32_probe_error_ = -1;
   std::uint64_t model_id_ = 0;  // the model that made it (DeformationModel::Owns)
 };
 
@@ -266,7 +276,8 @@ class DeformationModel {
   static std::size_t EstimateBytesBeforeBuild(int num_vertices, int num_triangles);
   std::size_t EstimatedBytes() const;
   // The bytes one more factorisation for other stiffness (Factorize) holds: the default
-  // factorisation's factor and linear response (same sparsity, same sizes).
+  // factorisation's factor and linear response (same sparsity, same sizes), the factor as it is
+  // built (in double, also where it is then stored in float32).
   std::size_t FactorizationBytes() const;
   // The bytes MakeScratch() allocates: one stream's solve buffers.
   std::size_t ScratchBytes() const;
@@ -286,6 +297,10 @@ class DeformationModel {
                            const CancelToken* cancel);
   // Factorize, stopping between the numeric factorisation and the linear response when `cancel`
   // (may be null) is cancelled.
+  // Replaces result's factor by its float32 rounding when options_.float32_factor_min_bytes asks
+  // for it and the rest-pose probe stays within kFloat32ProbeTolerance (MaterialFactorization).
+  void RoundFactorToFloat32IfWithinTolerance(MaterialFactorization* result) const;
+  DeformScratch MakeScratchWithWork(std::size_t solve_work_doubles) const;
   StatusOr<std::shared_ptr<const MaterialFactorization>> FactorizeCancellable(
       const Stiffness& stiffness, const CancelToken* cancel) const;
   Status BindToWeights(const SkinWeights& weights, const VertexAdjacency& adjacency);

@@ -84,6 +84,14 @@ struct ModelOptions {
   // vectors per knot. Default: 4; at most kMaxLinearBlendSegments.
   int linear_blend_segments = 4;
   static constexpr int kMaxLinearBlendSegments = 64;
+  // Store a factorisation's values in float32 (half the bytes each solve reads; the solve still
+  // computes in double) when its double factor holds at least this many bytes and the probe of
+  // MaterialFactorization::float32_probe_error() keeps its frames within a quarter of 1e-6 of the
+  // diagonal of the double factor's; otherwise the factor stays double. Negative: never (the
+  // default). Worth it where the solve is bound by memory: on the shared 133k arm (146 MB) the
+  // solve takes 0.72x the time (0.70x on two threads); on the 26k leg (25 MB) and smaller
+  // factors, which the caches hold, widening the floats costs more than the bytes save.
+  std::int64_t float32_factor_min_bytes = -1;
   MeshLimits limits;
 
   static ModelOptions Paper() { return {}; }

@@ -195,13 +195,33 @@ SupernodalFactorView CholeskyFactor::View() const {
   view.row_pointers = row_pointers_.data();
   view.value_pointers = value_pointers_.data();
   view.row_indices = row_indices_.data();
-  view.values = values_.data();
+  if (stores_float32()) {
+    view.float_values = float_values_.data();
+  } else {
+    view.values = values_.data();
+  }
   return view;
+}
+
+CholeskyFactor CholeskyFactor::RoundedToFloat32() const {
+  CholeskyFactor rounded;
+  if (!symbolic_) return rounded;
+  rounded.symbolic_ = symbolic_;
+  rounded.row_pointers_ = row_pointers_;
+  rounded.value_pointers_ = value_pointers_;
+  rounded.row_indices_ = row_indices_;
+  if (stores_float32()) {
+    rounded.float_values_ = float_values_;
+  } else {
+    rounded.float_values_.assign(values_.begin(), values_.end());  // the padding zeros too
+  }
+  return rounded;
 }
 
 std::size_t CholeskyFactor::bytes() const {
   if (!symbolic_) return 0;
-  return values_.size() * sizeof(double) + row_indices_.size() * sizeof(int) +
+  return values_.size() * sizeof(double) + float_values_.size() * sizeof(float) +
+         row_indices_.size() * sizeof(int) +
          (row_pointers_.size() + value_pointers_.size()) * sizeof(std::int64_t) +
          symbolic_->supernode_columns_.size() * sizeof(int);
 }

@@ -13,7 +13,9 @@ namespace deform {
 // row_indices[row_pointers[s] .. row_pointers[s + 1]) (its own columns first, then the rows below,
 // ascending), and its values a dense row-major (#rows) x (width) block at
 // values[value_pointers[s]], zero above the diagonal, and `values` is followed by at least
-// kSolveValuePadding readable zeros. permutation[new] = old.
+// kSolveValuePadding readable zeros. permutation[new] = old. A float32 factor sets `float_values`
+// (same layout and padding) instead of `values`: exactly one of the two is set. The passes read
+// float32 values widened to double and do all their arithmetic in double either way.
 inline constexpr int kSolveValuePadding = 3;
 
 struct SupernodalFactorView {
@@ -25,6 +27,7 @@ struct SupernodalFactorView {
   const std::int64_t* value_pointers = nullptr;
   const int* row_indices = nullptr;
   const double* values = nullptr;
+  const float* float_values = nullptr;
 };
 
 // The solution during a three-column solve: one row of four doubles per unknown (x, y, z and a

@@ -335,6 +335,62 @@ TEST_P(SolveKernelTest, ParallelSolveMatchesSolve3) {
             StatusCode::kFailedPrecondition);
 }
 
+// A float32 factor (RoundedToFloat32): every pass (three columns, many columns, the parallel
+// parts) reads the same rounded values, so they agree with each other to 1e-12 as the double ones
+// do; against the double factor they differ by the rounding only (well within 1e-5 on these
+// well-conditioned matrices, and not zero: the floats are what is read), and the values take half
+// the bytes.
+TEST_P(SolveKernelTest, Float32FactorSolvesWithItsRoundedValues) {
+  if (!SolveKernelAvailable(GetParam())) {
+    GTEST_SKIP() << SolveKernelName(GetParam()) << " is not available on this build or CPU";
+  }
+  using Rhs = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  ThreadPerPartRunner threads;
+  std::vector<std::pair<std::string, ColMajorMatrix>> cases;
+  for (const int n : {1, 2, 5, 7, 37, 301, 303, 2000})
+    cases.emplace_back("random " + std::to_string(n), RandomSpdMatrix(n, 4, 400 + n));
+  cases.emplace_back("grid 40", GridMatrix(40));
+  for (const auto& [name, a] : cases) {
+    auto symbolic = SymbolicCholesky::Analyze(a, Ordering::kMetis);
+    ASSERT_TRUE(symbolic.ok()) << symbolic.status().ToString();
+    auto exact = CholeskyFactor::Factorize(*symbolic, a);
+    ASSERT_TRUE(exact.ok()) << exact.status().ToString();
+    const CholeskyFactor rounded = exact->RoundedToFloat32();
+    EXPECT_FALSE(exact->stores_float32());
+    ASSERT_TRUE(rounded.stores_float32()) << name;
+    EXPECT_LT(rounded.bytes(), exact->bytes()) << name;
+    EXPECT_EQ(rounded.RoundedToFloat32().bytes(), rounded.bytes()) << name;
+    const int n = static_cast<int>(a.rows());
+    const Rhs b = Rhs::Random(n, 3);
+    Rhs expected(n, 3), x(n, 3);
+    std::vector<double> work3(exact->WorkSize(), std::nan(""));
+    ASSERT_TRUE(exact->Solve3(b.data(), expected.data(), work3.data(), GetParam()).ok());
+    ASSERT_TRUE(rounded.Solve3(b.data(), x.data(), work3.data(), GetParam()).ok());
+    const double difference = (x - expected).norm() / expected.norm();
+    EXPECT_LE(difference, 1e-5) << name;
+    if (n >= 5) EXPECT_GT(difference, 1e-12) << name << ": the float32 values were not read";
+    // Many columns: two frames, each equal to the float32 Solve3 of its columns.
+    RowMajor b6(n, 6), x6(n, 6);
+    b6 << b, b;
+    std::vector<double> work6(rounded.WorkSizeMany(6));
+    ASSERT_TRUE(rounded.SolveMany(b6.data(), x6.data(), 6, work6.data(), GetParam()).ok());
+    EXPECT_LE((x6.leftCols(3) - x).norm(), 1e-12 * x.norm()) << name;
+    EXPECT_LE((x6.rightCols(3) - x).norm(), 1e-12 * x.norm()) << name;
+    // The parallel solve on threads.
+    const ParallelSolvePlan plan = rounded.PlanParallel(2);
+    if (plan.parts == 0) continue;
+    std::vector<double> work(rounded.WorkSizeParallel(plan), std::nan(""));
+    Rhs parallel(n, 3);
+    ASSERT_TRUE(
+        rounded.Solve3Parallel(plan, b.data(), parallel.data(), work.data(), &threads, GetParam())
+            .ok());
+    EXPECT_LE((parallel - x).norm(), 1e-12 * x.norm()) << name;
+  }
+  EXPECT_FALSE(CholeskyFactor().RoundedToFloat32().stores_float32());
+  EXPECT_EQ(CholeskyFactor().RoundedToFloat32().size(), 0);
+}
+
 INSTANTIATE_TEST_SUITE_P(AllKernels, SolveKernelTest,
                          ::testing::Values(SolveKernel::kBaseline, SolveKernel::kAvx2Fma),
                          [](const auto& info) {

@@ -39,6 +39,11 @@ inline void Store4(double* p, Vec4 v) { *reinterpret_cast<Vec4Unaligned*>(p) = v
 inline Vec4 MakeVec4(double a, double b, double c, double d) { return Vec4{a, b, c, d}; }
 inline double Lane(Vec4 v, int i) { return v[i]; }
 inline double Sum4(Vec4 v) { return (v[0] + v[2]) + (v[1] + v[3]); }
+// Four floats of a float32 factor, widened to doubles (one SSE load and one conversion).
+typedef float Vec4fUnaligned __attribute__((vector_size(16), aligned(4), may_alias));
+inline Vec4 Load4(const float* p) {
+  return __builtin_convertvector(*reinterpret_cast<const Vec4fUnaligned*>(p), Vec4);
+}
 
 // (sum of a, sum of b, sum of c, sum of d) in two rounds of shuffles and adds.
 inline Vec4 Sum4x4(Vec4 a, Vec4 b, Vec4 c, Vec4 d) {
@@ -87,6 +92,8 @@ inline Vec4 MakeVec4(double a, double b, double c, double d) {
   return Vec4{Vec2{a, b}, Vec2{c, d}};
 }
 inline double Lane(Vec4 v, int i) { return i < 2 ? v.lo[i] : v.hi[i - 2]; }
+// Four floats of a float32 factor, widened to doubles.
+inline Vec4 Load4(const float* p) { return MakeVec4(p[0], p[1], p[2], p[3]); }
 inline double Sum4(Vec4 v) {
   const Vec2 s = v.lo + v.hi;
   return s[0] + s[1];
@@ -129,8 +136,9 @@ inline void MultiplyAdd3(Vec4 r, Vec4 x, Vec4 y, Vec4 z, Vec4* sx, Vec4* sy, Vec
 // sums[4 j + c] = sum over k < n of row_j[k] * p.c[k], for the four rows j and the columns c
 // (sums[4 j + 3] = 0: the layout of four solution rows). `n` is a multiple of four: the callers
 // pass a tile's start column or a padded width.
-inline void Dot4x3(const double* __restrict r0, const double* __restrict r1,
-                   const double* __restrict r2, const double* __restrict r3, const Planar& p, int n,
+template <typename Value>
+inline void Dot4x3(const Value* __restrict r0, const Value* __restrict r1,
+                   const Value* __restrict r2, const Value* __restrict r3, const Planar& p, int n,
                    double* __restrict sums) {
   const double* __restrict px = p.x;
   const double* __restrict py = p.y;
@@ -152,7 +160,8 @@ inline void Dot4x3(const double* __restrict r0, const double* __restrict r1,
 }
 
 // sums[c] = sum over k < n of row[k] * p.c[k].
-inline void Dot1x3(const double* __restrict row, const Planar& p, int n, double* __restrict sums) {
+template <typename Value>
+inline void Dot1x3(const Value* __restrict row, const Planar& p, int n, double* __restrict sums) {
   Vec4 a0 = Splat4(0), a1 = a0, a2 = a0;
   int k = 0;
   for (; k + 4 <= n; k += 4) {
@@ -173,8 +182,9 @@ inline void Dot1x3(const double* __restrict row, const Planar& p, int n, double*
 }
 
 // p.c[k] -= sum over the four rows j of row_j[k] * coefficients[3 j + c], for k < n.
-inline void SubtractRows4x3(const double* __restrict r0, const double* __restrict r1,
-                            const double* __restrict r2, const double* __restrict r3,
+template <typename Value>
+inline void SubtractRows4x3(const Value* __restrict r0, const Value* __restrict r1,
+                            const Value* __restrict r2, const Value* __restrict r3,
                             const double* __restrict coefficients, const Planar& p, int n) {
   double* __restrict px = p.x;
   double* __restrict py = p.y;
@@ -201,7 +211,8 @@ inline void SubtractRows4x3(const double* __restrict r0, const double* __restric
 }
 
 // p.c[k] -= row[k] * coefficients[c], for k < n.
-inline void SubtractRow1x3(const double* __restrict row, const double* __restrict coefficients,
+template <typename Value>
+inline void SubtractRow1x3(const Value* __restrict row, const double* __restrict coefficients,
                            const Planar& p, int n) {
   const double q0 = coefficients[0], q1 = coefficients[1], q2 = coefficients[2];
   int k = 0;
@@ -232,14 +243,15 @@ inline const double* Row(const double* y, int row) {
 // Forward substitution with a supernode's dense lower-triangular diagonal block (row-major,
 // `width` square): solves for its unknowns, whose right-hand sides are the solution rows from
 // `ys` on, writing them back there and planar into `p`.
-inline void ForwardDiagonal(const double* __restrict block, int width, double* __restrict ys,
+template <typename Value>
+inline void ForwardDiagonal(const Value* __restrict block, int width, double* __restrict ys,
                             const Planar& p) {
   int c = 0;
   for (; c + 4 <= width; c += 4) {
-    const double* r0 = block + static_cast<std::ptrdiff_t>(c) * width;
-    const double* r1 = r0 + width;
-    const double* r2 = r1 + width;
-    const double* r3 = r2 + width;
+    const Value* r0 = block + static_cast<std::ptrdiff_t>(c) * width;
+    const Value* r1 = r0 + width;
+    const Value* r2 = r1 + width;
+    const Value* r3 = r2 + width;
     double s[16];
     Dot4x3(r0, r1, r2, r3, p, c, s);
     const double* t = Row(ys, c);
@@ -258,7 +270,7 @@ inline void ForwardDiagonal(const double* __restrict block, int width, double* _
     }
   }
   for (; c < width; ++c) {
-    const double* row = block + static_cast<std::ptrdiff_t>(c) * width;
+    const Value* row = block + static_cast<std::ptrdiff_t>(c) * width;
     double s[3];
     Dot1x3(row, p, c, s);
     const double* t = Row(ys, c);
@@ -278,15 +290,16 @@ inline void ForwardDiagonal(const double* __restrict block, int width, double* _
 // entry (and is consumed); the solution goes to the solution rows from `ys` on. Rows of the block
 // are taken four at a time from the bottom: their corner triangle is solved, then they update the
 // rows above together.
-inline void BackwardDiagonal(const double* __restrict block, int width, double* __restrict ys,
+template <typename Value>
+inline void BackwardDiagonal(const Value* __restrict block, int width, double* __restrict ys,
                              const Planar& p) {
   int c = width;  // rows [0, c) are still to solve
   for (; c >= 4; c -= 4) {
     const int f = c - 4;
-    const double* r0 = block + static_cast<std::ptrdiff_t>(f) * width;
-    const double* r1 = r0 + width;
-    const double* r2 = r1 + width;
-    const double* r3 = r2 + width;
+    const Value* r0 = block + static_cast<std::ptrdiff_t>(f) * width;
+    const Value* r1 = r0 + width;
+    const Value* r2 = r1 + width;
+    const Value* r3 = r2 + width;
     double* in[3] = {p.x + f, p.y + f, p.z + f};
     double solved[12];  // solved[3 j + d]: unknown f + j, column d
     for (int d = 0; d < 3; ++d) {
@@ -310,7 +323,7 @@ inline void BackwardDiagonal(const double* __restrict block, int width, double* 
   }
   for (; c > 0; --c) {
     const int f = c - 1;
-    const double* row = block + static_cast<std::ptrdiff_t>(f) * width;
+    const Value* row = block + static_cast<std::ptrdiff_t>(f) * width;
     const double solved[3] = {p.x[f] / row[f], p.y[f] / row[f], p.z[f] / row[f]};
     double* t = Row(ys, f);
     t[0] = solved[0];
@@ -321,13 +334,14 @@ inline void BackwardDiagonal(const double* __restrict block, int width, double* 
 }
 
 // y[rows[r]] -= (block row r) . p for the rows below the diagonal block (r >= width).
-inline void ForwardUpdate(const double* __restrict block, const int* __restrict rows, int width,
+template <typename Value>
+inline void ForwardUpdate(const Value* __restrict block, const int* __restrict rows, int width,
                           std::int64_t num_rows, const Planar& p, double* __restrict y) {
   ZeroPadding(p, width);
   const int padded = RoundUp4(width);
   std::int64_t r = width;
   for (; r + 4 <= num_rows; r += 4) {
-    const double* r0 = block + r * width;
+    const Value* r0 = block + r * width;
     double s[16];
     Dot4x3(r0, r0 + width, r0 + 2 * width, r0 + 3 * width, p, padded, s);
     for (int j = 0; j < 4; ++j) {
@@ -346,13 +360,14 @@ inline void ForwardUpdate(const double* __restrict block, const int* __restrict 
 }
 
 // p -= sum over the rows below the diagonal block of (block row r) * y[rows[r]].
-inline void BackwardUpdate(const double* __restrict block, const int* __restrict rows, int width,
+template <typename Value>
+inline void BackwardUpdate(const Value* __restrict block, const int* __restrict rows, int width,
                            std::int64_t num_rows, const Planar& p, double* __restrict y) {
   ZeroPadding(p, width);  // not read back, but kept finite
   const int padded = RoundUp4(width);
   std::int64_t r = width;
   for (; r + 4 <= num_rows; r += 4) {
-    const double* r0 = block + r * width;
+    const Value* r0 = block + r * width;
     double q[12];
     for (int j = 0; j < 4; ++j) {
       const double* source = Row(y, rows[r + j]);
@@ -369,13 +384,13 @@ inline void BackwardUpdate(const double* __restrict block, const int* __restrict
 
 // The narrow supernodes (most of them, holding few of the values) with the width fixed at
 // compile time: each block row updates or reads one whole solution row.
-template <int kWidth>
-inline void ForwardUpdateNarrow(const double* __restrict block, const int* __restrict rows,
+template <typename Value, int kWidth>
+inline void ForwardUpdateNarrow(const Value* __restrict block, const int* __restrict rows,
                                 std::int64_t num_rows, const Planar& p, double* __restrict y) {
   Vec4 unknowns[kWidth];
   for (int k = 0; k < kWidth; ++k) unknowns[k] = MakeVec4(p.x[k], p.y[k], p.z[k], 0);
   for (std::int64_t r = kWidth; r < num_rows; ++r) {
-    const double* row = block + r * kWidth;
+    const Value* row = block + r * kWidth;
     double* t = Row(y, rows[r]);
     Vec4 v = Load4(t);
     for (int k = 0; k < kWidth; ++k) v -= Splat4(row[k]) * unknowns[k];
@@ -384,16 +399,16 @@ inline void ForwardUpdateNarrow(const double* __restrict block, const int* __res
 }
 
 // Two rows at a time into separate sums, so consecutive rows do not wait on each other's adds.
-template <int kWidth>
-inline void BackwardUpdateNarrow(const double* __restrict block, const int* __restrict rows,
+template <typename Value, int kWidth>
+inline void BackwardUpdateNarrow(const Value* __restrict block, const int* __restrict rows,
                                  std::int64_t num_rows, const Planar& p,
                                  const double* __restrict y) {
   Vec4 even[kWidth], odd[kWidth];
   for (int k = 0; k < kWidth; ++k) even[k] = odd[k] = Splat4(0);
   std::int64_t r = kWidth;
   for (; r + 2 <= num_rows; r += 2) {
-    const double* row0 = block + r * kWidth;
-    const double* row1 = row0 + kWidth;
+    const Value* row0 = block + r * kWidth;
+    const Value* row1 = row0 + kWidth;
     const Vec4 z0 = Load4(Row(y, rows[r]));
     const Vec4 z1 = Load4(Row(y, rows[r + 1]));
     for (int k = 0; k < kWidth; ++k) {
@@ -402,7 +417,7 @@ inline void BackwardUpdateNarrow(const double* __restrict block, const int* __re
     }
   }
   if (r < num_rows) {
-    const double* row = block + r * kWidth;
+    const Value* row = block + r * kWidth;
     const Vec4 z = Load4(Row(y, rows[r]));
     for (int k = 0; k < kWidth; ++k) even[k] += Splat4(row[k]) * z;
   }
@@ -433,42 +448,68 @@ inline void DispatchNarrow(int width, Kernel&& kernel) {
 }
 
 // Supernode sn's block of the factor (see SupernodalFactorView).
+template <typename Value>
 struct SupernodeBlock {
   int first;              // its first column
   int width;              // its number of columns
   const int* rows;        // its row indices
   std::int64_t num_rows;  // their number
-  const double* values;   // its dense row-major (num_rows) x (width) block
+  const Value* values;    // its dense row-major (num_rows) x (width) block
 };
 
-inline SupernodeBlock BlockOf(const SupernodalFactorView& f, int sn) {
+// The factor's values as stored: double, or float32 (widened to double as they are read).
+template <typename Value>
+inline const Value* ValuesOf(const SupernodalFactorView& f);
+template <>
+inline const double* ValuesOf<double>(const SupernodalFactorView& f) {
+  return f.values;
+}
+template <>
+inline const float* ValuesOf<float>(const SupernodalFactorView& f) {
+  return f.float_values;
+}
+
+template <typename Value>
+inline SupernodeBlock<Value> BlockOf(const SupernodalFactorView& f, int sn) {
   const int first = f.supernode_columns[sn];
-  return SupernodeBlock{
+  return SupernodeBlock<Value>{
       first, f.supernode_columns[sn + 1] - first, f.row_indices + f.row_pointers[sn],
-      f.row_pointers[sn + 1] - f.row_pointers[sn], f.values + f.value_pointers[sn]};
+      f.row_pointers[sn + 1] - f.row_pointers[sn], ValuesOf<Value>(f) + f.value_pointers[sn]};
+}
+
+// Runs `pass` with the factor's value type: pass(double()) or pass(float()).
+template <typename Pass>
+inline void WithValueType(const SupernodalFactorView& f, Pass&& pass) {
+  if (f.float_values != nullptr) {
+    pass(float());
+  } else {
+    pass(double());
+  }
 }
 
 // Supernode sn's step of the forward pass (L y = P b): its diagonal block solves its rows of y,
 // which then update the rows below.
+template <typename Value>
 inline void ForwardSupernode(const SupernodalFactorView& f, int sn, double* __restrict y,
                              double* planar_buffer) {
-  const SupernodeBlock s = BlockOf(f, sn);
+  const SupernodeBlock<Value> s = BlockOf<Value>(f, sn);
   const Planar p = PlanarOf(planar_buffer, s.width);
   ForwardDiagonal(s.values, s.width, Row(y, s.first), p);
   if (s.width > 4) {
     ForwardUpdate(s.values, s.rows, s.width, s.num_rows, p, y);
   } else {
     DispatchNarrow(s.width, [&](auto w) {
-      ForwardUpdateNarrow<decltype(w)::value>(s.values, s.rows, s.num_rows, p, y);
+      ForwardUpdateNarrow<Value, decltype(w)::value>(s.values, s.rows, s.num_rows, p, y);
     });
   }
 }
 
 // Supernode sn's step of the backward pass (L^T z = y): its rows subtract the rows below times
 // their solved values, then the transposed diagonal block solves them.
+template <typename Value>
 inline void BackwardSupernode(const SupernodalFactorView& f, int sn, double* __restrict y,
                               double* planar_buffer) {
-  const SupernodeBlock s = BlockOf(f, sn);
+  const SupernodeBlock<Value> s = BlockOf<Value>(f, sn);
   const Planar p = PlanarOf(planar_buffer, s.width);
   double* ys = Row(y, s.first);
   for (int k = 0; k < s.width; ++k) {
@@ -481,7 +522,7 @@ inline void BackwardSupernode(const SupernodalFactorView& f, int sn, double* __r
     BackwardUpdate(s.values, s.rows, s.width, s.num_rows, p, y);
   } else {
     DispatchNarrow(s.width, [&](auto w) {
-      BackwardUpdateNarrow<decltype(w)::value>(s.values, s.rows, s.num_rows, p, y);
+      BackwardUpdateNarrow<Value, decltype(w)::value>(s.values, s.rows, s.num_rows, p, y);
     });
   }
   BackwardDiagonal(s.values, s.width, ys, p);
@@ -491,13 +532,20 @@ inline void BackwardSupernode(const SupernodalFactorView& f, int sn, double* __r
 // as Solve3Impl's); the parallel solve's part (parallel_solve.h).
 void ForwardListImpl(const SupernodalFactorView& f, const int* supernodes, int count, double* y,
                      double* planar_buffer) {
-  for (int i = 0; i < count; ++i) ForwardSupernode(f, supernodes[i], y, planar_buffer);
+  WithValueType(f, [&](auto value) {
+    using Value = decltype(value);
+    for (int i = 0; i < count; ++i) ForwardSupernode<Value>(f, supernodes[i], y, planar_buffer);
+  });
 }
 
 // The backward pass over the listed supernodes only (taken in descending order).
 void BackwardListImpl(const SupernodalFactorView& f, const int* supernodes, int count, double* y,
                       double* planar_buffer) {
-  for (int i = count - 1; i >= 0; --i) BackwardSupernode(f, supernodes[i], y, planar_buffer);
+  WithValueType(f, [&](auto value) {
+    using Value = decltype(value);
+    for (int i = count - 1; i >= 0; --i)
+      BackwardSupernode<Value>(f, supernodes[i], y, planar_buffer);
+  });
 }
 
 void Solve3Impl(const SupernodalFactorView& f, const double* b, double* x, double* work) {
@@ -514,8 +562,13 @@ void Solve3Impl(const SupernodalFactorView& f, const double* b, double* x, doubl
     t[2] = source[2];
     t[3] = 0;
   }
-  for (int sn = 0; sn < f.num_supernodes; ++sn) ForwardSupernode(f, sn, y, planar_buffer);
-  for (int sn = f.num_supernodes - 1; sn >= 0; --sn) BackwardSupernode(f, sn, y, planar_buffer);
+  WithValueType(f, [&](auto value) {
+    using Value = decltype(value);
+    for (int sn = 0; sn < f.num_supernodes; ++sn) ForwardSupernode<Value>(f, sn, y, planar_buffer);
+    for (int sn = f.num_supernodes - 1; sn >= 0; --sn) {
+      BackwardSupernode<Value>(f, sn, y, planar_buffer);
+    }
+  });
   for (int i = 0; i < n; ++i) {
     double* target = x + 3 * static_cast<std::ptrdiff_t>(f.permutation[i]);
     const double* t = Row(y, i);
@@ -538,13 +591,13 @@ constexpr int kMaxBlockedVecs = 6;
 
 // Forward pass of one supernode: its diagonal block solves its own rows (contiguous in y), then
 // every row below subtracts its block row times them.
-template <int kVecs>
-inline void ForwardSupernodeMany(const SupernodeBlock& s, double* __restrict y) {
+template <typename Value, int kVecs>
+inline void ForwardSupernodeMany(const SupernodeBlock<Value>& s, double* __restrict y) {
   constexpr int kStride = 4 * kVecs;
   double* __restrict own = y + kStride * static_cast<std::ptrdiff_t>(s.first);
   const int width = s.width;
   for (int c = 0; c < width; ++c) {
-    const double* row = s.values + static_cast<std::ptrdiff_t>(c) * width;
+    const Value* row = s.values + static_cast<std::ptrdiff_t>(c) * width;
     Vec4 sum[kVecs];
     double* target = own + kStride * c;
     for (int j = 0; j < kVecs; ++j) sum[j] = Load4(target + 4 * j);
@@ -560,8 +613,8 @@ inline void ForwardSupernodeMany(const SupernodeBlock& s, double* __restrict y) 
   if constexpr (kVecs <= kMaxBlockedVecs) {
     // Two rows at a time: each load of the solved rows serves both (register blocking).
     for (; r + 2 <= s.num_rows; r += 2) {
-      const double* row0 = s.values + r * width;
-      const double* row1 = row0 + width;
+      const Value* row0 = s.values + r * width;
+      const Value* row1 = row0 + width;
       double* target0 = y + kStride * static_cast<std::ptrdiff_t>(s.rows[r]);
       double* target1 = y + kStride * static_cast<std::ptrdiff_t>(s.rows[r + 1]);
       Vec4 sum0[kVecs], sum1[kVecs];
@@ -586,7 +639,7 @@ inline void ForwardSupernodeMany(const SupernodeBlock& s, double* __restrict y) 
     }
   }
   for (; r < s.num_rows; ++r) {
-    const double* row = s.values + r * width;
+    const Value* row = s.values + r * width;
     double* target = y + kStride * static_cast<std::ptrdiff_t>(s.rows[r]);
     Vec4 sum[kVecs];
     for (int j = 0; j < kVecs; ++j) sum[j] = Load4(target + 4 * j);
@@ -602,8 +655,8 @@ inline void ForwardSupernodeMany(const SupernodeBlock& s, double* __restrict y) 
 // Backward pass of one supernode: its own rows subtract the block's rows below times the solved
 // rows there (column by column of the block, the sums kept in registers), then the transposed
 // diagonal block solves them, last row first.
-template <int kVecs>
-inline void BackwardSupernodeMany(const SupernodeBlock& s, double* __restrict y) {
+template <typename Value, int kVecs>
+inline void BackwardSupernodeMany(const SupernodeBlock<Value>& s, double* __restrict y) {
   constexpr int kStride = 4 * kVecs;
   double* __restrict own = y + kStride * static_cast<std::ptrdiff_t>(s.first);
   const int width = s.width;
@@ -643,7 +696,7 @@ inline void BackwardSupernodeMany(const SupernodeBlock& s, double* __restrict y)
     for (int j = 0; j < kVecs; ++j) Store4(target + 4 * j, Load4(target + 4 * j) - sum[j]);
   }
   for (int c = width - 1; c >= 0; --c) {
-    const double* row = s.values + static_cast<std::ptrdiff_t>(c) * width;
+    const Value* row = s.values + static_cast<std::ptrdiff_t>(c) * width;
     double* target = own + kStride * c;
     const Vec4 pivot = Splat4(row[c]);
     Vec4 solved[kVecs];
@@ -673,10 +726,15 @@ void SolveManyWithWidth(const SupernodalFactorView& f, const double* b, double* 
     for (; c < columns; ++c) t[c] = source[c];
     for (; c < kStride; ++c) t[c] = 0;
   }
-  for (int sn = 0; sn < f.num_supernodes; ++sn) ForwardSupernodeMany<kVecs>(BlockOf(f, sn), y);
-  for (int sn = f.num_supernodes - 1; sn >= 0; --sn) {
-    BackwardSupernodeMany<kVecs>(BlockOf(f, sn), y);
-  }
+  WithValueType(f, [&](auto value) {
+    using Value = decltype(value);
+    for (int sn = 0; sn < f.num_supernodes; ++sn) {
+      ForwardSupernodeMany<Value, kVecs>(BlockOf<Value>(f, sn), y);
+    }
+    for (int sn = f.num_supernodes - 1; sn >= 0; --sn) {
+      BackwardSupernodeMany<Value, kVecs>(BlockOf<Value>(f, sn), y);
+    }
+  });
   for (int i = 0; i < n; ++i) {
     double* target = x + static_cast<std::ptrdiff_t>(columns) * f.permutation[i];
     const double* t = y + kStride * static_cast<std::ptrdiff_t>(i);
