@@ -160,8 +160,9 @@ std::vector<double> TimeSolve3(const CholeskyFactor& factor, const Rhs& rhs, Def
   return seconds;
 }
 
-// `frames` frames' two triangular passes in one batch (CholeskyFactor::SolveMany over 3 * frames
-// columns), the right-hand sides those of the benchmark pose. Besides the counters of the other
+// `frames` frames' two triangular passes in one batch (CholeskyFactor::SolveFrames, as
+// DeformBatch runs them: each frame's right-hand side and solution in arrays of their own), the
+// right-hand sides those of the benchmark pose. Besides the counters of the other
 // solves (median_ms and the bounds are per batch): frame_ms, the median per frame;
 // unbatched_frame_ms, Solve3's median on the same right-hand side timed in the same benchmark;
 // x_unbatched, their ratio; frame_bound_ms and frame_cache_bound_ms, the bounds per frame.
@@ -171,15 +172,16 @@ void BM_BatchedSolve(benchmark::State& state, BenchMesh mesh, int frames_per_bat
   const CholeskyFactor& factor = frames->factorization->factor();
   DeformScratch& scratch = frames->scratch;
   const auto rhs = AssembledRightHandSide(frames.get());
-  const int columns = 3 * frames_per_batch;
-  const Eigen::Index n = rhs.rows();
-  std::vector<double> batch(static_cast<std::size_t>(n) * columns), solved(batch.size());
-  for (Eigen::Index i = 0; i < n; ++i) {
-    for (int c = 0; c < columns; ++c) batch[i * columns + c] = rhs(i, c % 3);
-  }
-  std::vector<double> work(factor.WorkSizeMany(columns));
+  // Each frame's right-hand side and solution in arrays of their own, as DeformBatch solves them.
+  std::vector<std::vector<double>> solved(frames_per_batch,
+                                          std::vector<double>(rhs.data(), rhs.data() + rhs.size()));
+  std::vector<const double*> in(frames_per_batch, rhs.data());
+  std::vector<double*> out;
+  for (std::vector<double>& frame : solved) out.push_back(frame.data());
+  std::vector<double> work(factor.WorkSizeMany(3 * frames_per_batch));
   const auto seconds = TimeEach(state, [&] {
-    benchmark::DoNotOptimize(factor.SolveMany(batch.data(), solved.data(), columns, work.data()));
+    benchmark::DoNotOptimize(
+        factor.SolveFrames(in.data(), out.data(), frames_per_batch, work.data()));
   });
   const std::vector<double> unbatched = TimeSolve3(factor, rhs, &scratch, seconds.size());
   ReportAgainstBound(state, factor.bytes(), seconds);

@@ -345,10 +345,7 @@ DeformBatchScratch DeformationModel::MakeBatchScratch(int max_frames) const {
   DeformBatchScratch batch;
   batch.model_id_ = id_;
   batch.max_frames = std::clamp(max_frames, 1, kMaxBatchFrames);
-  const int columns = 3 * batch.max_frames;
-  batch.columns.resize(static_cast<std::size_t>(mesh_.num_vertices() + system_.num_nodes) *
-                       columns);
-  batch.solve_work.resize(default_factorization_->factor().WorkSizeMany(columns));
+  batch.solve_work.resize(default_factorization_->factor().WorkSizeMany(3 * batch.max_frames));
   return batch;
 }
 
@@ -374,27 +371,18 @@ bool DeformationModel::DeformBatch(const MaterialFactorization& factorization,
     return true;
   }
   const auto start = Clock::now();
-  const Eigen::Index rows = mesh_.num_vertices() + system_.num_nodes;
-  const int columns = 3 * count;
-  double* packed = batch->columns.data();
+  // Each frame's right-hand side is solved where it is: the batched solve gathers the frames'
+  // rows into its own and scatters the solutions back.
+  double* solutions[kMaxBatchFrames];
   for (int f = 0; f < count; ++f) {
     AssembleOwnedRightHandSide(factorization, *poses[f], scratches[f]);
-    const double* rhs = scratches[f]->solution.data();
-    for (Eigen::Index i = 0; i < rows; ++i) {
-      for (int c = 0; c < 3; ++c) packed[i * columns + 3 * f + c] = rhs[3 * i + c];
-    }
+    solutions[f] = scratches[f]->solution.data();
   }
   const auto solve_start = Clock::now();
   const Status solved =
-      factorization.factor().SolveMany(packed, packed, columns, batch->solve_work.data());
+      factorization.factor().SolveFrames(solutions, solutions, count, batch->solve_work.data());
   assert(solved.ok());
   (void)solved;
-  for (int f = 0; f < count; ++f) {
-    double* x = scratches[f]->solution.data();
-    for (Eigen::Index i = 0; i < rows; ++i) {
-      for (int c = 0; c < 3; ++c) x[3 * i + c] = packed[i * columns + 3 * f + c];
-    }
-  }
   if (timings != nullptr) {
     timings->right_hand_side = std::chrono::duration<double>(solve_start - start).count();
     timings->solve = SecondsSince(solve_start);
@@ -403,10 +391,8 @@ bool DeformationModel::DeformBatch(const MaterialFactorization& factorization,
 }
 
 std::size_t DeformationModel::BatchScratchBytes(int max_frames) const {
-  const auto columns = static_cast<std::size_t>(3 * std::clamp(max_frames, 1, kMaxBatchFrames));
-  const auto rows = static_cast<std::size_t>(mesh_.num_vertices() + system_.num_nodes);
-  return sizeof(double) * (rows * columns + default_factorization_->factor().WorkSizeMany(
-                                                static_cast<int>(columns)));
+  const int columns = 3 * std::clamp(max_frames, 1, kMaxBatchFrames);
+  return sizeof(double) * default_factorization_->factor().WorkSizeMany(columns);
 }
 
 bool DeformationModel::AssembleRightHandSide(const MaterialFactorization& factorization,

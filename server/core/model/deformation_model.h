@@ -96,11 +96,11 @@ struct DeformScratch {
   std::uint64_t model_id_ = 0;  // the model that made it; 0 for a default-constructed scratch
 };
 
-// Buffers for DeformationModel::DeformBatch(): the batch's right-hand sides side by side and the
-// batched solve's work. Create with MakeBatchScratch(); one per caller that batches (a worker).
+// Buffers for DeformationModel::DeformBatch(): the batched solve's rows (the frames' right-hand
+// sides side by side, in the factor's order). Create with MakeBatchScratch(); one per caller that
+// batches (a worker).
 struct DeformBatchScratch {
   int max_frames = 0;
-  std::vector<double> columns;     // (n + m) rows of 3 * max_frames
   std::vector<double> solve_work;  // CholeskyFactor::WorkSizeMany(3 * max_frames)
 
  private:

@@ -163,6 +163,23 @@ Status CholeskyFactor::SolveMany(const double* b, double* x, int columns, double
   return Status::Ok();
 }
 
+Status CholeskyFactor::SolveFrames(const double* const* b, double* const* x, int frames,
+                                   double* work) const {
+  return SolveFrames(b, x, frames, work, BestSolveKernel());
+}
+
+Status CholeskyFactor::SolveFrames(const double* const* b, double* const* x, int frames,
+                                   double* work, SolveKernel kernel) const {
+  if (!symbolic_) return Status::FailedPrecondition("the Cholesky factor is empty");
+  if (frames < 1 || 3 * frames > kMaxSolveColumns) {
+    return Status::InvalidArgument("a batched solve takes 1 to " +
+                                   std::to_string(kMaxSolveColumns / 3) + " frames, not " +
+                                   std::to_string(frames));
+  }
+  SolveFramesFor(kernel)(View(), b, x, frames, work);
+  return Status::Ok();
+}
+
 ParallelSolvePlan CholeskyFactor::PlanParallel(int parts) const {
   return symbolic_ ? PlanParallelSolve(View(), parts) : ParallelSolvePlan();
 }

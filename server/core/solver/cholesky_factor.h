@@ -49,6 +49,14 @@ class CholeskyFactor {
   Status SolveMany(const double* b, double* x, int columns, double* work) const;
   Status SolveMany(const double* b, double* x, int columns, double* work, SolveKernel kernel) const;
   std::size_t WorkSizeMany(int columns) const;
+  // SolveMany for `frames` frames (1 to kMaxSolveColumns / 3) of three columns each, every frame
+  // in an array of its own stored as Solve3's (b[f][3 i + c]): no packed copy of the batch.
+  // x[f] may equal b[f]; `work` holds WorkSizeMany(3 * frames) doubles. Each frame matches its
+  // Solve3 to round-off. Allocation-free; const and thread-safe. FAILED_PRECONDITION for an empty
+  // factor, INVALID_ARGUMENT for a frame count out of range, nothing written either way.
+  Status SolveFrames(const double* const* b, double* const* x, int frames, double* work) const;
+  Status SolveFrames(const double* const* b, double* const* x, int frames, double* work,
+                     SolveKernel kernel) const;
   // Solve3 on several threads (parallel_solve.h): `plan` from PlanParallel (of this factor or one
   // of the same analysis), its parts run through `runner`; `work` holds WorkSizeParallel(plan)
   // doubles. Matches Solve3 to round-off. Allocation-free; const and thread-safe.

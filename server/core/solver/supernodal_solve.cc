@@ -6,11 +6,15 @@ namespace deform {
 void Solve3Baseline(const SupernodalFactorView& factor, const double* b, double* x, double* work);
 void SolveManyBaseline(const SupernodalFactorView& factor, const double* b, double* x, int columns,
                        double* work);
+void SolveFramesBaseline(const SupernodalFactorView& factor, const double* const* b,
+                         double* const* x, int frames, double* work);
 void ForwardListBaseline(const SupernodalFactorView& factor, const int* supernodes, int count,
                          double* y, double* planar_buffer);
 void BackwardListBaseline(const SupernodalFactorView& factor, const int* supernodes, int count,
                           double* y, double* planar_buffer);
 #if defined(DEFORM_HAVE_AVX2_KERNEL)
+void SolveFramesAvx2Fma(const SupernodalFactorView& factor, const double* const* b,
+                        double* const* x, int frames, double* work);
 void ForwardListAvx2Fma(const SupernodalFactorView& factor, const int* supernodes, int count,
                         double* y, double* planar_buffer);
 void BackwardListAvx2Fma(const SupernodalFactorView& factor, const int* supernodes, int count,
@@ -66,6 +70,14 @@ SolveManyFunction SolveManyFor(SolveKernel kernel) {
 #endif
   (void)kernel;
   return &SolveManyBaseline;
+}
+
+SolveFramesFunction SolveFramesFor(SolveKernel kernel) {
+#if defined(DEFORM_HAVE_AVX2_KERNEL)
+  if (kernel == SolveKernel::kAvx2Fma) return &SolveFramesAvx2Fma;
+#endif
+  (void)kernel;
+  return &SolveFramesBaseline;
 }
 
 SupernodeListPass ForwardListFor(SolveKernel kernel) {

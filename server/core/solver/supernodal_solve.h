@@ -61,6 +61,12 @@ inline std::int64_t SolveManyWorkSize(int size, int columns) {
 }
 using SolveManyFunction = void (*)(const SupernodalFactorView& factor, const double* b, double* x,
                                    int columns, double* work);
+// The same for `frames` frames (1 to kMaxSolveColumns / 3) whose three columns each stay in
+// arrays of their own, interleaved (b[f][3 i + c]): gathered into the batch and scattered back
+// in the same passes that apply the permutation, with no packed copy. x[f] may equal b[f]; `work`
+// holds SolveManyWorkSize(size, 3 * frames) doubles.
+using SolveFramesFunction = void (*)(const SupernodalFactorView& factor, const double* const* b,
+                                     double* const* x, int frames, double* work);
 
 enum class SolveKernel {
   kBaseline,  // any CPU the project builds for
@@ -75,6 +81,7 @@ SolveKernel BestSolveKernel();
 // The kernel's function; it must be available.
 Solve3Function Solve3For(SolveKernel kernel);
 SolveManyFunction SolveManyFor(SolveKernel kernel);
+SolveFramesFunction SolveFramesFor(SolveKernel kernel);
 // One direction's pass over the listed supernodes only (forward: ascending, backward: taken in
 // descending order), on solution rows `y` aligned to 32 bytes and a planar buffer for the widest
 // supernode; the parts of the parallel solve (parallel_solve.h).

@@ -240,6 +240,62 @@ TEST_P(SolveKernelTest, ManyColumnsMatchThreeAtATime) {
             StatusCode::kFailedPrecondition);
 }
 
+// Frames in arrays of their own (SolveFrames): each equals Solve3 of its three columns to 1e-12 of
+// its norm, in place too, for every frame count; counts out of range are refused.
+TEST_P(SolveKernelTest, FramesInTheirOwnArraysMatchThreeAtATime) {
+  if (!SolveKernelAvailable(GetParam())) {
+    GTEST_SKIP() << SolveKernelName(GetParam()) << " is not available on this build or CPU";
+  }
+  using Rhs = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+  constexpr int kMostFrames = kMaxSolveColumns / 3;
+  for (const int n : {1, 7, 301}) {
+    const ColMajorMatrix a = RandomSpdMatrix(n, 4, 500 + n);
+    auto symbolic = SymbolicCholesky::Analyze(a, Ordering::kMetis);
+    ASSERT_TRUE(symbolic.ok()) << symbolic.status().ToString();
+    auto factor = CholeskyFactor::Factorize(*symbolic, a);
+    ASSERT_TRUE(factor.ok()) << factor.status().ToString();
+    std::vector<Rhs> b, expected, x;
+    std::vector<double> work3(factor->WorkSize());
+    for (int f = 0; f < kMostFrames; ++f) {
+      b.push_back(Rhs::Random(n, 3));
+      expected.emplace_back(n, 3);
+      ASSERT_TRUE(factor->Solve3(b[f].data(), expected[f].data(), work3.data(), GetParam()).ok());
+    }
+    for (int frames = 1; frames <= kMostFrames; ++frames) {
+      x = b;
+      std::vector<const double*> in;
+      std::vector<double*> out;
+      for (int f = 0; f < frames; ++f) {
+        in.push_back(b[f].data());
+        out.push_back(x[f].data());
+      }
+      std::vector<double> work(factor->WorkSizeMany(3 * frames), std::nan(""));
+      ASSERT_TRUE(factor->SolveFrames(in.data(), out.data(), frames, work.data(), GetParam()).ok());
+      for (int f = 0; f < frames; ++f) {
+        EXPECT_LE((x[f] - expected[f]).norm(), 1e-12 * expected[f].norm())
+            << "n " << n << ", frame " << f << " of " << frames;
+      }
+      std::vector<Rhs> in_place(b.begin(), b.begin() + frames);
+      std::vector<double*> both;
+      for (Rhs& frame : in_place) both.push_back(frame.data());
+      ASSERT_TRUE(
+          factor->SolveFrames(both.data(), both.data(), frames, work.data(), GetParam()).ok());
+      for (int f = 0; f < frames; ++f) EXPECT_EQ((in_place[f] - x[f]).norm(), 0) << f;
+    }
+    std::vector<const double*> in(kMostFrames + 1, b[0].data());
+    std::vector<double*> out(kMostFrames + 1, x[0].data());
+    std::vector<double> work(factor->WorkSizeMany(kMaxSolveColumns));
+    EXPECT_EQ(factor->SolveFrames(in.data(), out.data(), 0, work.data()).code(),
+              StatusCode::kInvalidArgument);
+    EXPECT_EQ(factor->SolveFrames(in.data(), out.data(), kMostFrames + 1, work.data()).code(),
+              StatusCode::kInvalidArgument);
+  }
+  const double* in[1] = {nullptr};
+  double* out[1] = {nullptr};
+  EXPECT_EQ(CholeskyFactor().SolveFrames(in, out, 1, nullptr).code(),
+            StatusCode::kFailedPrecondition);
+}
+
 // Runs every part on its own thread (a thread per part per call: tests only), so the parts of a
 // parallel solve really run side by side (and under TSan, any shared write is reported).
 class ThreadPerPartRunner final : public ParallelRunner {

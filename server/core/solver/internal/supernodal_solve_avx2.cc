@@ -13,6 +13,11 @@ void SolveManyAvx2Fma(const SupernodalFactorView& factor, const double* b, doubl
   SolveManyImpl(factor, b, x, columns, work);
 }
 
+void SolveFramesAvx2Fma(const SupernodalFactorView& factor, const double* const* b,
+                        double* const* x, int frames, double* work) {
+  SolveFramesImpl(factor, b, x, frames, work);
+}
+
 void ForwardListAvx2Fma(const SupernodalFactorView& factor, const int* supernodes, int count,
                         double* y, double* planar_buffer) {
   ForwardListImpl(factor, supernodes, count, y, planar_buffer);

@@ -12,6 +12,11 @@ void SolveManyBaseline(const SupernodalFactorView& factor, const double* b, doub
   SolveManyImpl(factor, b, x, columns, work);
 }
 
+void SolveFramesBaseline(const SupernodalFactorView& factor, const double* const* b,
+                         double* const* x, int frames, double* work) {
+  SolveFramesImpl(factor, b, x, frames, work);
+}
+
 void ForwardListBaseline(const SupernodalFactorView& factor, const int* supernodes, int count,
                          double* y, double* planar_buffer) {
   ForwardListImpl(factor, supernodes, count, y, planar_buffer);

@@ -712,19 +712,20 @@ inline void BackwardSupernodeMany(const SupernodeBlock<Value>& s, double* __rest
   }
 }
 
-template <int kVecs>
-void SolveManyWithWidth(const SupernodalFactorView& f, const double* b, double* x, int columns,
-                        double* work) {
+// The batched passes on solution rows of kVecs four-double vectors: gather(row, i) fills row i
+// (its first columns; the rest is zeroed here) from the right-hand sides of unknown
+// permutation[i], scatter(row, i) takes the solution back out.
+template <int kVecs, typename Gather, typename Scatter>
+void SolveRowsWithWidth(const SupernodalFactorView& f, int columns, double* work, Gather&& gather,
+                        Scatter&& scatter) {
   constexpr int kStride = 4 * kVecs;
   const int n = f.size;
   const std::uintptr_t misalignment = reinterpret_cast<std::uintptr_t>(work) % 32;
   double* __restrict y = work + (misalignment ? (32 - misalignment) / sizeof(double) : 0);
   for (int i = 0; i < n; ++i) {
-    const double* source = b + static_cast<std::ptrdiff_t>(columns) * f.permutation[i];
     double* t = y + kStride * static_cast<std::ptrdiff_t>(i);
-    int c = 0;
-    for (; c < columns; ++c) t[c] = source[c];
-    for (; c < kStride; ++c) t[c] = 0;
+    gather(t, f.permutation[i]);
+    for (int c = columns; c < kStride; ++c) t[c] = 0;
   }
   WithValueType(f, [&](auto value) {
     using Value = decltype(value);
@@ -735,24 +736,63 @@ void SolveManyWithWidth(const SupernodalFactorView& f, const double* b, double* 
       BackwardSupernodeMany<Value, kVecs>(BlockOf<Value>(f, sn), y);
     }
   });
-  for (int i = 0; i < n; ++i) {
-    double* target = x + static_cast<std::ptrdiff_t>(columns) * f.permutation[i];
-    const double* t = y + kStride * static_cast<std::ptrdiff_t>(i);
-    for (int c = 0; c < columns; ++c) target[c] = t[c];
-  }
+  for (int i = 0; i < n; ++i)
+    scatter(y + kStride * static_cast<std::ptrdiff_t>(i), f.permutation[i]);
 }
 
-template <int... kVecs>
-void SolveManyDispatch(const SupernodalFactorView& f, const double* b, double* x, int columns,
-                       double* work, std::integer_sequence<int, kVecs...>) {
+// Calls run(Vecs<v>()) for v = (columns + 3) / 4, v in [1, kMaxSolveColumns / 4].
+template <int kVecs>
+struct Vecs {
+  static constexpr int value = kVecs;
+};
+template <typename Run, int... kVecs>
+void DispatchVecs(int columns, Run&& run, std::integer_sequence<int, kVecs...>) {
   const int vecs = (columns + 3) / 4;
-  ((vecs == kVecs + 1 ? SolveManyWithWidth<kVecs + 1>(f, b, x, columns, work) : void()), ...);
+  ((vecs == kVecs + 1 ? run(Vecs<kVecs + 1>()) : void()), ...);
+}
+template <typename Run>
+void DispatchVecs(int columns, Run&& run) {
+  DispatchVecs(columns, run, std::make_integer_sequence<int, kMaxSolveColumns / 4>());
 }
 
 void SolveManyImpl(const SupernodalFactorView& f, const double* b, double* x, int columns,
                    double* work) {
-  SolveManyDispatch(f, b, x, columns, work,
-                    std::make_integer_sequence<int, kMaxSolveColumns / 4>());
+  DispatchVecs(columns, [&](auto vecs) {
+    SolveRowsWithWidth<decltype(vecs)::value>(
+        f, columns, work,
+        [&](double* __restrict row, int unknown) {
+          const double* source = b + static_cast<std::ptrdiff_t>(columns) * unknown;
+          for (int c = 0; c < columns; ++c) row[c] = source[c];
+        },
+        [&](const double* __restrict row, int unknown) {
+          double* target = x + static_cast<std::ptrdiff_t>(columns) * unknown;
+          for (int c = 0; c < columns; ++c) target[c] = row[c];
+        });
+  });
+}
+
+void SolveFramesImpl(const SupernodalFactorView& f, const double* const* b, double* const* x,
+                     int frames, double* work) {
+  DispatchVecs(3 * frames, [&](auto vecs) {
+    SolveRowsWithWidth<decltype(vecs)::value>(
+        f, 3 * frames, work,
+        [&](double* __restrict row, int unknown) {
+          for (int frame = 0; frame < frames; ++frame) {
+            const double* source = b[frame] + 3 * static_cast<std::ptrdiff_t>(unknown);
+            row[3 * frame] = source[0];
+            row[3 * frame + 1] = source[1];
+            row[3 * frame + 2] = source[2];
+          }
+        },
+        [&](const double* __restrict row, int unknown) {
+          for (int frame = 0; frame < frames; ++frame) {
+            double* target = x[frame] + 3 * static_cast<std::ptrdiff_t>(unknown);
+            target[0] = row[3 * frame];
+            target[1] = row[3 * frame + 1];
+            target[2] = row[3 * frame + 2];
+          }
+        });
+  });
 }
 
 }  // namespace
