@@ -771,13 +771,16 @@ void SolveManyImpl(const SupernodalFactorView& f, const double* b, double* x, in
   });
 }
 
-void SolveFramesImpl(const SupernodalFactorView& f, const double* const* b, double* const* x,
-                     int frames, double* work) {
-  DispatchVecs(3 * frames, [&](auto vecs) {
+// The frames' gather and scatter with their count fixed at compile time, so each row's copies
+// unroll.
+template <int kFrames>
+void SolveFramesOf(const SupernodalFactorView& f, const double* const* b, double* const* x,
+                   double* work) {
+  DispatchVecs(3 * kFrames, [&](auto vecs) {
     SolveRowsWithWidth<decltype(vecs)::value>(
-        f, 3 * frames, work,
+        f, 3 * kFrames, work,
         [&](double* __restrict row, int unknown) {
-          for (int frame = 0; frame < frames; ++frame) {
+          for (int frame = 0; frame < kFrames; ++frame) {
             const double* source = b[frame] + 3 * static_cast<std::ptrdiff_t>(unknown);
             row[3 * frame] = source[0];
             row[3 * frame + 1] = source[1];
@@ -785,7 +788,7 @@ void SolveFramesImpl(const SupernodalFactorView& f, const double* const* b, doub
           }
         },
         [&](const double* __restrict row, int unknown) {
-          for (int frame = 0; frame < frames; ++frame) {
+          for (int frame = 0; frame < kFrames; ++frame) {
             double* target = x[frame] + 3 * static_cast<std::ptrdiff_t>(unknown);
             target[0] = row[3 * frame];
             target[1] = row[3 * frame + 1];
@@ -793,6 +796,18 @@ void SolveFramesImpl(const SupernodalFactorView& f, const double* const* b, doub
           }
         });
   });
+}
+
+template <int... kFrames>
+void SolveFramesDispatch(const SupernodalFactorView& f, const double* const* b, double* const* x,
+                         int frames, double* work, std::integer_sequence<int, kFrames...>) {
+  ((frames == kFrames + 1 ? SolveFramesOf<kFrames + 1>(f, b, x, work) : void()), ...);
+}
+
+void SolveFramesImpl(const SupernodalFactorView& f, const double* const* b, double* const* x,
+                     int frames, double* work) {
+  SolveFramesDispatch(f, b, x, frames, work,
+                      std::make_integer_sequence<int, kMaxSolveColumns / 3>());
 }
 
 }  // namespace
