@@ -256,13 +256,15 @@ inline void ForwardDiagonal(const Value* __restrict block, int width, double* __
     Dot4x3(r0, r1, r2, r3, p, c, s);
     const double* t = Row(ys, c);
     for (int i = 0; i < 16; ++i) s[i] = t[i] - s[i];
-    // The 4 by 4 triangle at the tile's corner, one column (x, y, z) at a time.
+    // The 4 by 4 triangle at the tile's corner, one column (x, y, z) at a time. The pivots'
+    // inverses depend on the factor alone, so their divisions stay off the chain of unknowns.
+    const double i0 = 1.0 / r0[c], i1 = 1.0 / r1[c + 1], i2 = 1.0 / r2[c + 2], i3 = 1.0 / r3[c + 3];
     double* out[3] = {p.x + c, p.y + c, p.z + c};
     for (int d = 0; d < 3; ++d) {
-      const double u0 = s[d] / r0[c];
-      const double u1 = (s[4 + d] - r1[c] * u0) / r1[c + 1];
-      const double u2 = (s[8 + d] - r2[c] * u0 - r2[c + 1] * u1) / r2[c + 2];
-      const double u3 = (s[12 + d] - r3[c] * u0 - r3[c + 1] * u1 - r3[c + 2] * u2) / r3[c + 3];
+      const double u0 = s[d] * i0;
+      const double u1 = (s[4 + d] - r1[c] * u0) * i1;
+      const double u2 = (s[8 + d] - r2[c] * u0 - r2[c + 1] * u1) * i2;
+      const double u3 = (s[12 + d] - r3[c] * u0 - r3[c + 1] * u1 - r3[c + 2] * u2) * i3;
       out[d][0] = u0;
       out[d][1] = u1;
       out[d][2] = u2;
@@ -274,9 +276,10 @@ inline void ForwardDiagonal(const Value* __restrict block, int width, double* __
     double s[3];
     Dot1x3(row, p, c, s);
     const double* t = Row(ys, c);
-    p.x[c] = (t[0] - s[0]) / row[c];
-    p.y[c] = (t[1] - s[1]) / row[c];
-    p.z[c] = (t[2] - s[2]) / row[c];
+    const double inverse = 1.0 / row[c];
+    p.x[c] = (t[0] - s[0]) * inverse;
+    p.y[c] = (t[1] - s[1]) * inverse;
+    p.z[c] = (t[2] - s[2]) * inverse;
   }
   for (int k = 0; k < width; ++k) {
     double* t = Row(ys, k);
@@ -302,12 +305,13 @@ inline void BackwardDiagonal(const Value* __restrict block, int width, double* _
     const Value* r3 = r2 + width;
     double* in[3] = {p.x + f, p.y + f, p.z + f};
     double solved[12];  // solved[3 j + d]: unknown f + j, column d
+    const double i0 = 1.0 / r0[f], i1 = 1.0 / r1[f + 1], i2 = 1.0 / r2[f + 2], i3 = 1.0 / r3[f + 3];
     for (int d = 0; d < 3; ++d) {
       const double* v = in[d];
-      const double u3 = v[3] / r3[f + 3];
-      const double u2 = (v[2] - r3[f + 2] * u3) / r2[f + 2];
-      const double u1 = (v[1] - r3[f + 1] * u3 - r2[f + 1] * u2) / r1[f + 1];
-      const double u0 = (v[0] - r3[f] * u3 - r2[f] * u2 - r1[f] * u1) / r0[f];
+      const double u3 = v[3] * i3;
+      const double u2 = (v[2] - r3[f + 2] * u3) * i2;
+      const double u1 = (v[1] - r3[f + 1] * u3 - r2[f + 1] * u2) * i1;
+      const double u0 = (v[0] - r3[f] * u3 - r2[f] * u2 - r1[f] * u1) * i0;
       solved[d] = u0;
       solved[3 + d] = u1;
       solved[6 + d] = u2;
@@ -324,7 +328,8 @@ inline void BackwardDiagonal(const Value* __restrict block, int width, double* _
   for (; c > 0; --c) {
     const int f = c - 1;
     const Value* row = block + static_cast<std::ptrdiff_t>(f) * width;
-    const double solved[3] = {p.x[f] / row[f], p.y[f] / row[f], p.z[f] / row[f]};
+    const double inverse = 1.0 / row[f];
+    const double solved[3] = {p.x[f] * inverse, p.y[f] * inverse, p.z[f] * inverse};
     double* t = Row(ys, f);
     t[0] = solved[0];
     t[1] = solved[1];
@@ -606,8 +611,11 @@ inline void ForwardSupernodeMany(const SupernodeBlock<Value>& s, double* __restr
       const double* known = own + kStride * k;
       for (int j = 0; j < kVecs; ++j) sum[j] -= l * Load4(known + 4 * j);
     }
-    const Vec4 pivot = Splat4(row[c]);
-    for (int j = 0; j < kVecs; ++j) Store4(target + 4 * j, sum[j] / pivot);
+    // One division per column, not one per vector: a four-wide division takes several times a
+    // multiplication's issue slots, and the narrow supernodes' columns have few rows to amortise
+    // it.
+    const Vec4 inverse_pivot = Splat4(1.0 / static_cast<double>(row[c]));
+    for (int j = 0; j < kVecs; ++j) Store4(target + 4 * j, sum[j] * inverse_pivot);
   }
   std::int64_t r = width;
   if constexpr (kVecs <= kMaxBlockedVecs) {
@@ -698,10 +706,10 @@ inline void BackwardSupernodeMany(const SupernodeBlock<Value>& s, double* __rest
   for (int c = width - 1; c >= 0; --c) {
     const Value* row = s.values + static_cast<std::ptrdiff_t>(c) * width;
     double* target = own + kStride * c;
-    const Vec4 pivot = Splat4(row[c]);
+    const Vec4 inverse_pivot = Splat4(1.0 / static_cast<double>(row[c]));  // (as forward)
     Vec4 solved[kVecs];
     for (int j = 0; j < kVecs; ++j) {
-      solved[j] = Load4(target + 4 * j) / pivot;
+      solved[j] = Load4(target + 4 * j) * inverse_pivot;
       Store4(target + 4 * j, solved[j]);
     }
     for (int k = 0; k < c; ++k) {
