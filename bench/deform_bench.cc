@@ -145,19 +145,27 @@ void BM_TriangularSolve(benchmark::State& state, BenchMesh mesh, SolveKernel ker
   ReportAgainstBound(state, factor.bytes(), seconds);
 }
 
-// Solve3 on `rhs`, timed max(runs, 20) times after another benchmark's timed loop, for the
-// comparisons made in one benchmark (each run's wall time in seconds).
-template <typename Rhs>
-std::vector<double> TimeSolve3(const CholeskyFactor& factor, const Rhs& rhs, DeformScratch* scratch,
-                               std::size_t runs) {
+// `run` timed max(runs, 20) times after another benchmark's timed loop, for the comparisons made
+// in one benchmark (each run's wall time in seconds).
+template <typename Run>
+std::vector<double> TimeRuns(std::size_t runs, Run&& run) {
   std::vector<double> seconds;
-  for (std::size_t run = 0; run < std::max<std::size_t>(runs, 20); ++run) {
+  for (std::size_t i = 0; i < std::max<std::size_t>(runs, 20); ++i) {
     const auto start = Clock::now();
-    benchmark::DoNotOptimize(
-        factor.Solve3(rhs.data(), scratch->solution.data(), scratch->solve_work.data()));
+    run();
     seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
   }
   return seconds;
+}
+
+// Solve3 on `rhs`, timed as TimeRuns does.
+template <typename Rhs>
+std::vector<double> TimeSolve3(const CholeskyFactor& factor, const Rhs& rhs, DeformScratch* scratch,
+                               std::size_t runs) {
+  return TimeRuns(runs, [&] {
+    benchmark::DoNotOptimize(
+        factor.Solve3(rhs.data(), scratch->solution.data(), scratch->solve_work.data()));
+  });
 }
 
 // `frames` frames' two triangular passes in one batch (CholeskyFactor::SolveFrames, as
@@ -249,12 +257,8 @@ void BM_Float32Solve(benchmark::State& state, BenchMesh mesh, int parts) {
   };
   const auto seconds = TimeEach(state, [&] { benchmark::DoNotOptimize(solve(rounded)); });
   const auto rounded_solution = scratch.solution;
-  std::vector<double> exact_seconds;
-  for (std::size_t run = 0; run < std::max<std::size_t>(seconds.size(), 20); ++run) {
-    const auto start = Clock::now();
-    benchmark::DoNotOptimize(solve(exact));
-    exact_seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
-  }
+  const std::vector<double> exact_seconds =
+      TimeRuns(seconds.size(), [&] { benchmark::DoNotOptimize(solve(exact)); });
   ReportAgainstBound(state, rounded.bytes(), seconds);
   const int n = frames->model->mesh().num_vertices();
   state.counters["max_difference"] =

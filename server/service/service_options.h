@@ -79,7 +79,7 @@ struct ServerOptions {
   // rounding keeps frames within a quarter of 1e-6 of the diagonal (ModelOptions::
   // float32_factor_min_bytes; the probe leaves the others in double); negative: never. Default:
   // 64 MiB, where the solve is bound by memory reads: the shared 133k arm's 146 MB factor solves
-  // in 0.70-0.72x the time, the 26k leg's 25 MB factor gains nothing (README, "A float32 factor").
+  // in 0.66-0.76x the time, the 26k leg's 25 MB factor gains nothing (README, "A float32 factor").
   std::int64_t float32_factor_min_bytes = std::int64_t{64} << 20;
   // Largest gRPC message received or sent. Default: 64 MiB.
   int max_message_bytes = 64 << 20;

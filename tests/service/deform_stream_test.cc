@@ -534,7 +534,9 @@ TEST_F(DeformStreamTest, ABatchLimitOfOneSolvesEveryFrameAlone) {
   for (int s = 0; s < kStreams; ++s) {
     ASSERT_TRUE(recorders[s]->WaitForFrameWithSequence(10)) << s;
     for (const RecordedEvent& event : recorders[s]->events()) {
-      if (event.is_frame) EXPECT_EQ(event.frame.timings().batch_frames(), 1u);
+      if (event.is_frame) {
+        EXPECT_EQ(event.frame.timings().batch_frames(), 1u);
+      }
     }
     streams[s]->Close();
   }

@@ -274,15 +274,16 @@ void DeformationModel::RoundFactorToFloat32IfWithinTolerance(MaterialFactorizati
   CholeskyFactor rounded = exact.RoundedToFloat32();
   DeformScratch scratch = MakeScratchWithWork(exact.WorkSize());
   if (!AssembleRightHandSide(*result, Pose::Rest(skeleton_), &scratch)) return;
-  const auto rhs = scratch.solution;
-  auto exact_solution = rhs, rounded_solution = rhs;
-  if (!exact.Solve3(rhs.data(), exact_solution.data(), scratch.solve_work.data()).ok() ||
-      !rounded.Solve3(rhs.data(), rounded_solution.data(), scratch.solve_work.data()).ok()) {
+  // The rest pose's right-hand side, solved with each factor (the rounded one in place).
+  auto exact_solution = scratch.solution;
+  double* const rounded_solution = scratch.solution.data();
+  if (!exact.Solve3(exact_solution.data(), exact_solution.data(), scratch.solve_work.data()).ok() ||
+      !rounded.Solve3(rounded_solution, rounded_solution, scratch.solve_work.data()).ok()) {
     return;
   }
   const int n = mesh_.num_vertices();
   const double largest =
-      (exact_solution.topRows(n) - rounded_solution.topRows(n)).rowwise().norm().maxCoeff();
+      (exact_solution.topRows(n) - scratch.positions()).rowwise().norm().maxCoeff();
   result->float32_probe_error_ = diagonal_ > 0 ? largest / diagonal_ : largest;
   if (result->float32_probe_error_ <= MaterialFactorization::kFloat32ProbeTolerance) {
     result->factor_ = std::move(rounded);

@@ -295,12 +295,13 @@ class DeformationModel {
   // The binding steps of Precompute: set regions_, bone_weights_, rigid_bones_, bound_bones_.
   Status BindAutomatically(const VertexAdjacency& adjacency, const TriangleBvh& bvh,
                            const CancelToken* cancel);
-  // Factorize, stopping between the numeric factorisation and the linear response when `cancel`
-  // (may be null) is cancelled.
   // Replaces result's factor by its float32 rounding when options_.float32_factor_min_bytes asks
   // for it and the rest-pose probe stays within kFloat32ProbeTolerance (MaterialFactorization).
   void RoundFactorToFloat32IfWithinTolerance(MaterialFactorization* result) const;
+  // MakeScratch with `solve_work_doubles` of solve work (before default_factorization_ exists).
   DeformScratch MakeScratchWithWork(std::size_t solve_work_doubles) const;
+  // Factorize, stopping between the numeric factorisation and the linear response when `cancel`
+  // (may be null) is cancelled.
   StatusOr<std::shared_ptr<const MaterialFactorization>> FactorizeCancellable(
       const Stiffness& stiffness, const CancelToken* cancel) const;
   Status BindToWeights(const SkinWeights& weights, const VertexAdjacency& adjacency);

@@ -89,8 +89,9 @@ struct ModelOptions {
   // MaterialFactorization::float32_probe_error() keeps its frames within a quarter of 1e-6 of the
   // diagonal of the double factor's; otherwise the factor stays double. Negative: never (the
   // default). Worth it where the solve is bound by memory: on the shared 133k arm (146 MB) the
-  // solve takes 0.72x the time (0.70x on two threads); on the 26k leg (25 MB) and smaller
-  // factors, which the caches hold, widening the floats costs more than the bytes save.
+  // solve takes 0.76x the time (0.66x on two threads; README, "A float32 factor"); on the 26k leg
+  // (25 MB) and smaller factors, which the caches hold, widening the floats costs more than the
+  // bytes save (1.05x and 1.25x).
   std::int64_t float32_factor_min_bytes = -1;
   MeshLimits limits;
 

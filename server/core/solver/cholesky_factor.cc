@@ -139,7 +139,7 @@ Status CholeskyFactor::Solve3(const double* b, double* x, double* work) const {
 
 Status CholeskyFactor::Solve3(const double* b, double* x, double* work, SolveKernel kernel) const {
   if (!symbolic_) return Status::FailedPrecondition("the Cholesky factor is empty");
-  Solve3For(kernel)(View(), b, x, work);
+  SolveKernelFunctionsFor(kernel).solve3(View(), b, x, work);
   return Status::Ok();
 }
 
@@ -159,7 +159,7 @@ Status CholeskyFactor::SolveMany(const double* b, double* x, int columns, double
                                    std::to_string(kMaxSolveColumns) + " columns, not " +
                                    std::to_string(columns));
   }
-  SolveManyFor(kernel)(View(), b, x, columns, work);
+  SolveKernelFunctionsFor(kernel).solve_many(View(), b, x, columns, work);
   return Status::Ok();
 }
 
@@ -176,7 +176,7 @@ Status CholeskyFactor::SolveFrames(const double* const* b, double* const* x, int
                                    std::to_string(kMaxSolveColumns / 3) + " frames, not " +
                                    std::to_string(frames));
   }
-  SolveFramesFor(kernel)(View(), b, x, frames, work);
+  SolveKernelFunctionsFor(kernel).solve_frames(View(), b, x, frames, work);
   return Status::Ok();
 }
 

@@ -249,10 +249,11 @@ void ParallelSolve3(const SupernodalFactorView& f, const ParallelSolvePlan& plan
                     SolveKernel kernel, const double* b, double* x, double* work,
                     ParallelRunner* runner) {
   const std::uintptr_t misalignment = reinterpret_cast<std::uintptr_t>(work) % 32;
+  const SolveKernelFunctions& passes = SolveKernelFunctionsFor(kernel);
   SolveContext c{&f,
                  &plan,
-                 ForwardListFor(kernel),
-                 BackwardListFor(kernel),
+                 passes.forward_list,
+                 passes.backward_list,
                  b,
                  x,
                  work + (misalignment ? (32 - misalignment) / sizeof(double) : 0),

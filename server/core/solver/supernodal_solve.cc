@@ -3,25 +3,9 @@
 namespace deform {
 
 // Defined in supernodal_solve_baseline.cc and, where built, supernodal_solve_avx2.cc.
-void Solve3Baseline(const SupernodalFactorView& factor, const double* b, double* x, double* work);
-void SolveManyBaseline(const SupernodalFactorView& factor, const double* b, double* x, int columns,
-                       double* work);
-void SolveFramesBaseline(const SupernodalFactorView& factor, const double* const* b,
-                         double* const* x, int frames, double* work);
-void ForwardListBaseline(const SupernodalFactorView& factor, const int* supernodes, int count,
-                         double* y, double* planar_buffer);
-void BackwardListBaseline(const SupernodalFactorView& factor, const int* supernodes, int count,
-                          double* y, double* planar_buffer);
+extern const SolveKernelFunctions kBaselineSolveKernel;
 #if defined(DEFORM_HAVE_AVX2_KERNEL)
-void SolveFramesAvx2Fma(const SupernodalFactorView& factor, const double* const* b,
-                        double* const* x, int frames, double* work);
-void ForwardListAvx2Fma(const SupernodalFactorView& factor, const int* supernodes, int count,
-                        double* y, double* planar_buffer);
-void BackwardListAvx2Fma(const SupernodalFactorView& factor, const int* supernodes, int count,
-                         double* y, double* planar_buffer);
-void Solve3Avx2Fma(const SupernodalFactorView& factor, const double* b, double* x, double* work);
-void SolveManyAvx2Fma(const SupernodalFactorView& factor, const double* b, double* x, int columns,
-                      double* work);
+extern const SolveKernelFunctions kAvx2FmaSolveKernel;
 #endif
 
 const char* SolveKernelName(SolveKernel kernel) {
@@ -56,44 +40,12 @@ SolveKernel BestSolveKernel() {
   return best;
 }
 
-Solve3Function Solve3For(SolveKernel kernel) {
+const SolveKernelFunctions& SolveKernelFunctionsFor(SolveKernel kernel) {
 #if defined(DEFORM_HAVE_AVX2_KERNEL)
-  if (kernel == SolveKernel::kAvx2Fma) return &Solve3Avx2Fma;
+  if (kernel == SolveKernel::kAvx2Fma) return kAvx2FmaSolveKernel;
 #endif
   (void)kernel;
-  return &Solve3Baseline;
-}
-
-SolveManyFunction SolveManyFor(SolveKernel kernel) {
-#if defined(DEFORM_HAVE_AVX2_KERNEL)
-  if (kernel == SolveKernel::kAvx2Fma) return &SolveManyAvx2Fma;
-#endif
-  (void)kernel;
-  return &SolveManyBaseline;
-}
-
-SolveFramesFunction SolveFramesFor(SolveKernel kernel) {
-#if defined(DEFORM_HAVE_AVX2_KERNEL)
-  if (kernel == SolveKernel::kAvx2Fma) return &SolveFramesAvx2Fma;
-#endif
-  (void)kernel;
-  return &SolveFramesBaseline;
-}
-
-SupernodeListPass ForwardListFor(SolveKernel kernel) {
-#if defined(DEFORM_HAVE_AVX2_KERNEL)
-  if (kernel == SolveKernel::kAvx2Fma) return &ForwardListAvx2Fma;
-#endif
-  (void)kernel;
-  return &ForwardListBaseline;
-}
-
-SupernodeListPass BackwardListFor(SolveKernel kernel) {
-#if defined(DEFORM_HAVE_AVX2_KERNEL)
-  if (kernel == SolveKernel::kAvx2Fma) return &BackwardListAvx2Fma;
-#endif
-  (void)kernel;
-  return &BackwardListBaseline;
+  return kBaselineSolveKernel;
 }
 
 }  // namespace deform

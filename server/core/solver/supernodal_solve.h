@@ -78,16 +78,21 @@ const char* SolveKernelName(SolveKernel kernel);
 bool SolveKernelAvailable(SolveKernel kernel);
 // The fastest available kernel, chosen once per process.
 SolveKernel BestSolveKernel();
-// The kernel's function; it must be available.
-Solve3Function Solve3For(SolveKernel kernel);
-SolveManyFunction SolveManyFor(SolveKernel kernel);
-SolveFramesFunction SolveFramesFor(SolveKernel kernel);
 // One direction's pass over the listed supernodes only (forward: ascending, backward: taken in
 // descending order), on solution rows `y` aligned to 32 bytes and a planar buffer for the widest
 // supernode; the parts of the parallel solve (parallel_solve.h).
 using SupernodeListPass = void (*)(const SupernodalFactorView& factor, const int* supernodes,
                                    int count, double* y, double* planar_buffer);
-SupernodeListPass ForwardListFor(SolveKernel kernel);
-SupernodeListPass BackwardListFor(SolveKernel kernel);
+
+// One kernel's passes: supernodal_solve_impl.h compiled for its instruction set.
+struct SolveKernelFunctions {
+  Solve3Function solve3;
+  SolveManyFunction solve_many;
+  SolveFramesFunction solve_frames;
+  SupernodeListPass forward_list;
+  SupernodeListPass backward_list;
+};
+// The kernel's passes; it must be available.
+const SolveKernelFunctions& SolveKernelFunctionsFor(SolveKernel kernel);
 
 }  // namespace deform

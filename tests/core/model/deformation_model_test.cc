@@ -253,7 +253,9 @@ TEST(DeformationModel, AFrameSolvedOnSeveralThreadsEqualsTheSerialFrame) {
         const long before = test_support::AllocationCount();
         ASSERT_TRUE(
             model->DeformParallel(factorization, pose, &scratch, plan, work.data(), runner));
-        if (runner == &serial) EXPECT_EQ(test_support::AllocationCount() - before, 0);
+        if (runner == &serial) {
+          EXPECT_EQ(test_support::AllocationCount() - before, 0);
+        }
         EXPECT_LE(MaxDistance(scratch.positions(), expected),
                   1e-12 * model->bounding_box_diagonal())
             << spec << ", " << parts << " parts";

@@ -425,7 +425,9 @@ TEST_P(SolveKernelTest, Float32FactorSolvesWithItsRoundedValues) {
     ASSERT_TRUE(rounded.Solve3(b.data(), x.data(), work3.data(), GetParam()).ok());
     const double difference = (x - expected).norm() / expected.norm();
     EXPECT_LE(difference, 1e-5) << name;
-    if (n >= 5) EXPECT_GT(difference, 1e-12) << name << ": the float32 values were not read";
+    if (n >= 5) {
+      EXPECT_GT(difference, 1e-12) << name << ": the float32 values were not read";
+    }
     // Many columns: two frames, each equal to the float32 Solve3 of its columns.
     RowMajor b6(n, 6), x6(n, 6);
     b6 << b, b;

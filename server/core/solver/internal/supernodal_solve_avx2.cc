@@ -4,28 +4,9 @@
 
 namespace deform {
 
-void Solve3Avx2Fma(const SupernodalFactorView& factor, const double* b, double* x, double* work) {
-  Solve3Impl(factor, b, x, work);
-}
-
-void SolveManyAvx2Fma(const SupernodalFactorView& factor, const double* b, double* x, int columns,
-                      double* work) {
-  SolveManyImpl(factor, b, x, columns, work);
-}
-
-void SolveFramesAvx2Fma(const SupernodalFactorView& factor, const double* const* b,
-                        double* const* x, int frames, double* work) {
-  SolveFramesImpl(factor, b, x, frames, work);
-}
-
-void ForwardListAvx2Fma(const SupernodalFactorView& factor, const int* supernodes, int count,
-                        double* y, double* planar_buffer) {
-  ForwardListImpl(factor, supernodes, count, y, planar_buffer);
-}
-
-void BackwardListAvx2Fma(const SupernodalFactorView& factor, const int* supernodes, int count,
-                         double* y, double* planar_buffer) {
-  BackwardListImpl(factor, supernodes, count, y, planar_buffer);
-}
+// Declared (and picked) in supernodal_solve.cc.
+extern const SolveKernelFunctions kAvx2FmaSolveKernel;
+const SolveKernelFunctions kAvx2FmaSolveKernel = {&Solve3Impl, &SolveManyImpl, &SolveFramesImpl,
+                                                  &ForwardListImpl, &BackwardListImpl};
 
 }  // namespace deform

@@ -1,6 +1,7 @@
 // The supernodal triangular passes, written once and compiled once per instruction set: included
 // by supernodal_solve_baseline.cc and supernodal_solve_avx2.cc (built with -mavx2 -mfma), each of
-// which exports Solve3Impl under its own name. Include it in exactly one place per variant.
+// which exports a table of these passes (SolveKernelFunctions) under its own name. Include it in
+// exactly one place per variant.
 //
 // Everything here is in an anonymous namespace and no library header is included, so the variants
 // never meet at link time: an inline function with external linkage compiled with AVX2 could
@@ -23,11 +24,23 @@
 namespace deform {
 namespace {
 
-// A width fixed at compile time, for the dispatch of the narrow supernodes.
-template <int kWidth>
-struct Width {
-  static constexpr int value = kWidth;
+// A count fixed at compile time: a narrow supernode's width, a batch's vectors per row or frames.
+template <int kCount>
+struct Count {
+  static constexpr int value = kCount;
 };
+
+template <typename Run, int... kCounts>
+inline void WithCountOf(int count, Run&& run, std::integer_sequence<int, kCounts...>) {
+  ((count == kCounts + 1 ? run(Count<kCounts + 1>()) : void()), ...);
+}
+
+// Calls run(Count<count>()) for `count` in [1, kMax], so that what `run` calls is compiled for
+// every count and its loops over the count unroll; does nothing for another count.
+template <int kMax, typename Run>
+inline void WithCount(int count, Run&& run) {
+  WithCountOf(count, run, std::make_integer_sequence<int, kMax>());
+}
 
 #if defined(__AVX__)
 // Four doubles: one AVX register.
@@ -434,24 +447,6 @@ inline void BackwardUpdateNarrow(const Value* __restrict block, const int* __res
   }
 }
 
-template <typename Kernel>
-inline void DispatchNarrow(int width, Kernel&& kernel) {
-  switch (width) {
-    case 1:
-      kernel(Width<1>());
-      break;
-    case 2:
-      kernel(Width<2>());
-      break;
-    case 3:
-      kernel(Width<3>());
-      break;
-    default:
-      kernel(Width<4>());
-      break;
-  }
-}
-
 // Supernode sn's block of the factor (see SupernodalFactorView).
 template <typename Value>
 struct SupernodeBlock {
@@ -503,7 +498,7 @@ inline void ForwardSupernode(const SupernodalFactorView& f, int sn, double* __re
   if (s.width > 4) {
     ForwardUpdate(s.values, s.rows, s.width, s.num_rows, p, y);
   } else {
-    DispatchNarrow(s.width, [&](auto w) {
+    WithCount<4>(s.width, [&](auto w) {
       ForwardUpdateNarrow<Value, decltype(w)::value>(s.values, s.rows, s.num_rows, p, y);
     });
   }
@@ -526,7 +521,7 @@ inline void BackwardSupernode(const SupernodalFactorView& f, int sn, double* __r
   if (s.width > 4) {
     BackwardUpdate(s.values, s.rows, s.width, s.num_rows, p, y);
   } else {
-    DispatchNarrow(s.width, [&](auto w) {
+    WithCount<4>(s.width, [&](auto w) {
       BackwardUpdateNarrow<Value, decltype(w)::value>(s.values, s.rows, s.num_rows, p, y);
     });
   }
@@ -548,8 +543,9 @@ void BackwardListImpl(const SupernodalFactorView& f, const int* supernodes, int 
                       double* planar_buffer) {
   WithValueType(f, [&](auto value) {
     using Value = decltype(value);
-    for (int i = count - 1; i >= 0; --i)
+    for (int i = count - 1; i >= 0; --i) {
       BackwardSupernode<Value>(f, supernodes[i], y, planar_buffer);
+    }
   });
 }
 
@@ -744,28 +740,14 @@ void SolveRowsWithWidth(const SupernodalFactorView& f, int columns, double* work
       BackwardSupernodeMany<Value, kVecs>(BlockOf<Value>(f, sn), y);
     }
   });
-  for (int i = 0; i < n; ++i)
+  for (int i = 0; i < n; ++i) {
     scatter(y + kStride * static_cast<std::ptrdiff_t>(i), f.permutation[i]);
-}
-
-// Calls run(Vecs<v>()) for v = (columns + 3) / 4, v in [1, kMaxSolveColumns / 4].
-template <int kVecs>
-struct Vecs {
-  static constexpr int value = kVecs;
-};
-template <typename Run, int... kVecs>
-void DispatchVecs(int columns, Run&& run, std::integer_sequence<int, kVecs...>) {
-  const int vecs = (columns + 3) / 4;
-  ((vecs == kVecs + 1 ? run(Vecs<kVecs + 1>()) : void()), ...);
-}
-template <typename Run>
-void DispatchVecs(int columns, Run&& run) {
-  DispatchVecs(columns, run, std::make_integer_sequence<int, kMaxSolveColumns / 4>());
+  }
 }
 
 void SolveManyImpl(const SupernodalFactorView& f, const double* b, double* x, int columns,
                    double* work) {
-  DispatchVecs(columns, [&](auto vecs) {
+  WithCount<kMaxSolveColumns / 4>((columns + 3) / 4, [&](auto vecs) {
     SolveRowsWithWidth<decltype(vecs)::value>(
         f, columns, work,
         [&](double* __restrict row, int unknown) {
@@ -779,13 +761,12 @@ void SolveManyImpl(const SupernodalFactorView& f, const double* b, double* x, in
   });
 }
 
-// The frames' gather and scatter with their count fixed at compile time, so each row's copies
-// unroll.
-template <int kFrames>
-void SolveFramesOf(const SupernodalFactorView& f, const double* const* b, double* const* x,
-                   double* work) {
-  DispatchVecs(3 * kFrames, [&](auto vecs) {
-    SolveRowsWithWidth<decltype(vecs)::value>(
+// The frames' count fixed at compile time, so each row's gather and scatter unroll.
+void SolveFramesImpl(const SupernodalFactorView& f, const double* const* b, double* const* x,
+                     int frames, double* work) {
+  WithCount<kMaxSolveColumns / 3>(frames, [&](auto count) {
+    constexpr int kFrames = decltype(count)::value;
+    SolveRowsWithWidth<(3 * kFrames + 3) / 4>(
         f, 3 * kFrames, work,
         [&](double* __restrict row, int unknown) {
           for (int frame = 0; frame < kFrames; ++frame) {
@@ -804,18 +785,6 @@ void SolveFramesOf(const SupernodalFactorView& f, const double* const* b, double
           }
         });
   });
-}
-
-template <int... kFrames>
-void SolveFramesDispatch(const SupernodalFactorView& f, const double* const* b, double* const* x,
-                         int frames, double* work, std::integer_sequence<int, kFrames...>) {
-  ((frames == kFrames + 1 ? SolveFramesOf<kFrames + 1>(f, b, x, work) : void()), ...);
-}
-
-void SolveFramesImpl(const SupernodalFactorView& f, const double* const* b, double* const* x,
-                     int frames, double* work) {
-  SolveFramesDispatch(f, b, x, frames, work,
-                      std::make_integer_sequence<int, kMaxSolveColumns / 3>());
 }
 
 }  // namespace
