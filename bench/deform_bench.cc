@@ -168,13 +168,15 @@ std::vector<double> TimeSolve3(const CholeskyFactor& factor, const Rhs& rhs, Def
   });
 }
 
-// `frames` frames' two triangular passes in one batch (CholeskyFactor::SolveFrames, as
-// DeformBatch runs them: each frame's right-hand side and solution in arrays of their own), the
-// right-hand sides those of the benchmark pose. Besides the counters of the other
-// solves (median_ms and the bounds are per batch): frame_ms, the median per frame;
-// unbatched_frame_ms, Solve3's median on the same right-hand side timed in the same benchmark;
+// `frames` frames' two triangular passes in one batch with `kernel` (CholeskyFactor::SolveFrames,
+// as DeformBatch runs them: each frame's right-hand side and solution in arrays of their own), the
+// right-hand sides those of the benchmark pose. Besides the counters of the other solves
+// (median_ms and the bounds are per batch): frame_ms, the median per frame; unbatched_frame_ms,
+// Solve3's median (the best kernel) on the same right-hand side timed in the same benchmark;
 // x_unbatched, their ratio; frame_bound_ms and frame_cache_bound_ms, the bounds per frame.
-void BM_BatchedSolve(benchmark::State& state, BenchMesh mesh, int frames_per_batch) {
+void BM_BatchedSolve(benchmark::State& state, BenchMesh mesh, int frames_per_batch,
+                     SolveKernel kernel) {
+  if (!SolveKernelAvailable(kernel)) return state.SkipWithError("kernel not available here");
   auto frames = SetUpFrames(state, mesh);
   if (!frames) return;
   const CholeskyFactor& factor = frames->factorization->factor();
@@ -189,7 +191,7 @@ void BM_BatchedSolve(benchmark::State& state, BenchMesh mesh, int frames_per_bat
   std::vector<double> work(factor.WorkSizeMany(3 * frames_per_batch));
   const auto seconds = TimeEach(state, [&] {
     benchmark::DoNotOptimize(
-        factor.SolveFrames(in.data(), out.data(), frames_per_batch, work.data()));
+        factor.SolveFrames(in.data(), out.data(), frames_per_batch, work.data(), kernel));
   });
   const std::vector<double> unbatched = TimeSolve3(factor, rhs, &scratch, seconds.size());
   ReportAgainstBound(state, factor.bytes(), seconds);
@@ -349,7 +351,12 @@ void RegisterBenchmarks(const BenchMesh& mesh) {
         ->MinTime(1.0);
   }
   for (const int frames : {1, 2, 4, 8, 16}) {
-    RegisterFor(mesh, "BatchedSolve/frames:" + std::to_string(frames), BM_BatchedSolve, frames)
+    RegisterFor(mesh, "BatchedSolve/frames:" + std::to_string(frames), BM_BatchedSolve, frames,
+                BestSolveKernel())
+        ->MinTime(1.0);
+  }
+  if (BestSolveKernel() == SolveKernel::kAvx512) {  // the four-wide batch in the same run
+    RegisterFor(mesh, "BatchedSolveAvx2Kernel/frames:8", BM_BatchedSolve, 8, SolveKernel::kAvx2Fma)
         ->MinTime(1.0);
   }
   RegisterFor(mesh, "ParallelSolve/parts:2", BM_ParallelSolve, 2)->MinTime(1.0);

@@ -1,11 +1,16 @@
 #include "core/solver/supernodal_solve.h"
 
+#include <initializer_list>
+
 namespace deform {
 
 // Defined in supernodal_solve_baseline.cc and, where built, supernodal_solve_avx2.cc.
 extern const SolveKernelFunctions kBaselineSolveKernel;
 #if defined(DEFORM_HAVE_AVX2_KERNEL)
 extern const SolveKernelFunctions kAvx2FmaSolveKernel;
+#endif
+#if defined(DEFORM_HAVE_AVX512_KERNEL)
+extern const SolveKernelFunctions kAvx512SolveKernel;
 #endif
 
 const char* SolveKernelName(SolveKernel kernel) {
@@ -14,6 +19,8 @@ const char* SolveKernelName(SolveKernel kernel) {
       return "baseline";
     case SolveKernel::kAvx2Fma:
       return "avx2+fma";
+    case SolveKernel::kAvx512:
+      return "avx512";
   }
   return "unknown";
 }
@@ -30,19 +37,34 @@ bool SolveKernelAvailable(SolveKernel kernel) {
 #else
       return false;
 #endif
+    case SolveKernel::kAvx512:
+#if defined(DEFORM_HAVE_AVX512_KERNEL)
+      // libgcc's check includes the operating system's saving of the AVX-512 registers (XCR0).
+      return SolveKernelAvailable(SolveKernel::kAvx2Fma) && __builtin_cpu_supports("avx512f") &&
+             __builtin_cpu_supports("avx512vl");
+#else
+      return false;
+#endif
   }
   return false;
 }
 
 SolveKernel BestSolveKernel() {
-  static const SolveKernel best =
-      SolveKernelAvailable(SolveKernel::kAvx2Fma) ? SolveKernel::kAvx2Fma : SolveKernel::kBaseline;
+  static const SolveKernel best = [] {
+    for (const SolveKernel kernel : {SolveKernel::kAvx512, SolveKernel::kAvx2Fma}) {
+      if (SolveKernelAvailable(kernel)) return kernel;
+    }
+    return SolveKernel::kBaseline;
+  }();
   return best;
 }
 
 const SolveKernelFunctions& SolveKernelFunctionsFor(SolveKernel kernel) {
 #if defined(DEFORM_HAVE_AVX2_KERNEL)
   if (kernel == SolveKernel::kAvx2Fma) return kAvx2FmaSolveKernel;
+#endif
+#if defined(DEFORM_HAVE_AVX512_KERNEL)
+  if (kernel == SolveKernel::kAvx512) return kAvx512SolveKernel;
 #endif
   (void)kernel;
   return kBaselineSolveKernel;

@@ -56,8 +56,14 @@ using Solve3Function = void (*)(const SupernodalFactorView& factor, const double
 // the factor per direction for all the columns; allocates nothing. Each column's result equals
 // Solve3's for that column to round-off (the sums run in another order).
 inline constexpr int kMaxSolveColumns = 48;  // sixteen frames of three coordinates
+// The widest batch vector of any variant, in doubles (AVX-512's eight): a batch's solution rows
+// are padded to a multiple of it and aligned to it.
+inline constexpr int kSolveBatchLanes = 8;
 inline std::int64_t SolveManyWorkSize(int size, int columns) {
-  return 4 * ((static_cast<std::int64_t>(columns) + 3) / 4) * size + 4;
+  return kSolveBatchLanes *
+             ((static_cast<std::int64_t>(columns) + kSolveBatchLanes - 1) / kSolveBatchLanes) *
+             size +
+         kSolveBatchLanes;
 }
 using SolveManyFunction = void (*)(const SupernodalFactorView& factor, const double* b, double* x,
                                    int columns, double* work);
@@ -71,6 +77,7 @@ using SolveFramesFunction = void (*)(const SupernodalFactorView& factor, const d
 enum class SolveKernel {
   kBaseline,  // any CPU the project builds for
   kAvx2Fma,   // x86-64 with AVX2 and FMA (checked at run time)
+  kAvx512,    // x86-64 with AVX-512 F and VL as well: the batched passes eight doubles wide
 };
 
 const char* SolveKernelName(SolveKernel kernel);

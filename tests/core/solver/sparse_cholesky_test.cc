@@ -450,10 +450,14 @@ TEST_P(SolveKernelTest, Float32FactorSolvesWithItsRoundedValues) {
 }
 
 INSTANTIATE_TEST_SUITE_P(AllKernels, SolveKernelTest,
-                         ::testing::Values(SolveKernel::kBaseline, SolveKernel::kAvx2Fma),
+                         ::testing::Values(SolveKernel::kBaseline, SolveKernel::kAvx2Fma,
+                                           SolveKernel::kAvx512),
                          [](const auto& info) {
-                           return std::string(info.param == SolveKernel::kBaseline ? "baseline"
-                                                                                   : "avx2_fma");
+                           std::string name = SolveKernelName(info.param);  // "avx2+fma"
+                           for (char& c : name) {
+                             if (c == '+') c = '_';
+                           }
+                           return name;
                          });
 
 TEST(SolveKernel, TheBestIsAvailable) {

@@ -582,36 +582,57 @@ void Solve3Impl(const SupernodalFactorView& f, const double* b, double* x, doubl
 // ---------------------------------------------------------------------------------------------
 // Many right-hand sides at once (CholeskyFactor::SolveMany): one pass over the factor serves every
 // column, so the factor's bytes are read once per batch instead of once per frame. The solution
-// rows are kVecs four-double vectors wide (columns padded with zeros to a multiple of four), and
+// rows are kVecs batch vectors wide (columns padded with zeros to a multiple of kBatchLanes), and
 // each factor value multiplies a whole row of them.
+//
+// A batch vector is one register of the widest width the variant is compiled for: eight doubles
+// with AVX-512 (each broadcast factor value then serves twice the columns per instruction, and a
+// batch of eight frames' 24 columns is three vectors), four elsewhere (Vec4).
+#if defined(__AVX512F__)
+typedef double BatchVec __attribute__((vector_size(64)));
+typedef double BatchVecUnaligned __attribute__((vector_size(64), aligned(8), may_alias));
+constexpr int kBatchLanes = 8;
+inline BatchVec LoadBatch(const double* p) {
+  return *reinterpret_cast<const BatchVecUnaligned*>(p);
+}
+inline void StoreBatch(double* p, BatchVec v) { *reinterpret_cast<BatchVecUnaligned*>(p) = v; }
+inline BatchVec SplatBatch(double v) { return BatchVec{v, v, v, v, v, v, v, v}; }
+#else
+typedef Vec4 BatchVec;
+constexpr int kBatchLanes = 4;
+inline BatchVec LoadBatch(const double* p) { return Load4(p); }
+inline void StoreBatch(double* p, BatchVec v) { Store4(p, v); }
+inline BatchVec SplatBatch(double v) { return Splat4(v); }
+#endif
+static_assert(kBatchLanes <= kSolveBatchLanes, "SolveManyWorkSize must cover this variant's rows");
 
-// Widest solution rows (in four-double vectors) whose updates are register-blocked two at a time:
-// two rows' (or columns') sums of kVecs vectors each, the broadcasts and a load fit the sixteen
-// AVX registers.
+// Widest solution rows (in batch vectors) whose updates are register-blocked two at a time: two
+// rows' (or columns') sums of kVecs vectors each, the broadcasts and a load fit the sixteen AVX
+// registers (thirty-two with AVX-512).
 constexpr int kMaxBlockedVecs = 6;
 
 // Forward pass of one supernode: its diagonal block solves its own rows (contiguous in y), then
 // every row below subtracts its block row times them.
 template <typename Value, int kVecs>
 inline void ForwardSupernodeMany(const SupernodeBlock<Value>& s, double* __restrict y) {
-  constexpr int kStride = 4 * kVecs;
+  constexpr int kStride = kBatchLanes * kVecs;
   double* __restrict own = y + kStride * static_cast<std::ptrdiff_t>(s.first);
   const int width = s.width;
   for (int c = 0; c < width; ++c) {
     const Value* row = s.values + static_cast<std::ptrdiff_t>(c) * width;
-    Vec4 sum[kVecs];
+    BatchVec sum[kVecs];
     double* target = own + kStride * c;
-    for (int j = 0; j < kVecs; ++j) sum[j] = Load4(target + 4 * j);
+    for (int j = 0; j < kVecs; ++j) sum[j] = LoadBatch(target + kBatchLanes * j);
     for (int k = 0; k < c; ++k) {
-      const Vec4 l = Splat4(row[k]);
+      const BatchVec l = SplatBatch(row[k]);
       const double* known = own + kStride * k;
-      for (int j = 0; j < kVecs; ++j) sum[j] -= l * Load4(known + 4 * j);
+      for (int j = 0; j < kVecs; ++j) sum[j] -= l * LoadBatch(known + kBatchLanes * j);
     }
     // One division per column, not one per vector: a four-wide division takes several times a
     // multiplication's issue slots, and the narrow supernodes' columns have few rows to amortise
     // it.
-    const Vec4 inverse_pivot = Splat4(1.0 / static_cast<double>(row[c]));
-    for (int j = 0; j < kVecs; ++j) Store4(target + 4 * j, sum[j] * inverse_pivot);
+    const BatchVec inverse_pivot = SplatBatch(1.0 / static_cast<double>(row[c]));
+    for (int j = 0; j < kVecs; ++j) StoreBatch(target + kBatchLanes * j, sum[j] * inverse_pivot);
   }
   std::int64_t r = width;
   if constexpr (kVecs <= kMaxBlockedVecs) {
@@ -621,38 +642,38 @@ inline void ForwardSupernodeMany(const SupernodeBlock<Value>& s, double* __restr
       const Value* row1 = row0 + width;
       double* target0 = y + kStride * static_cast<std::ptrdiff_t>(s.rows[r]);
       double* target1 = y + kStride * static_cast<std::ptrdiff_t>(s.rows[r + 1]);
-      Vec4 sum0[kVecs], sum1[kVecs];
+      BatchVec sum0[kVecs], sum1[kVecs];
       for (int j = 0; j < kVecs; ++j) {
-        sum0[j] = Load4(target0 + 4 * j);
-        sum1[j] = Load4(target1 + 4 * j);
+        sum0[j] = LoadBatch(target0 + kBatchLanes * j);
+        sum1[j] = LoadBatch(target1 + kBatchLanes * j);
       }
       for (int k = 0; k < width; ++k) {
-        const Vec4 l0 = Splat4(row0[k]);
-        const Vec4 l1 = Splat4(row1[k]);
+        const BatchVec l0 = SplatBatch(row0[k]);
+        const BatchVec l1 = SplatBatch(row1[k]);
         const double* known = own + kStride * k;
         for (int j = 0; j < kVecs; ++j) {
-          const Vec4 v = Load4(known + 4 * j);
+          const BatchVec v = LoadBatch(known + kBatchLanes * j);
           sum0[j] -= l0 * v;
           sum1[j] -= l1 * v;
         }
       }
       for (int j = 0; j < kVecs; ++j) {
-        Store4(target0 + 4 * j, sum0[j]);
-        Store4(target1 + 4 * j, sum1[j]);
+        StoreBatch(target0 + kBatchLanes * j, sum0[j]);
+        StoreBatch(target1 + kBatchLanes * j, sum1[j]);
       }
     }
   }
   for (; r < s.num_rows; ++r) {
     const Value* row = s.values + r * width;
     double* target = y + kStride * static_cast<std::ptrdiff_t>(s.rows[r]);
-    Vec4 sum[kVecs];
-    for (int j = 0; j < kVecs; ++j) sum[j] = Load4(target + 4 * j);
+    BatchVec sum[kVecs];
+    for (int j = 0; j < kVecs; ++j) sum[j] = LoadBatch(target + kBatchLanes * j);
     for (int k = 0; k < width; ++k) {
-      const Vec4 l = Splat4(row[k]);
+      const BatchVec l = SplatBatch(row[k]);
       const double* known = own + kStride * k;
-      for (int j = 0; j < kVecs; ++j) sum[j] -= l * Load4(known + 4 * j);
+      for (int j = 0; j < kVecs; ++j) sum[j] -= l * LoadBatch(known + kBatchLanes * j);
     }
-    for (int j = 0; j < kVecs; ++j) Store4(target + 4 * j, sum[j]);
+    for (int j = 0; j < kVecs; ++j) StoreBatch(target + kBatchLanes * j, sum[j]);
   }
 }
 
@@ -661,21 +682,21 @@ inline void ForwardSupernodeMany(const SupernodeBlock<Value>& s, double* __restr
 // diagonal block solves them, last row first.
 template <typename Value, int kVecs>
 inline void BackwardSupernodeMany(const SupernodeBlock<Value>& s, double* __restrict y) {
-  constexpr int kStride = 4 * kVecs;
+  constexpr int kStride = kBatchLanes * kVecs;
   double* __restrict own = y + kStride * static_cast<std::ptrdiff_t>(s.first);
   const int width = s.width;
   int k = 0;
   if constexpr (kVecs <= kMaxBlockedVecs) {
     // Two columns of the block at a time: each load of a solved row serves both.
     for (; k + 2 <= width; k += 2) {
-      Vec4 sum0[kVecs], sum1[kVecs];
-      for (int j = 0; j < kVecs; ++j) sum0[j] = sum1[j] = Splat4(0);
+      BatchVec sum0[kVecs], sum1[kVecs];
+      for (int j = 0; j < kVecs; ++j) sum0[j] = sum1[j] = SplatBatch(0);
       for (std::int64_t r = width; r < s.num_rows; ++r) {
-        const Vec4 l0 = Splat4(s.values[r * width + k]);
-        const Vec4 l1 = Splat4(s.values[r * width + k + 1]);
+        const BatchVec l0 = SplatBatch(s.values[r * width + k]);
+        const BatchVec l1 = SplatBatch(s.values[r * width + k + 1]);
         const double* solved = y + kStride * static_cast<std::ptrdiff_t>(s.rows[r]);
         for (int j = 0; j < kVecs; ++j) {
-          const Vec4 v = Load4(solved + 4 * j);
+          const BatchVec v = LoadBatch(solved + kBatchLanes * j);
           sum0[j] += l0 * v;
           sum1[j] += l1 * v;
         }
@@ -683,49 +704,51 @@ inline void BackwardSupernodeMany(const SupernodeBlock<Value>& s, double* __rest
       double* target0 = own + kStride * k;
       double* target1 = target0 + kStride;
       for (int j = 0; j < kVecs; ++j) {
-        Store4(target0 + 4 * j, Load4(target0 + 4 * j) - sum0[j]);
-        Store4(target1 + 4 * j, Load4(target1 + 4 * j) - sum1[j]);
+        StoreBatch(target0 + kBatchLanes * j, LoadBatch(target0 + kBatchLanes * j) - sum0[j]);
+        StoreBatch(target1 + kBatchLanes * j, LoadBatch(target1 + kBatchLanes * j) - sum1[j]);
       }
     }
   }
   for (; k < width; ++k) {
-    Vec4 sum[kVecs];
-    for (int j = 0; j < kVecs; ++j) sum[j] = Splat4(0);
+    BatchVec sum[kVecs];
+    for (int j = 0; j < kVecs; ++j) sum[j] = SplatBatch(0);
     for (std::int64_t r = width; r < s.num_rows; ++r) {
-      const Vec4 l = Splat4(s.values[r * width + k]);
+      const BatchVec l = SplatBatch(s.values[r * width + k]);
       const double* solved = y + kStride * static_cast<std::ptrdiff_t>(s.rows[r]);
-      for (int j = 0; j < kVecs; ++j) sum[j] += l * Load4(solved + 4 * j);
+      for (int j = 0; j < kVecs; ++j) sum[j] += l * LoadBatch(solved + kBatchLanes * j);
     }
     double* target = own + kStride * k;
-    for (int j = 0; j < kVecs; ++j) Store4(target + 4 * j, Load4(target + 4 * j) - sum[j]);
+    for (int j = 0; j < kVecs; ++j) StoreBatch(target + kBatchLanes * j, LoadBatch(target + kBatchLanes * j) - sum[j]);
   }
   for (int c = width - 1; c >= 0; --c) {
     const Value* row = s.values + static_cast<std::ptrdiff_t>(c) * width;
     double* target = own + kStride * c;
-    const Vec4 inverse_pivot = Splat4(1.0 / static_cast<double>(row[c]));  // (as forward)
-    Vec4 solved[kVecs];
+    const BatchVec inverse_pivot = SplatBatch(1.0 / static_cast<double>(row[c]));  // (as forward)
+    BatchVec solved[kVecs];
     for (int j = 0; j < kVecs; ++j) {
-      solved[j] = Load4(target + 4 * j) * inverse_pivot;
-      Store4(target + 4 * j, solved[j]);
+      solved[j] = LoadBatch(target + kBatchLanes * j) * inverse_pivot;
+      StoreBatch(target + kBatchLanes * j, solved[j]);
     }
     for (int k = 0; k < c; ++k) {
-      const Vec4 l = Splat4(row[k]);
+      const BatchVec l = SplatBatch(row[k]);
       double* above = own + kStride * k;
-      for (int j = 0; j < kVecs; ++j) Store4(above + 4 * j, Load4(above + 4 * j) - l * solved[j]);
+      for (int j = 0; j < kVecs; ++j) StoreBatch(above + kBatchLanes * j, LoadBatch(above + kBatchLanes * j) - l * solved[j]);
     }
   }
 }
 
-// The batched passes on solution rows of kVecs four-double vectors: gather(row, i) fills row i
+// The batched passes on solution rows of kVecs batch vectors: gather(row, i) fills row i
 // (its first columns; the rest is zeroed here) from the right-hand sides of unknown
 // permutation[i], scatter(row, i) takes the solution back out.
 template <int kVecs, typename Gather, typename Scatter>
 void SolveRowsWithWidth(const SupernodalFactorView& f, int columns, double* work, Gather&& gather,
                         Scatter&& scatter) {
-  constexpr int kStride = 4 * kVecs;
+  constexpr int kStride = kBatchLanes * kVecs;
   const int n = f.size;
-  const std::uintptr_t misalignment = reinterpret_cast<std::uintptr_t>(work) % 32;
-  double* __restrict y = work + (misalignment ? (32 - misalignment) / sizeof(double) : 0);
+  // The rows start at the first boundary of a whole batch vector in `work`.
+  constexpr std::uintptr_t kAlignment = kBatchLanes * sizeof(double);
+  const std::uintptr_t misalignment = reinterpret_cast<std::uintptr_t>(work) % kAlignment;
+  double* __restrict y = work + (misalignment ? (kAlignment - misalignment) / sizeof(double) : 0);
   for (int i = 0; i < n; ++i) {
     double* t = y + kStride * static_cast<std::ptrdiff_t>(i);
     gather(t, f.permutation[i]);
@@ -747,7 +770,7 @@ void SolveRowsWithWidth(const SupernodalFactorView& f, int columns, double* work
 
 void SolveManyImpl(const SupernodalFactorView& f, const double* b, double* x, int columns,
                    double* work) {
-  WithCount<kMaxSolveColumns / 4>((columns + 3) / 4, [&](auto vecs) {
+  WithCount<kMaxSolveColumns / kBatchLanes>((columns + kBatchLanes - 1) / kBatchLanes, [&](auto vecs) {
     SolveRowsWithWidth<decltype(vecs)::value>(
         f, columns, work,
         [&](double* __restrict row, int unknown) {
@@ -766,7 +789,7 @@ void SolveFramesImpl(const SupernodalFactorView& f, const double* const* b, doub
                      int frames, double* work) {
   WithCount<kMaxSolveColumns / 3>(frames, [&](auto count) {
     constexpr int kFrames = decltype(count)::value;
-    SolveRowsWithWidth<(3 * kFrames + 3) / 4>(
+    SolveRowsWithWidth<(3 * kFrames + kBatchLanes - 1) / kBatchLanes>(
         f, 3 * kFrames, work,
         [&](double* __restrict row, int unknown) {
           for (int frame = 0; frame < kFrames; ++frame) {
