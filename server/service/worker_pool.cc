@@ -78,6 +78,11 @@ void WorkerPool::Shutdown() {
   }
 }
 
+int WorkerPool::BatchShare(int queued, int idle_workers, int max_batch) {
+  const int workers = std::clamp(queued / kMinBatchShare, 1, 1 + std::max(idle_workers, 0));
+  return std::clamp((queued + workers - 1) / workers, 1, std::max(max_batch, 1));
+}
+
 std::shared_ptr<UrgentTask> WorkerPool::TakeUrgentLocked(std::shared_ptr<UrgentTask>* others,
                                                          int* count) {
   std::shared_ptr<UrgentTask> head = std::move(urgent_head_);
@@ -86,16 +91,15 @@ std::shared_ptr<UrgentTask> WorkerPool::TakeUrgentLocked(std::shared_ptr<UrgentT
   *count = 0;
   const void* key = max_batch_ > 1 ? head->BatchKey() : nullptr;
   if (key == nullptr) return head;
-  // The batch's share of the queued tasks with its key: the workers now idle will take the rest,
-  // so a few tasks are spread over the free workers rather than solved by one while others wait.
+  // The batch's share of the queued tasks with its key (BatchShare): the workers now idle will
+  // take the rest.
   int matching = 0;
   int scanned = 0;
   for (const UrgentTask* task = urgent_head_.get(); task != nullptr && scanned < kBatchScanLimit;
        task = task->next_urgent_.get(), ++scanned) {
     if (task->BatchKey() == key) ++matching;
   }
-  const int workers = 1 + idle_workers_;
-  const int take = std::min(max_batch_ - 1, (1 + matching + workers - 1) / workers - 1);
+  const int take = BatchShare(1 + matching, idle_workers_, max_batch_) - 1;
   // Walk the queue through the links that own each task, unlinking the first `take` matches.
   std::shared_ptr<UrgentTask>* link = &urgent_head_;
   UrgentTask* previous = nullptr;

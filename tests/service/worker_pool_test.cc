@@ -141,6 +141,22 @@ TEST(WorkerPoolTest, ABatchTakenFromTheQueuesTailLeavesItUsable) {
   }
 }
 
+// A worker's share of the queued tasks of one key: spread over the idle workers only while each
+// gets at least kMinBatchShare, never more than the batch limit, never less than the head.
+TEST(WorkerPoolTest, ABatchIsSharedWithIdleWorkersOnlyInWorthwhileShares) {
+  static_assert(WorkerPool::kMinBatchShare == 4, "the cases below are written for four");
+  EXPECT_EQ(WorkerPool::BatchShare(1, 1, 8), 1);
+  EXPECT_EQ(WorkerPool::BatchShare(2, 1, 8), 2);   // not split into two lone tasks
+  EXPECT_EQ(WorkerPool::BatchShare(7, 1, 8), 7);   // 4 + 3: the second share too small
+  EXPECT_EQ(WorkerPool::BatchShare(8, 1, 8), 4);   // 4 + 4
+  EXPECT_EQ(WorkerPool::BatchShare(9, 1, 8), 5);   // 5 + 4
+  EXPECT_EQ(WorkerPool::BatchShare(8, 0, 8), 8);   // nobody to share with
+  EXPECT_EQ(WorkerPool::BatchShare(12, 2, 16), 4);  // three workers, four each
+  EXPECT_EQ(WorkerPool::BatchShare(12, 5, 16), 4);  // no more workers than shares of four
+  EXPECT_EQ(WorkerPool::BatchShare(20, 0, 8), 8);   // the batch limit
+  EXPECT_EQ(WorkerPool::BatchShare(20, 0, 1), 1);
+}
+
 TEST(WorkerPoolTest, ALoneTaskWithAKeyRunsWithoutWaitingForOthers) {
   WorkerPool pool(2, 8);
   int mesh = 0;
