@@ -12,9 +12,9 @@
 // task from the head of the queue also takes queued tasks with the same key and hands them to the
 // first task's RunUrgentBatch, which runs them all: its share of them when other workers are idle
 // and the tasks are enough for a worthwhile batch each (those take the rest, so many tasks are
-// spread over the free workers; BatchShare), up to the pool's max_batch in all, looking at most kBatchScanLimit tasks deep. Nothing waits for a batch to fill:
-// a batch is only what is already queued, so a lone task runs as soon as a worker is free, as
-// before.
+// spread over the free workers; BatchShare), up to the pool's max_batch in all, looking at most
+// kBatchScanLimit tasks deep. Nothing waits for a batch to fill: a batch is only what is already
+// queued, so a lone task runs as soon as a worker is free, as before.
 //
 // Ownership: the pool holds a reference to every task it has been given (the urgent task's
 // shared_ptr, the background task's function and its captures) until the task has run, and drops

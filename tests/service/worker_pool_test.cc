@@ -146,11 +146,11 @@ TEST(WorkerPoolTest, ABatchTakenFromTheQueuesTailLeavesItUsable) {
 TEST(WorkerPoolTest, ABatchIsSharedWithIdleWorkersOnlyInWorthwhileShares) {
   static_assert(WorkerPool::kMinBatchShare == 4, "the cases below are written for four");
   EXPECT_EQ(WorkerPool::BatchShare(1, 1, 8), 1);
-  EXPECT_EQ(WorkerPool::BatchShare(2, 1, 8), 2);   // not split into two lone tasks
-  EXPECT_EQ(WorkerPool::BatchShare(7, 1, 8), 7);   // 4 + 3: the second share too small
-  EXPECT_EQ(WorkerPool::BatchShare(8, 1, 8), 4);   // 4 + 4
-  EXPECT_EQ(WorkerPool::BatchShare(9, 1, 8), 5);   // 5 + 4
-  EXPECT_EQ(WorkerPool::BatchShare(8, 0, 8), 8);   // nobody to share with
+  EXPECT_EQ(WorkerPool::BatchShare(2, 1, 8), 2);    // not split into two lone tasks
+  EXPECT_EQ(WorkerPool::BatchShare(7, 1, 8), 7);    // 4 + 3: the second share too small
+  EXPECT_EQ(WorkerPool::BatchShare(8, 1, 8), 4);    // 4 + 4
+  EXPECT_EQ(WorkerPool::BatchShare(9, 1, 8), 5);    // 5 + 4
+  EXPECT_EQ(WorkerPool::BatchShare(8, 0, 8), 8);    // nobody to share with
   EXPECT_EQ(WorkerPool::BatchShare(12, 2, 16), 4);  // three workers, four each
   EXPECT_EQ(WorkerPool::BatchShare(12, 5, 16), 4);  // no more workers than shares of four
   EXPECT_EQ(WorkerPool::BatchShare(20, 0, 8), 8);   // the batch limit

@@ -248,6 +248,13 @@ inline void SubtractRow1x3(const Value* __restrict row, const double* __restrict
 // The solution rows during the solve (supernodal_solve.h).
 constexpr int kRowStride = kSolveRowStride;
 
+// The first `doubles`-double boundary in `work` (whose size leaves that much slack).
+inline double* AlignedTo(double* work, int doubles) {
+  const std::uintptr_t bytes = doubles * sizeof(double);
+  const std::uintptr_t misalignment = reinterpret_cast<std::uintptr_t>(work) % bytes;
+  return work + (misalignment ? (bytes - misalignment) / sizeof(double) : 0);
+}
+
 inline double* Row(double* y, int row) { return y + kRowStride * static_cast<std::ptrdiff_t>(row); }
 inline const double* Row(const double* y, int row) {
   return y + kRowStride * static_cast<std::ptrdiff_t>(row);
@@ -552,8 +559,7 @@ void BackwardListImpl(const SupernodalFactorView& f, const int* supernodes, int 
 void Solve3Impl(const SupernodalFactorView& f, const double* b, double* x, double* work) {
   const int n = f.size;
   // The solution rows start at the first 32-byte boundary of `work`.
-  const std::uintptr_t misalignment = reinterpret_cast<std::uintptr_t>(work) % 32;
-  double* __restrict y = work + (misalignment ? (32 - misalignment) / sizeof(double) : 0);
+  double* __restrict y = AlignedTo(work, kRowStride);
   double* const planar_buffer = y + kRowStride * static_cast<std::ptrdiff_t>(n);
   for (int i = 0; i < n; ++i) {
     const double* source = b + 3 * static_cast<std::ptrdiff_t>(f.permutation[i]);
@@ -606,6 +612,9 @@ inline BatchVec SplatBatch(double v) { return Splat4(v); }
 #endif
 static_assert(kBatchLanes <= kSolveBatchLanes, "SolveManyWorkSize must cover this variant's rows");
 
+// Batch vectors in a row of `columns` columns (zero-padded).
+constexpr int BatchVecsFor(int columns) { return (columns + kBatchLanes - 1) / kBatchLanes; }
+
 // Widest solution rows (in batch vectors) whose updates are register-blocked two at a time: two
 // rows' (or columns') sums of kVecs vectors each, the broadcasts and a load fit the sixteen AVX
 // registers (thirty-two with AVX-512).
@@ -628,7 +637,7 @@ inline void ForwardSupernodeMany(const SupernodeBlock<Value>& s, double* __restr
       const double* known = own + kStride * k;
       for (int j = 0; j < kVecs; ++j) sum[j] -= l * LoadBatch(known + kBatchLanes * j);
     }
-    // One division per column, not one per vector: a four-wide division takes several times a
+    // One division per column, not one per vector: a vector division takes several times a
     // multiplication's issue slots, and the narrow supernodes' columns have few rows to amortise
     // it.
     const BatchVec inverse_pivot = SplatBatch(1.0 / static_cast<double>(row[c]));
@@ -718,7 +727,9 @@ inline void BackwardSupernodeMany(const SupernodeBlock<Value>& s, double* __rest
       for (int j = 0; j < kVecs; ++j) sum[j] += l * LoadBatch(solved + kBatchLanes * j);
     }
     double* target = own + kStride * k;
-    for (int j = 0; j < kVecs; ++j) StoreBatch(target + kBatchLanes * j, LoadBatch(target + kBatchLanes * j) - sum[j]);
+    for (int j = 0; j < kVecs; ++j) {
+      StoreBatch(target + kBatchLanes * j, LoadBatch(target + kBatchLanes * j) - sum[j]);
+    }
   }
   for (int c = width - 1; c >= 0; --c) {
     const Value* row = s.values + static_cast<std::ptrdiff_t>(c) * width;
@@ -732,7 +743,9 @@ inline void BackwardSupernodeMany(const SupernodeBlock<Value>& s, double* __rest
     for (int k = 0; k < c; ++k) {
       const BatchVec l = SplatBatch(row[k]);
       double* above = own + kStride * k;
-      for (int j = 0; j < kVecs; ++j) StoreBatch(above + kBatchLanes * j, LoadBatch(above + kBatchLanes * j) - l * solved[j]);
+      for (int j = 0; j < kVecs; ++j) {
+        StoreBatch(above + kBatchLanes * j, LoadBatch(above + kBatchLanes * j) - l * solved[j]);
+      }
     }
   }
 }
@@ -745,10 +758,7 @@ void SolveRowsWithWidth(const SupernodalFactorView& f, int columns, double* work
                         Scatter&& scatter) {
   constexpr int kStride = kBatchLanes * kVecs;
   const int n = f.size;
-  // The rows start at the first boundary of a whole batch vector in `work`.
-  constexpr std::uintptr_t kAlignment = kBatchLanes * sizeof(double);
-  const std::uintptr_t misalignment = reinterpret_cast<std::uintptr_t>(work) % kAlignment;
-  double* __restrict y = work + (misalignment ? (kAlignment - misalignment) / sizeof(double) : 0);
+  double* __restrict y = AlignedTo(work, kBatchLanes);  // at a whole batch vector's boundary
   for (int i = 0; i < n; ++i) {
     double* t = y + kStride * static_cast<std::ptrdiff_t>(i);
     gather(t, f.permutation[i]);
@@ -770,7 +780,7 @@ void SolveRowsWithWidth(const SupernodalFactorView& f, int columns, double* work
 
 void SolveManyImpl(const SupernodalFactorView& f, const double* b, double* x, int columns,
                    double* work) {
-  WithCount<kMaxSolveColumns / kBatchLanes>((columns + kBatchLanes - 1) / kBatchLanes, [&](auto vecs) {
+  WithCount<BatchVecsFor(kMaxSolveColumns)>(BatchVecsFor(columns), [&](auto vecs) {
     SolveRowsWithWidth<decltype(vecs)::value>(
         f, columns, work,
         [&](double* __restrict row, int unknown) {
@@ -789,7 +799,7 @@ void SolveFramesImpl(const SupernodalFactorView& f, const double* const* b, doub
                      int frames, double* work) {
   WithCount<kMaxSolveColumns / 3>(frames, [&](auto count) {
     constexpr int kFrames = decltype(count)::value;
-    SolveRowsWithWidth<(3 * kFrames + kBatchLanes - 1) / kBatchLanes>(
+    SolveRowsWithWidth<BatchVecsFor(3 * kFrames)>(
         f, 3 * kFrames, work,
         [&](double* __restrict row, int unknown) {
           for (int frame = 0; frame < kFrames; ++frame) {
