@@ -615,10 +615,107 @@ static_assert(kBatchLanes <= kSolveBatchLanes, "SolveManyWorkSize must cover thi
 // Batch vectors in a row of `columns` columns (zero-padded).
 constexpr int BatchVecsFor(int columns) { return (columns + kBatchLanes - 1) / kBatchLanes; }
 
-// Widest solution rows (in batch vectors) whose updates are register-blocked two at a time: two
-// rows' (or columns') sums of kVecs vectors each, the broadcasts and a load fit the sixteen AVX
-// registers (thirty-two with AVX-512).
-constexpr int kMaxBlockedVecs = 6;
+// Register blocking of the batched passes: an update works on BlockFor(kVecs) solution rows
+// (forward) or columns of the block (backward) at once, so that each load of a solution row
+// serves all of them and their BlockFor(kVecs) * kVecs independent multiply-add chains hide the
+// multiply-add's latency; the diagonal blocks are solved in tiles of as many rows. BlockFor is the
+// largest power of two up to eight whose accumulators (at most sixteen vectors), one loaded row
+// and two broadcasts fit the registers: thirty-two with AVX-512, sixteen elsewhere.
+#if defined(__AVX512F__)
+constexpr int kBatchRegisters = 32;
+#else
+constexpr int kBatchRegisters = 16;
+#endif
+constexpr int BlockFor(int vecs) {
+  int block = 8;
+  while (block > 1 && (block * vecs > 16 || block * vecs + vecs + 2 > kBatchRegisters)) block /= 2;
+  return block;
+}
+
+// Rows [r, num_rows) of the block below the diagonal, kRows at a time while they last, then in
+// halving blocks: y[rows[i]] -= (block row i) * (the supernode's solved rows `own`).
+template <typename Value, int kVecs, int kRows>
+inline void ForwardRowsMany(const SupernodeBlock<Value>& s, const double* __restrict own,
+                            double* __restrict y, std::int64_t r) {
+  constexpr int kStride = kBatchLanes * kVecs;
+  const int width = s.width;
+  for (; r + kRows <= s.num_rows; r += kRows) {
+    const Value* block_rows = s.values + r * width;
+    double* target[kRows];
+    BatchVec sum[kRows][kVecs];
+    for (int i = 0; i < kRows; ++i) {
+      target[i] = y + kStride * static_cast<std::ptrdiff_t>(s.rows[r + i]);
+      for (int j = 0; j < kVecs; ++j) sum[i][j] = LoadBatch(target[i] + kBatchLanes * j);
+    }
+    for (int k = 0; k < width; ++k) {
+      const double* known = own + kStride * k;
+      BatchVec v[kVecs];
+      for (int j = 0; j < kVecs; ++j) v[j] = LoadBatch(known + kBatchLanes * j);
+      for (int i = 0; i < kRows; ++i) {
+        const BatchVec l = SplatBatch(block_rows[i * width + k]);
+        for (int j = 0; j < kVecs; ++j) sum[i][j] -= l * v[j];
+      }
+    }
+    for (int i = 0; i < kRows; ++i) {
+      for (int j = 0; j < kVecs; ++j) StoreBatch(target[i] + kBatchLanes * j, sum[i][j]);
+    }
+  }
+  if constexpr (kRows > 1) ForwardRowsMany<Value, kVecs, kRows / 2>(s, own, y, r);
+}
+
+// Forward substitution with the diagonal block on the supernode's own rows: kTile rows at a
+// time, each tile first subtracting the columns already solved (register-blocked as the rows
+// below), then solving its own small triangle in registers; the last rows one at a time. One
+// division per row, not one per vector: a vector division takes several times a multiplication's
+// issue slots.
+template <typename Value, int kVecs, int kTile>
+inline void ForwardDiagonalMany(const SupernodeBlock<Value>& s, double* __restrict own) {
+  constexpr int kStride = kBatchLanes * kVecs;
+  const int width = s.width;
+  int c = 0;
+  for (; c + kTile <= width; c += kTile) {
+    const Value* tile_rows = s.values + static_cast<std::ptrdiff_t>(c) * width;
+    double* const tile = own + kStride * c;
+    BatchVec sum[kTile][kVecs];
+    for (int i = 0; i < kTile; ++i) {
+      for (int j = 0; j < kVecs; ++j) sum[i][j] = LoadBatch(tile + kStride * i + kBatchLanes * j);
+    }
+    for (int k = 0; k < c; ++k) {
+      const double* known = own + kStride * k;
+      BatchVec v[kVecs];
+      for (int j = 0; j < kVecs; ++j) v[j] = LoadBatch(known + kBatchLanes * j);
+      for (int i = 0; i < kTile; ++i) {
+        const BatchVec l = SplatBatch(tile_rows[i * width + k]);
+        for (int j = 0; j < kVecs; ++j) sum[i][j] -= l * v[j];
+      }
+    }
+    for (int i = 0; i < kTile; ++i) {
+      const Value* row = tile_rows + i * width;
+      for (int m = 0; m < i; ++m) {
+        const BatchVec l = SplatBatch(row[c + m]);
+        for (int j = 0; j < kVecs; ++j) sum[i][j] -= l * sum[m][j];
+      }
+      const BatchVec inverse_pivot = SplatBatch(1.0 / static_cast<double>(row[c + i]));
+      for (int j = 0; j < kVecs; ++j) {
+        sum[i][j] = sum[i][j] * inverse_pivot;
+        StoreBatch(tile + kStride * i + kBatchLanes * j, sum[i][j]);
+      }
+    }
+  }
+  for (; c < width; ++c) {
+    const Value* row = s.values + static_cast<std::ptrdiff_t>(c) * width;
+    BatchVec sum[kVecs];
+    double* target = own + kStride * c;
+    for (int j = 0; j < kVecs; ++j) sum[j] = LoadBatch(target + kBatchLanes * j);
+    for (int k = 0; k < c; ++k) {
+      const BatchVec l = SplatBatch(row[k]);
+      const double* known = own + kStride * k;
+      for (int j = 0; j < kVecs; ++j) sum[j] -= l * LoadBatch(known + kBatchLanes * j);
+    }
+    const BatchVec inverse_pivot = SplatBatch(1.0 / static_cast<double>(row[c]));
+    for (int j = 0; j < kVecs; ++j) StoreBatch(target + kBatchLanes * j, sum[j] * inverse_pivot);
+  }
+}
 
 // Forward pass of one supernode: its diagonal block solves its own rows (contiguous in y), then
 // every row below subtracts its block row times them.
@@ -626,121 +723,108 @@ template <typename Value, int kVecs>
 inline void ForwardSupernodeMany(const SupernodeBlock<Value>& s, double* __restrict y) {
   constexpr int kStride = kBatchLanes * kVecs;
   double* __restrict own = y + kStride * static_cast<std::ptrdiff_t>(s.first);
-  const int width = s.width;
-  for (int c = 0; c < width; ++c) {
-    const Value* row = s.values + static_cast<std::ptrdiff_t>(c) * width;
-    BatchVec sum[kVecs];
-    double* target = own + kStride * c;
-    for (int j = 0; j < kVecs; ++j) sum[j] = LoadBatch(target + kBatchLanes * j);
-    for (int k = 0; k < c; ++k) {
-      const BatchVec l = SplatBatch(row[k]);
-      const double* known = own + kStride * k;
-      for (int j = 0; j < kVecs; ++j) sum[j] -= l * LoadBatch(known + kBatchLanes * j);
-    }
-    // One division per column, not one per vector: a vector division takes several times a
-    // multiplication's issue slots, and the narrow supernodes' columns have few rows to amortise
-    // it.
-    const BatchVec inverse_pivot = SplatBatch(1.0 / static_cast<double>(row[c]));
-    for (int j = 0; j < kVecs; ++j) StoreBatch(target + kBatchLanes * j, sum[j] * inverse_pivot);
-  }
-  std::int64_t r = width;
-  if constexpr (kVecs <= kMaxBlockedVecs) {
-    // Two rows at a time: each load of the solved rows serves both (register blocking).
-    for (; r + 2 <= s.num_rows; r += 2) {
-      const Value* row0 = s.values + r * width;
-      const Value* row1 = row0 + width;
-      double* target0 = y + kStride * static_cast<std::ptrdiff_t>(s.rows[r]);
-      double* target1 = y + kStride * static_cast<std::ptrdiff_t>(s.rows[r + 1]);
-      BatchVec sum0[kVecs], sum1[kVecs];
-      for (int j = 0; j < kVecs; ++j) {
-        sum0[j] = LoadBatch(target0 + kBatchLanes * j);
-        sum1[j] = LoadBatch(target1 + kBatchLanes * j);
-      }
-      for (int k = 0; k < width; ++k) {
-        const BatchVec l0 = SplatBatch(row0[k]);
-        const BatchVec l1 = SplatBatch(row1[k]);
-        const double* known = own + kStride * k;
-        for (int j = 0; j < kVecs; ++j) {
-          const BatchVec v = LoadBatch(known + kBatchLanes * j);
-          sum0[j] -= l0 * v;
-          sum1[j] -= l1 * v;
-        }
-      }
-      for (int j = 0; j < kVecs; ++j) {
-        StoreBatch(target0 + kBatchLanes * j, sum0[j]);
-        StoreBatch(target1 + kBatchLanes * j, sum1[j]);
-      }
-    }
-  }
-  for (; r < s.num_rows; ++r) {
-    const Value* row = s.values + r * width;
-    double* target = y + kStride * static_cast<std::ptrdiff_t>(s.rows[r]);
-    BatchVec sum[kVecs];
-    for (int j = 0; j < kVecs; ++j) sum[j] = LoadBatch(target + kBatchLanes * j);
-    for (int k = 0; k < width; ++k) {
-      const BatchVec l = SplatBatch(row[k]);
-      const double* known = own + kStride * k;
-      for (int j = 0; j < kVecs; ++j) sum[j] -= l * LoadBatch(known + kBatchLanes * j);
-    }
-    for (int j = 0; j < kVecs; ++j) StoreBatch(target + kBatchLanes * j, sum[j]);
-  }
+  ForwardDiagonalMany<Value, kVecs, BlockFor(kVecs)>(s, own);
+  ForwardRowsMany<Value, kVecs, BlockFor(kVecs)>(s, own, y, s.width);
 }
 
-// Backward pass of one supernode: its own rows subtract the block's rows below times the solved
-// rows there (column by column of the block, the sums kept in registers), then the transposed
-// diagonal block solves them, last row first.
-template <typename Value, int kVecs>
-inline void BackwardSupernodeMany(const SupernodeBlock<Value>& s, double* __restrict y) {
+// Columns [k, width) of the block: own[c] -= sum over the rows below the diagonal of
+// (block column c) * (their solved rows), kColumns columns at a time while they last, then in
+// halving blocks. Where the columns' sums are fewer than eight vectors (narrow supernodes, small
+// batches), the rows alternate between kSplits sets of sums, so that consecutive rows do not wait
+// on each other's multiply-adds.
+template <typename Value, int kVecs, int kColumns>
+inline void BackwardColumnsMany(const SupernodeBlock<Value>& s, double* __restrict own,
+                                const double* __restrict y, int k) {
   constexpr int kStride = kBatchLanes * kVecs;
-  double* __restrict own = y + kStride * static_cast<std::ptrdiff_t>(s.first);
+  constexpr int kSplits = kColumns * kVecs >= 8 ? 1 : kColumns * kVecs >= 4 ? 2 : 4;
   const int width = s.width;
-  int k = 0;
-  if constexpr (kVecs <= kMaxBlockedVecs) {
-    // Two columns of the block at a time: each load of a solved row serves both.
-    for (; k + 2 <= width; k += 2) {
-      BatchVec sum0[kVecs], sum1[kVecs];
-      for (int j = 0; j < kVecs; ++j) sum0[j] = sum1[j] = SplatBatch(0);
-      for (std::int64_t r = width; r < s.num_rows; ++r) {
-        const BatchVec l0 = SplatBatch(s.values[r * width + k]);
-        const BatchVec l1 = SplatBatch(s.values[r * width + k + 1]);
-        const double* solved = y + kStride * static_cast<std::ptrdiff_t>(s.rows[r]);
-        for (int j = 0; j < kVecs; ++j) {
-          const BatchVec v = LoadBatch(solved + kBatchLanes * j);
-          sum0[j] += l0 * v;
-          sum1[j] += l1 * v;
-        }
+  for (; k + kColumns <= width; k += kColumns) {
+    BatchVec sum[kSplits][kColumns][kVecs];
+    for (int u = 0; u < kSplits; ++u) {
+      for (int c = 0; c < kColumns; ++c) {
+        for (int j = 0; j < kVecs; ++j) sum[u][c][j] = SplatBatch(0);
       }
-      double* target0 = own + kStride * k;
-      double* target1 = target0 + kStride;
+    }
+    std::int64_t r = width;
+    const auto add_row = [&](std::int64_t row_index, BatchVec(&into)[kColumns][kVecs]) {
+      const Value* row = s.values + row_index * width + k;
+      const double* solved = y + kStride * static_cast<std::ptrdiff_t>(s.rows[row_index]);
+      BatchVec v[kVecs];
+      for (int j = 0; j < kVecs; ++j) v[j] = LoadBatch(solved + kBatchLanes * j);
+      for (int c = 0; c < kColumns; ++c) {
+        const BatchVec l = SplatBatch(row[c]);
+        for (int j = 0; j < kVecs; ++j) into[c][j] += l * v[j];
+      }
+    };
+    for (; r + kSplits <= s.num_rows; r += kSplits) {
+      for (int u = 0; u < kSplits; ++u) add_row(r + u, sum[u]);
+    }
+    for (; r < s.num_rows; ++r) add_row(r, sum[0]);
+    for (int u = 1; u < kSplits; ++u) {
+      for (int c = 0; c < kColumns; ++c) {
+        for (int j = 0; j < kVecs; ++j) sum[0][c][j] += sum[u][c][j];
+      }
+    }
+    for (int c = 0; c < kColumns; ++c) {
+      double* target = own + kStride * (k + c);
       for (int j = 0; j < kVecs; ++j) {
-        StoreBatch(target0 + kBatchLanes * j, LoadBatch(target0 + kBatchLanes * j) - sum0[j]);
-        StoreBatch(target1 + kBatchLanes * j, LoadBatch(target1 + kBatchLanes * j) - sum1[j]);
+        StoreBatch(target + kBatchLanes * j, LoadBatch(target + kBatchLanes * j) - sum[0][c][j]);
       }
     }
   }
-  for (; k < width; ++k) {
-    BatchVec sum[kVecs];
-    for (int j = 0; j < kVecs; ++j) sum[j] = SplatBatch(0);
-    for (std::int64_t r = width; r < s.num_rows; ++r) {
-      const BatchVec l = SplatBatch(s.values[r * width + k]);
-      const double* solved = y + kStride * static_cast<std::ptrdiff_t>(s.rows[r]);
-      for (int j = 0; j < kVecs; ++j) sum[j] += l * LoadBatch(solved + kBatchLanes * j);
+  if constexpr (kColumns > 1) BackwardColumnsMany<Value, kVecs, kColumns / 2>(s, own, y, k);
+}
+
+// Back substitution with the transposed diagonal block on the supernode's own rows, the last
+// first: kTile rows at a time, each tile solving its small triangle in registers and then
+// subtracting its solved rows from every row above it in one load and store per row; the first
+// rows one at a time.
+template <typename Value, int kVecs, int kTile>
+inline void BackwardDiagonalMany(const SupernodeBlock<Value>& s, double* __restrict own) {
+  constexpr int kStride = kBatchLanes * kVecs;
+  const int width = s.width;
+  int c = width;  // rows [0, c) are still to solve
+  for (; c >= kTile; c -= kTile) {
+    const int f = c - kTile;
+    const Value* tile_rows = s.values + static_cast<std::ptrdiff_t>(f) * width;
+    double* const tile = own + kStride * f;
+    BatchVec solved[kTile][kVecs];
+    for (int i = kTile - 1; i >= 0; --i) {
+      const Value* row = tile_rows + i * width;
+      double* const target = tile + kStride * i;
+      for (int j = 0; j < kVecs; ++j) solved[i][j] = LoadBatch(target + kBatchLanes * j);
+      for (int m = kTile - 1; m > i; --m) {
+        const BatchVec l = SplatBatch(tile_rows[m * width + f + i]);
+        for (int j = 0; j < kVecs; ++j) solved[i][j] -= l * solved[m][j];
+      }
+      const BatchVec inverse_pivot = SplatBatch(1.0 / static_cast<double>(row[f + i]));
+      for (int j = 0; j < kVecs; ++j) {
+        solved[i][j] = solved[i][j] * inverse_pivot;
+        StoreBatch(target + kBatchLanes * j, solved[i][j]);
+      }
     }
-    double* target = own + kStride * k;
-    for (int j = 0; j < kVecs; ++j) {
-      StoreBatch(target + kBatchLanes * j, LoadBatch(target + kBatchLanes * j) - sum[j]);
+    for (int k = 0; k < f; ++k) {
+      double* above = own + kStride * k;
+      BatchVec sum[kVecs];
+      for (int j = 0; j < kVecs; ++j) sum[j] = LoadBatch(above + kBatchLanes * j);
+      for (int i = 0; i < kTile; ++i) {
+        const BatchVec l = SplatBatch(tile_rows[i * width + k]);
+        for (int j = 0; j < kVecs; ++j) sum[j] -= l * solved[i][j];
+      }
+      for (int j = 0; j < kVecs; ++j) StoreBatch(above + kBatchLanes * j, sum[j]);
     }
   }
-  for (int c = width - 1; c >= 0; --c) {
-    const Value* row = s.values + static_cast<std::ptrdiff_t>(c) * width;
-    double* target = own + kStride * c;
-    const BatchVec inverse_pivot = SplatBatch(1.0 / static_cast<double>(row[c]));  // (as forward)
+  for (; c > 0; --c) {
+    const int f = c - 1;
+    const Value* row = s.values + static_cast<std::ptrdiff_t>(f) * width;
+    double* target = own + kStride * f;
+    const BatchVec inverse_pivot = SplatBatch(1.0 / static_cast<double>(row[f]));
     BatchVec solved[kVecs];
     for (int j = 0; j < kVecs; ++j) {
       solved[j] = LoadBatch(target + kBatchLanes * j) * inverse_pivot;
       StoreBatch(target + kBatchLanes * j, solved[j]);
     }
-    for (int k = 0; k < c; ++k) {
+    for (int k = 0; k < f; ++k) {
       const BatchVec l = SplatBatch(row[k]);
       double* above = own + kStride * k;
       for (int j = 0; j < kVecs; ++j) {
@@ -748,6 +832,18 @@ inline void BackwardSupernodeMany(const SupernodeBlock<Value>& s, double* __rest
       }
     }
   }
+}
+
+// Backward pass of one supernode: its own rows subtract the block's rows below times the solved
+// rows there (columns of the block taken together, the sums kept in registers), then the
+// transposed diagonal block solves them, last row first.
+template <typename Value, int kVecs>
+inline void BackwardSupernodeMany(const SupernodeBlock<Value>& s, double* __restrict y) {
+  constexpr int kStride = kBatchLanes * kVecs;
+  double* __restrict own = y + kStride * static_cast<std::ptrdiff_t>(s.first);
+  const int width = s.width;
+  BackwardColumnsMany<Value, kVecs, BlockFor(kVecs)>(s, own, y, 0);
+  BackwardDiagonalMany<Value, kVecs, BlockFor(kVecs)>(s, own);
 }
 
 // The batched passes on solution rows of kVecs batch vectors: gather(row, i) fills row i
