@@ -278,7 +278,8 @@ void DeformStreamReactor::HandleStart() {
   solver_.emplace(*model_, entry_->presentation.file_vertex_to_mesh, std::move(*encoder));
   if (entry_->parallel_plan != nullptr) {
     parallel_runner_.emplace(&core_->pool);
-    solver_->EnableParallel(entry_->parallel_plan.get(), &*parallel_runner_);
+    solver_->EnableParallel(entry_->parallel_plan.get(), &*parallel_runner_,
+                            &core_->registry.open_streams());
   }
   spdlog::info("{} opened", log_context_);
 

@@ -35,10 +35,17 @@ FrameSolver::FrameSolver(const DeformationModel& model, const std::vector<int>& 
       bone_transforms_(static_cast<std::size_t>(codec::kFloatsPerBoneTransform) *
                        model.skeleton().num_bones()) {}
 
-void FrameSolver::EnableParallel(const ParallelSolvePlan* plan, ParallelRunner* runner) {
+void FrameSolver::EnableParallel(const ParallelSolvePlan* plan, ParallelRunner* runner,
+                                 const std::atomic<int>* open_streams) {
   parallel_plan_ = plan;
   parallel_runner_ = runner;
+  open_streams_ = open_streams;
   parallel_work_.assign(model_.default_factorization()->factor().WorkSizeParallel(*plan), 0.0);
+}
+
+bool FrameSolver::SplitsALoneFrame() const {
+  return parallel_plan_ != nullptr &&
+         open_streams_->load(std::memory_order_relaxed) < parallel_plan_->parts;
 }
 
 std::size_t FrameSolver::ParallelWorkBytes(const DeformationModel& model,
@@ -97,7 +104,7 @@ void FrameSolver::DeformTogether(const MaterialFactorization& factorization,
                                  FrameSolver* const* solvers, int count,
                                  const BatchScratchPool* scratches, Deformed* deformed) {
   const DeformationModel& model = solvers[0]->model_;
-  if (count == 1 && solvers[0]->parallel_plan_ != nullptr) {
+  if (count == 1 && solvers[0]->SplitsALoneFrame()) {
     FrameSolver& solver = *solvers[0];
     model.DeformParallel(factorization, solver.pose_, &solver.scratch_, *solver.parallel_plan_,
                          solver.parallel_work_.data(), solver.parallel_runner_, &deformed->timings);

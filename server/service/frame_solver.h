@@ -12,6 +12,7 @@
 // or needed. The model must outlive the solver.
 #pragma once
 
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <memory>
@@ -44,9 +45,13 @@ class FrameSolver {
   explicit FrameSolver(const DeformationModel& model);
 
   // Lets a frame solved alone run on several threads: `plan` (of the model's factor analysis) and
-  // `runner` (both must outlive the solver). Allocates the parallel solve's work:
-  // ParallelWorkBytes.
-  void EnableParallel(const ParallelSolvePlan* plan, ParallelRunner* runner);
+  // `runner`, while fewer streams than the plan has parts (one per worker) are open on the
+  // service (`open_streams`, MeshRegistry::open_streams()): with as many streams as workers or
+  // more, the workers have other frames to solve, and a split solve takes about 1.3 times the
+  // workers' time of a whole one. All three must outlive the solver. Allocates the parallel
+  // solve's work: ParallelWorkBytes.
+  void EnableParallel(const ParallelSolvePlan* plan, ParallelRunner* runner,
+                      const std::atomic<int>* open_streams);
   static std::size_t ParallelWorkBytes(const DeformationModel& model,
                                        const ParallelSolvePlan& plan);
 
@@ -84,6 +89,8 @@ class FrameSolver {
   const DeformationModel& model_;
   const std::vector<int>& client_order_;
   void Encode(v1::DeformFrame* frame);
+  // Whether a frame solved alone is split now (EnableParallel).
+  bool SplitsALoneFrame() const;
   // DeformPrepared's work, without its start and end times.
   static void DeformTogether(const MaterialFactorization& factorization,
                              FrameSolver* const* solvers, int count,
@@ -96,6 +103,7 @@ class FrameSolver {
   std::vector<float> bone_transforms_;  // 12 per bone, for predicted frames
   const ParallelSolvePlan* parallel_plan_ = nullptr;
   ParallelRunner* parallel_runner_ = nullptr;
+  const std::atomic<int>* open_streams_ = nullptr;
   std::vector<double> parallel_work_;
 };
 

@@ -259,11 +259,13 @@ Status MeshRegistry::AttachStream(const MeshEntry& entry) {
   MutexLock lock(&mutex_);
   if (entry.unloaded.load()) return NotLoaded(entry.id);
   entry.open_streams.fetch_add(1);
+  open_streams_.fetch_add(1);
   return Status::Ok();
 }
 
 void MeshRegistry::DetachStream(const MeshEntry& entry) {
   MutexLock lock(&mutex_);
+  open_streams_.fetch_sub(1);
   if (entry.open_streams.fetch_sub(1) == 1 && entry.unloaded.load()) {
     memory_retained_ -= entry.memory_bytes;
     ReleaseMemoryLocked(entry);

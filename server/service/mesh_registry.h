@@ -194,6 +194,8 @@ class MeshRegistry {
   int loads_in_progress() const;
   // Meshes registered since the registry was made (unloaded ones included).
   int registrations() const;
+  // Streams attached to any mesh now (every mesh's open_streams together), read without a lock.
+  const std::atomic<int>& open_streams() const { return open_streams_; }
 
  private:
   // Per-tenant counts: slots held by loads in progress, loaded meshes, their memory.
@@ -225,6 +227,7 @@ class MeshRegistry {
   std::size_t memory_streams_ DEFORM_GUARDED_BY(mutex_) = 0;   // held by MemoryHolds
   std::uint64_t next_order_ DEFORM_GUARDED_BY(mutex_) = 1;     // also counts registrations
   std::map<std::string, TenantUsage> tenants_ DEFORM_GUARDED_BY(mutex_);
+  std::atomic<int> open_streams_{0};  // changed under mutex_, read without it
 };
 
 }  // namespace deform::service

@@ -544,8 +544,37 @@ TEST_F(DeformStreamTest, ABatchLimitOfOneSolvesEveryFrameAlone) {
 }
 
 // A lone stream's frames of a mesh with a parallel plan (the threshold lowered to every mesh) are
-// split over the workers (FrameTimings.solve_parts) and are still the core's frames.
+// split over the workers (FrameTimings.solve_parts) while the service has fewer streams open than
+// workers, and are still the core's frames. (Three workers: the fixture's background stream is
+// open too.)
 TEST_F(DeformStreamTest, ALoneStreamsFramesSplitOverTheWorkersEqualTheCoreResult) {
+  service::ServerOptions options = TestServerOptions();
+  options.workers = 3;
+  options.parallel_solve_min_factor_bytes = 0;
+  StartServer(options);
+  constexpr int kVertices = 4000;
+  const std::string mesh_id = LoadPhantom(kVertices);
+  StreamRecorder recorder(/*keep_positions=*/true);
+  auto stream = client_->OpenStream(mesh_id, recorder.Callbacks());
+  std::uint64_t sequence = 0;
+  for (const int degrees : {30, 75, 120}) {
+    ASSERT_TRUE(stream->SendPose(KneePose(++sequence, degrees)));
+    ASSERT_TRUE(recorder.WaitForFrameWithSequence(sequence));
+    const v1::DeformFrame frame = recorder.last_frame();
+    EXPECT_EQ(frame.timings().solve_parts(), 3u);
+    const CoreResult core = CoreDeform(kVertices, "knee:flexion:" + std::to_string(degrees));
+    EXPECT_LE(DistanceFromCore(client::DecodePositions(frame.positions()), core),
+              1e-6 * core.diagonal)
+        << degrees;
+  }
+  stream->Close();
+  EXPECT_TRUE(stream->Wait().ok());
+  ExpectBackgroundStreamAlive();
+}
+
+// With as many streams open as workers (this one and the fixture's background stream on two
+// workers), the cores have other streams' frames to solve: a lone frame is solved whole, not split.
+TEST_F(DeformStreamTest, ALoneFrameIsNotSplitWhileAsManyStreamsAsWorkersAreOpen) {
   service::ServerOptions options = TestServerOptions();
   options.workers = 2;
   options.parallel_solve_min_factor_bytes = 0;
@@ -559,7 +588,7 @@ TEST_F(DeformStreamTest, ALoneStreamsFramesSplitOverTheWorkersEqualTheCoreResult
     ASSERT_TRUE(stream->SendPose(KneePose(++sequence, degrees)));
     ASSERT_TRUE(recorder.WaitForFrameWithSequence(sequence));
     const v1::DeformFrame frame = recorder.last_frame();
-    EXPECT_EQ(frame.timings().solve_parts(), 2u);
+    EXPECT_EQ(frame.timings().solve_parts(), 1u);
     const CoreResult core = CoreDeform(kVertices, "knee:flexion:" + std::to_string(degrees));
     EXPECT_LE(DistanceFromCore(client::DecodePositions(frame.positions()), core),
               1e-6 * core.diagonal)
