@@ -619,7 +619,7 @@ constexpr int BatchVecsFor(int columns) { return (columns + kBatchLanes - 1) / k
 // (forward) or columns of the block (backward) at once, so that each load of a solution row
 // serves all of them and their BlockFor(kVecs) * kVecs independent multiply-add chains hide the
 // multiply-add's latency; the diagonal blocks are solved in tiles of as many rows. BlockFor is the
-// largest power of two up to eight whose accumulators (at most sixteen vectors), one loaded row
+// largest power of two up to eight whose accumulators (at most sixteen vectors), one loaded vector
 // and two broadcasts fit the registers: thirty-two with AVX-512, sixteen elsewhere.
 #if defined(__AVX512F__)
 constexpr int kBatchRegisters = 32;
@@ -628,7 +628,7 @@ constexpr int kBatchRegisters = 16;
 #endif
 constexpr int BlockFor(int vecs) {
   int block = 8;
-  while (block > 1 && (block * vecs > 16 || block * vecs + vecs + 2 > kBatchRegisters)) block /= 2;
+  while (block > 1 && (block * vecs > 16 || block * vecs + 3 > kBatchRegisters)) block /= 2;
   return block;
 }
 
