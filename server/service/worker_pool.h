@@ -66,9 +66,9 @@ class WorkerPool {
   static constexpr int kMaxBatch = 16;
   // Smallest share of a batch handed to a worker of its own: the queued tasks of one key are
   // spread over the idle workers only while each still gets this many. A batched solve costs per
-  // frame about 0.77 of a lone frame's at 2 frames and 0.52 at 4 (deform_bench's BatchedSolve on
-  // the legs), so splitting fewer than 2 x 4 frames puts frames on a worker at nearly their lone
-  // cost, which a busy server pays for in frames it cannot deliver.
+  // frame about 0.6 of a lone frame's at 2 frames and 0.45 at 4 (deform_bench's BatchedSolve on
+  // the legs), so splitting fewer than 2 x 4 frames puts frames on a worker at well above their
+  // batched cost, which a busy server pays for in frames it cannot deliver.
   static constexpr int kMinBatchShare = 4;
   // How many of `queued` tasks of one key (the head included) the worker taking the head runs as
   // its batch when `idle_workers` others are idle: its even share over as many workers as can each
