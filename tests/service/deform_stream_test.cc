@@ -543,60 +543,47 @@ TEST_F(DeformStreamTest, ABatchLimitOfOneSolvesEveryFrameAlone) {
   for (auto& stream : streams) EXPECT_TRUE(stream->Wait().ok());
 }
 
-// A lone stream's frames of a mesh with a parallel plan (the threshold lowered to every mesh) are
-// split over the workers (FrameTimings.solve_parts) while the service has fewer streams open than
-// workers, and are still the core's frames. (Three workers: the fixture's background stream is
-// open too.)
-TEST_F(DeformStreamTest, ALoneStreamsFramesSplitOverTheWorkersEqualTheCoreResult) {
-  service::ServerOptions options = TestServerOptions();
-  options.workers = 3;
-  options.parallel_solve_min_factor_bytes = 0;
-  StartServer(options);
-  constexpr int kVertices = 4000;
-  const std::string mesh_id = LoadPhantom(kVertices);
-  StreamRecorder recorder(/*keep_positions=*/true);
-  auto stream = client_->OpenStream(mesh_id, recorder.Callbacks());
-  std::uint64_t sequence = 0;
-  for (const int degrees : {30, 75, 120}) {
-    ASSERT_TRUE(stream->SendPose(KneePose(++sequence, degrees)));
-    ASSERT_TRUE(recorder.WaitForFrameWithSequence(sequence));
-    const v1::DeformFrame frame = recorder.last_frame();
-    EXPECT_EQ(frame.timings().solve_parts(), 3u);
-    const CoreResult core = CoreDeform(kVertices, "knee:flexion:" + std::to_string(degrees));
-    EXPECT_LE(DistanceFromCore(client::DecodePositions(frame.positions()), core),
-              1e-6 * core.diagonal)
-        << degrees;
+// A lone stream on a server with `workers` workers and a parallel plan for every mesh (the
+// threshold lowered to zero): three poses' frames are solved in `parts` parts
+// (FrameTimings.solve_parts) and are the core's frames. The fixture's background stream is open
+// too, so the service has two streams open.
+class LoneFrameSplitTest : public DeformStreamTest {
+ protected:
+  void ExpectThreeFramesSolvedIn(int workers, unsigned parts) {
+    service::ServerOptions options = TestServerOptions();
+    options.workers = workers;
+    options.parallel_solve_min_factor_bytes = 0;
+    StartServer(options);
+    constexpr int kVertices = 4000;
+    const std::string mesh_id = LoadPhantom(kVertices);
+    StreamRecorder recorder(/*keep_positions=*/true);
+    auto stream = client_->OpenStream(mesh_id, recorder.Callbacks());
+    std::uint64_t sequence = 0;
+    for (const int degrees : {30, 75, 120}) {
+      ASSERT_TRUE(stream->SendPose(KneePose(++sequence, degrees)));
+      ASSERT_TRUE(recorder.WaitForFrameWithSequence(sequence));
+      const v1::DeformFrame frame = recorder.last_frame();
+      EXPECT_EQ(frame.timings().solve_parts(), parts);
+      const CoreResult core = CoreDeform(kVertices, "knee:flexion:" + std::to_string(degrees));
+      EXPECT_LE(DistanceFromCore(client::DecodePositions(frame.positions()), core),
+                1e-6 * core.diagonal)
+          << degrees;
+    }
+    stream->Close();
+    EXPECT_TRUE(stream->Wait().ok());
+    ExpectBackgroundStreamAlive();
   }
-  stream->Close();
-  EXPECT_TRUE(stream->Wait().ok());
-  ExpectBackgroundStreamAlive();
+};
+
+// Fewer streams open than workers (two of three): a lone frame is split over the workers.
+TEST_F(LoneFrameSplitTest, FramesSplitOverTheWorkersWhileFewerStreamsThanWorkersAreOpen) {
+  ExpectThreeFramesSolvedIn(/*workers=*/3, /*parts=*/3);
 }
 
-// With as many streams open as workers (this one and the fixture's background stream on two
-// workers), the cores have other streams' frames to solve: a lone frame is solved whole, not split.
-TEST_F(DeformStreamTest, ALoneFrameIsNotSplitWhileAsManyStreamsAsWorkersAreOpen) {
-  service::ServerOptions options = TestServerOptions();
-  options.workers = 2;
-  options.parallel_solve_min_factor_bytes = 0;
-  StartServer(options);
-  constexpr int kVertices = 4000;
-  const std::string mesh_id = LoadPhantom(kVertices);
-  StreamRecorder recorder(/*keep_positions=*/true);
-  auto stream = client_->OpenStream(mesh_id, recorder.Callbacks());
-  std::uint64_t sequence = 0;
-  for (const int degrees : {30, 75, 120}) {
-    ASSERT_TRUE(stream->SendPose(KneePose(++sequence, degrees)));
-    ASSERT_TRUE(recorder.WaitForFrameWithSequence(sequence));
-    const v1::DeformFrame frame = recorder.last_frame();
-    EXPECT_EQ(frame.timings().solve_parts(), 1u);
-    const CoreResult core = CoreDeform(kVertices, "knee:flexion:" + std::to_string(degrees));
-    EXPECT_LE(DistanceFromCore(client::DecodePositions(frame.positions()), core),
-              1e-6 * core.diagonal)
-        << degrees;
-  }
-  stream->Close();
-  EXPECT_TRUE(stream->Wait().ok());
-  ExpectBackgroundStreamAlive();
+// As many streams open as workers (two of two): the cores have other streams' frames to solve, so
+// a lone frame is solved whole.
+TEST_F(LoneFrameSplitTest, FramesAreSolvedWholeWhileAsManyStreamsAsWorkersAreOpen) {
+  ExpectThreeFramesSolvedIn(/*workers=*/2, /*parts=*/1);
 }
 
 // With the float32 threshold lowered to every mesh, the phantom's factor is stored in float32 (the

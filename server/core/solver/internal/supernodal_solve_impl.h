@@ -632,6 +632,23 @@ constexpr int BlockFor(int vecs) {
   return block;
 }
 
+// sum[i] -= (row i of `rows`, its first `count` values) * (the solved rows own[0, count)), for
+// kRows rows of a supernode's block (`width` values each) whose sums are held in registers.
+template <typename Value, int kVecs, int kRows>
+inline void SubtractSolvedColumns(const Value* __restrict rows, int width, int count,
+                                  const double* __restrict own, BatchVec (&sum)[kRows][kVecs]) {
+  constexpr int kStride = kBatchLanes * kVecs;
+  for (int k = 0; k < count; ++k) {
+    const double* known = own + kStride * k;
+    BatchVec v[kVecs];
+    for (int j = 0; j < kVecs; ++j) v[j] = LoadBatch(known + kBatchLanes * j);
+    for (int i = 0; i < kRows; ++i) {
+      const BatchVec l = SplatBatch(rows[i * width + k]);
+      for (int j = 0; j < kVecs; ++j) sum[i][j] -= l * v[j];
+    }
+  }
+}
+
 // Rows [r, num_rows) of the block below the diagonal, kRows at a time while they last, then in
 // halving blocks: y[rows[i]] -= (block row i) * (the supernode's solved rows `own`).
 template <typename Value, int kVecs, int kRows>
@@ -647,15 +664,7 @@ inline void ForwardRowsMany(const SupernodeBlock<Value>& s, const double* __rest
       target[i] = y + kStride * static_cast<std::ptrdiff_t>(s.rows[r + i]);
       for (int j = 0; j < kVecs; ++j) sum[i][j] = LoadBatch(target[i] + kBatchLanes * j);
     }
-    for (int k = 0; k < width; ++k) {
-      const double* known = own + kStride * k;
-      BatchVec v[kVecs];
-      for (int j = 0; j < kVecs; ++j) v[j] = LoadBatch(known + kBatchLanes * j);
-      for (int i = 0; i < kRows; ++i) {
-        const BatchVec l = SplatBatch(block_rows[i * width + k]);
-        for (int j = 0; j < kVecs; ++j) sum[i][j] -= l * v[j];
-      }
-    }
+    SubtractSolvedColumns<Value, kVecs, kRows>(block_rows, width, width, own, sum);
     for (int i = 0; i < kRows; ++i) {
       for (int j = 0; j < kVecs; ++j) StoreBatch(target[i] + kBatchLanes * j, sum[i][j]);
     }
@@ -680,15 +689,7 @@ inline void ForwardDiagonalMany(const SupernodeBlock<Value>& s, double* __restri
     for (int i = 0; i < kTile; ++i) {
       for (int j = 0; j < kVecs; ++j) sum[i][j] = LoadBatch(tile + kStride * i + kBatchLanes * j);
     }
-    for (int k = 0; k < c; ++k) {
-      const double* known = own + kStride * k;
-      BatchVec v[kVecs];
-      for (int j = 0; j < kVecs; ++j) v[j] = LoadBatch(known + kBatchLanes * j);
-      for (int i = 0; i < kTile; ++i) {
-        const BatchVec l = SplatBatch(tile_rows[i * width + k]);
-        for (int j = 0; j < kVecs; ++j) sum[i][j] -= l * v[j];
-      }
-    }
+    SubtractSolvedColumns<Value, kVecs, kTile>(tile_rows, width, c, own, sum);
     for (int i = 0; i < kTile; ++i) {
       const Value* row = tile_rows + i * width;
       for (int m = 0; m < i; ++m) {
@@ -841,7 +842,6 @@ template <typename Value, int kVecs>
 inline void BackwardSupernodeMany(const SupernodeBlock<Value>& s, double* __restrict y) {
   constexpr int kStride = kBatchLanes * kVecs;
   double* __restrict own = y + kStride * static_cast<std::ptrdiff_t>(s.first);
-  const int width = s.width;
   BackwardColumnsMany<Value, kVecs, BlockFor(kVecs)>(s, own, y, 0);
   BackwardDiagonalMany<Value, kVecs, BlockFor(kVecs)>(s, own);
 }
