@@ -196,7 +196,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 16));
   app.add_option("--parallel-solve-min-mb", args.parallel_solve_min_mb,
                  "A lone stream's frames of a mesh whose factor holds this many MiB or more are "
-                 "split over the idle workers")
+                 "split over the idle workers while fewer streams than workers are open")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1e9));
   app.add_option("--float32-factor-min-mb", args.float32_factor_min_mb,
