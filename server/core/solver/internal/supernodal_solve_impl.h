@@ -672,16 +672,15 @@ inline void ForwardRowsMany(const SupernodeBlock<Value>& s, const double* __rest
   if constexpr (kRows > 1) ForwardRowsMany<Value, kVecs, kRows / 2>(s, own, y, r);
 }
 
-// Forward substitution with the diagonal block on the supernode's own rows: kTile rows at a
-// time, each tile first subtracting the columns already solved (register-blocked as the rows
-// below), then solving its own small triangle in registers; the last rows one at a time. One
-// division per row, not one per vector: a vector division takes several times a multiplication's
-// issue slots.
+// Forward substitution with the diagonal block on the supernode's own rows from `c` on: kTile
+// rows at a time while they last, then in halving tiles, each tile first subtracting the columns
+// already solved (register-blocked as the rows below), then solving its own small triangle in
+// registers. One division per row, not one per vector: a vector division takes several times a
+// multiplication's issue slots.
 template <typename Value, int kVecs, int kTile>
-inline void ForwardDiagonalMany(const SupernodeBlock<Value>& s, double* __restrict own) {
+inline void ForwardDiagonalMany(const SupernodeBlock<Value>& s, double* __restrict own, int c) {
   constexpr int kStride = kBatchLanes * kVecs;
   const int width = s.width;
-  int c = 0;
   for (; c + kTile <= width; c += kTile) {
     const Value* tile_rows = s.values + static_cast<std::ptrdiff_t>(c) * width;
     double* const tile = own + kStride * c;
@@ -703,19 +702,7 @@ inline void ForwardDiagonalMany(const SupernodeBlock<Value>& s, double* __restri
       }
     }
   }
-  for (; c < width; ++c) {
-    const Value* row = s.values + static_cast<std::ptrdiff_t>(c) * width;
-    BatchVec sum[kVecs];
-    double* target = own + kStride * c;
-    for (int j = 0; j < kVecs; ++j) sum[j] = LoadBatch(target + kBatchLanes * j);
-    for (int k = 0; k < c; ++k) {
-      const BatchVec l = SplatBatch(row[k]);
-      const double* known = own + kStride * k;
-      for (int j = 0; j < kVecs; ++j) sum[j] -= l * LoadBatch(known + kBatchLanes * j);
-    }
-    const BatchVec inverse_pivot = SplatBatch(1.0 / static_cast<double>(row[c]));
-    for (int j = 0; j < kVecs; ++j) StoreBatch(target + kBatchLanes * j, sum[j] * inverse_pivot);
-  }
+  if constexpr (kTile > 1) ForwardDiagonalMany<Value, kVecs, kTile / 2>(s, own, c);
 }
 
 // Forward pass of one supernode: its diagonal block solves its own rows (contiguous in y), then
@@ -724,7 +711,7 @@ template <typename Value, int kVecs>
 inline void ForwardSupernodeMany(const SupernodeBlock<Value>& s, double* __restrict y) {
   constexpr int kStride = kBatchLanes * kVecs;
   double* __restrict own = y + kStride * static_cast<std::ptrdiff_t>(s.first);
-  ForwardDiagonalMany<Value, kVecs, BlockFor(kVecs)>(s, own);
+  ForwardDiagonalMany<Value, kVecs, BlockFor(kVecs)>(s, own, 0);
   ForwardRowsMany<Value, kVecs, BlockFor(kVecs)>(s, own, y, s.width);
 }
 
@@ -776,15 +763,14 @@ inline void BackwardColumnsMany(const SupernodeBlock<Value>& s, double* __restri
   if constexpr (kColumns > 1) BackwardColumnsMany<Value, kVecs, kColumns / 2>(s, own, y, k);
 }
 
-// Back substitution with the transposed diagonal block on the supernode's own rows, the last
-// first: kTile rows at a time, each tile solving its small triangle in registers and then
-// subtracting its solved rows from every row above it in one load and store per row; the first
-// rows one at a time.
+// Back substitution with the transposed diagonal block on the supernode's rows [0, c), the last
+// first: kTile rows at a time while they last, then in halving tiles, each tile solving its small
+// triangle in registers and then subtracting its solved rows from every row above it in one load
+// and store per row.
 template <typename Value, int kVecs, int kTile>
-inline void BackwardDiagonalMany(const SupernodeBlock<Value>& s, double* __restrict own) {
+inline void BackwardDiagonalMany(const SupernodeBlock<Value>& s, double* __restrict own, int c) {
   constexpr int kStride = kBatchLanes * kVecs;
   const int width = s.width;
-  int c = width;  // rows [0, c) are still to solve
   for (; c >= kTile; c -= kTile) {
     const int f = c - kTile;
     const Value* tile_rows = s.values + static_cast<std::ptrdiff_t>(f) * width;
@@ -815,24 +801,7 @@ inline void BackwardDiagonalMany(const SupernodeBlock<Value>& s, double* __restr
       for (int j = 0; j < kVecs; ++j) StoreBatch(above + kBatchLanes * j, sum[j]);
     }
   }
-  for (; c > 0; --c) {
-    const int f = c - 1;
-    const Value* row = s.values + static_cast<std::ptrdiff_t>(f) * width;
-    double* target = own + kStride * f;
-    const BatchVec inverse_pivot = SplatBatch(1.0 / static_cast<double>(row[f]));
-    BatchVec solved[kVecs];
-    for (int j = 0; j < kVecs; ++j) {
-      solved[j] = LoadBatch(target + kBatchLanes * j) * inverse_pivot;
-      StoreBatch(target + kBatchLanes * j, solved[j]);
-    }
-    for (int k = 0; k < f; ++k) {
-      const BatchVec l = SplatBatch(row[k]);
-      double* above = own + kStride * k;
-      for (int j = 0; j < kVecs; ++j) {
-        StoreBatch(above + kBatchLanes * j, LoadBatch(above + kBatchLanes * j) - l * solved[j]);
-      }
-    }
-  }
+  if constexpr (kTile > 1) BackwardDiagonalMany<Value, kVecs, kTile / 2>(s, own, c);
 }
 
 // Backward pass of one supernode: its own rows subtract the block's rows below times the solved
@@ -843,7 +812,7 @@ inline void BackwardSupernodeMany(const SupernodeBlock<Value>& s, double* __rest
   constexpr int kStride = kBatchLanes * kVecs;
   double* __restrict own = y + kStride * static_cast<std::ptrdiff_t>(s.first);
   BackwardColumnsMany<Value, kVecs, BlockFor(kVecs)>(s, own, y, 0);
-  BackwardDiagonalMany<Value, kVecs, BlockFor(kVecs)>(s, own);
+  BackwardDiagonalMany<Value, kVecs, BlockFor(kVecs)>(s, own, s.width);
 }
 
 // The batched passes on solution rows of kVecs batch vectors: gather(row, i) fills row i
