@@ -245,6 +245,85 @@ inline void SubtractRow1x3(const Value* __restrict row, const double* __restrict
   }
 }
 
+// The factor's values are read as one stream: ascending in the forward pass, supernode after
+// supernode, and descending supernode by supernode in the backward pass. Each pass asks for the
+// bytes it will read kPrefetchBytes later (ahead in the forward pass, below in the backward pass)
+// as it reads the ones in hand, so that a factor larger than the cache arrives while the kernel
+// computes instead of after it: without it the 133k arm's solve took about the sum of its
+// arithmetic (factor made cache-resident) and of reading its factor from memory, not the larger
+// of the two. Into the outer caches (prefetcht2): a non-temporal hint was twice as slow. The
+// distance and the hint were chosen by measurement (deform_bench's TriangularSolve and
+// BatchedSolve on the arm; 8 to 64 KB measured alike).
+constexpr std::ptrdiff_t kPrefetchBytes = 16384;
+// A factor small enough to stay in a core's cache between solves (the 1.6k leg's 0.8 MB) is not
+// prefetched: there the prefetches only cost issue slots (5-10% of its solve, measured).
+constexpr std::int64_t kPrefetchMinFactorBytes = std::int64_t{4} << 20;
+
+template <typename Value>
+inline bool StreamsFromMemory(const SupernodalFactorView& f) {
+  return f.value_pointers[f.num_supernodes] * static_cast<std::int64_t>(sizeof(Value)) >
+         kPrefetchMinFactorBytes;
+}
+
+// Supernode sn's block of the factor (see SupernodalFactorView).
+template <typename Value>
+struct SupernodeBlock {
+  int first;              // its first column
+  int width;              // its number of columns
+  const int* rows;        // its row indices
+  std::int64_t num_rows;  // their number
+  const Value* values;    // its dense row-major (num_rows) x (width) block
+  bool prefetch;          // the factor is streamed from memory (StreamsFromMemory)
+};
+
+// The factor's values as stored: double, or float32 (widened to double as they are read).
+template <typename Value>
+inline const Value* ValuesOf(const SupernodalFactorView& f);
+template <>
+inline const double* ValuesOf<double>(const SupernodalFactorView& f) {
+  return f.values;
+}
+template <>
+inline const float* ValuesOf<float>(const SupernodalFactorView& f) {
+  return f.float_values;
+}
+
+template <typename Value>
+inline SupernodeBlock<Value> BlockOf(const SupernodalFactorView& f, int sn) {
+  const int first = f.supernode_columns[sn];
+  return SupernodeBlock<Value>{first,
+                               f.supernode_columns[sn + 1] - first,
+                               f.row_indices + f.row_pointers[sn],
+                               f.row_pointers[sn + 1] - f.row_pointers[sn],
+                               ValuesOf<Value>(f) + f.value_pointers[sn],
+                               StreamsFromMemory<Value>(f)};
+}
+
+// Asks for the cache line at `address` into the outer caches (prefetcht2). Inline assembly on
+// x86: GCC 12 drops a loop of __builtin_prefetch behind a condition as if it did nothing.
+inline void PrefetchLine(const char* address) {
+#if defined(__x86_64__) || defined(__i386__)
+  asm volatile("prefetcht2 %0" : : "m"(*address));
+#else
+  __builtin_prefetch(address, 0, 1);
+#endif
+}
+
+enum class Pass { kForward, kBackward };
+
+// Asks for the bytes at distance kPrefetchBytes from [values, values + count) of `s`'s block in
+// `pass`'s direction, when its factor streams from memory. A prefetch never faults: addresses
+// beyond the factor's ends are harmless.
+template <Pass kPass, typename Value>
+inline void PrefetchFactor(const SupernodeBlock<Value>& s, const Value* values,
+                           std::ptrdiff_t count) {
+  if (!s.prefetch) return;
+  const char* begin = reinterpret_cast<const char*>(values) +
+                      (kPass == Pass::kForward ? kPrefetchBytes : -kPrefetchBytes);
+  const std::ptrdiff_t bytes = count * static_cast<std::ptrdiff_t>(sizeof(Value));
+  for (std::ptrdiff_t offset = 0; offset < bytes; offset += 64) PrefetchLine(begin + offset);
+}
+
 // The solution rows during the solve (supernodal_solve.h).
 constexpr int kRowStride = kSolveRowStride;
 
@@ -260,18 +339,21 @@ inline const double* Row(const double* y, int row) {
   return y + kRowStride * static_cast<std::ptrdiff_t>(row);
 }
 
-// Forward substitution with a supernode's dense lower-triangular diagonal block (row-major,
-// `width` square): solves for its unknowns, whose right-hand sides are the solution rows from
+// Forward substitution with `supernode`'s dense lower-triangular diagonal block (row-major,
+// width square): solves for its unknowns, whose right-hand sides are the solution rows from
 // `ys` on, writing them back there and planar into `p`.
 template <typename Value>
-inline void ForwardDiagonal(const Value* __restrict block, int width, double* __restrict ys,
+inline void ForwardDiagonal(const SupernodeBlock<Value>& supernode, double* __restrict ys,
                             const Planar& p) {
+  const Value* __restrict block = supernode.values;
+  const int width = supernode.width;
   int c = 0;
   for (; c + 4 <= width; c += 4) {
     const Value* r0 = block + static_cast<std::ptrdiff_t>(c) * width;
     const Value* r1 = r0 + width;
     const Value* r2 = r1 + width;
     const Value* r3 = r2 + width;
+    PrefetchFactor<Pass::kForward>(supernode, r0, 4 * width);
     double s[16];
     Dot4x3(r0, r1, r2, r3, p, c, s);
     const double* t = Row(ys, c);
@@ -293,6 +375,7 @@ inline void ForwardDiagonal(const Value* __restrict block, int width, double* __
   }
   for (; c < width; ++c) {
     const Value* row = block + static_cast<std::ptrdiff_t>(c) * width;
+    PrefetchFactor<Pass::kForward>(supernode, row, width);
     double s[3];
     Dot1x3(row, p, c, s);
     const double* t = Row(ys, c);
@@ -314,8 +397,10 @@ inline void ForwardDiagonal(const Value* __restrict block, int width, double* __
 // are taken four at a time from the bottom: their corner triangle is solved, then they update the
 // rows above together.
 template <typename Value>
-inline void BackwardDiagonal(const Value* __restrict block, int width, double* __restrict ys,
+inline void BackwardDiagonal(const SupernodeBlock<Value>& supernode, double* __restrict ys,
                              const Planar& p) {
+  const Value* __restrict block = supernode.values;
+  const int width = supernode.width;
   int c = width;  // rows [0, c) are still to solve
   for (; c >= 4; c -= 4) {
     const int f = c - 4;
@@ -323,6 +408,7 @@ inline void BackwardDiagonal(const Value* __restrict block, int width, double* _
     const Value* r1 = r0 + width;
     const Value* r2 = r1 + width;
     const Value* r3 = r2 + width;
+    PrefetchFactor<Pass::kBackward>(supernode, r0, 4 * width);
     double* in[3] = {p.x + f, p.y + f, p.z + f};
     double solved[12];  // solved[3 j + d]: unknown f + j, column d
     const double i0 = 1.0 / r0[f], i1 = 1.0 / r1[f + 1], i2 = 1.0 / r2[f + 2], i3 = 1.0 / r3[f + 3];
@@ -348,6 +434,7 @@ inline void BackwardDiagonal(const Value* __restrict block, int width, double* _
   for (; c > 0; --c) {
     const int f = c - 1;
     const Value* row = block + static_cast<std::ptrdiff_t>(f) * width;
+    PrefetchFactor<Pass::kBackward>(supernode, row, width);
     const double inverse = 1.0 / row[f];
     const double solved[3] = {p.x[f] * inverse, p.y[f] * inverse, p.z[f] * inverse};
     double* t = Row(ys, f);
@@ -358,15 +445,20 @@ inline void BackwardDiagonal(const Value* __restrict block, int width, double* _
   }
 }
 
-// y[rows[r]] -= (block row r) . p for the rows below the diagonal block (r >= width).
+// y[rows[r]] -= (block row r) . p for `supernode`'s rows below its diagonal block (r >= width).
 template <typename Value>
-inline void ForwardUpdate(const Value* __restrict block, const int* __restrict rows, int width,
-                          std::int64_t num_rows, const Planar& p, double* __restrict y) {
+inline void ForwardUpdate(const SupernodeBlock<Value>& supernode, const Planar& p,
+                          double* __restrict y) {
+  const Value* __restrict block = supernode.values;
+  const int* __restrict rows = supernode.rows;
+  const int width = supernode.width;
+  const std::int64_t num_rows = supernode.num_rows;
   ZeroPadding(p, width);
   const int padded = RoundUp4(width);
   std::int64_t r = width;
   for (; r + 4 <= num_rows; r += 4) {
     const Value* r0 = block + r * width;
+    PrefetchFactor<Pass::kForward>(supernode, r0, 4 * width);
     double s[16];
     Dot4x3(r0, r0 + width, r0 + 2 * width, r0 + 3 * width, p, padded, s);
     for (int j = 0; j < 4; ++j) {
@@ -375,6 +467,7 @@ inline void ForwardUpdate(const Value* __restrict block, const int* __restrict r
     }
   }
   for (; r < num_rows; ++r) {
+    PrefetchFactor<Pass::kForward>(supernode, block + r * width, width);
     double s[3];
     Dot1x3(block + r * width, p, padded, s);
     double* t = Row(y, rows[r]);
@@ -384,15 +477,20 @@ inline void ForwardUpdate(const Value* __restrict block, const int* __restrict r
   }
 }
 
-// p -= sum over the rows below the diagonal block of (block row r) * y[rows[r]].
+// p -= sum over `supernode`'s rows below its diagonal block of (block row r) * y[rows[r]].
 template <typename Value>
-inline void BackwardUpdate(const Value* __restrict block, const int* __restrict rows, int width,
-                           std::int64_t num_rows, const Planar& p, double* __restrict y) {
+inline void BackwardUpdate(const SupernodeBlock<Value>& supernode, const Planar& p,
+                           double* __restrict y) {
+  const Value* __restrict block = supernode.values;
+  const int* __restrict rows = supernode.rows;
+  const int width = supernode.width;
+  const std::int64_t num_rows = supernode.num_rows;
   ZeroPadding(p, width);  // not read back, but kept finite
   const int padded = RoundUp4(width);
   std::int64_t r = width;
   for (; r + 4 <= num_rows; r += 4) {
     const Value* r0 = block + r * width;
+    PrefetchFactor<Pass::kBackward>(supernode, r0, 4 * width);
     double q[12];
     for (int j = 0; j < 4; ++j) {
       const double* source = Row(y, rows[r + j]);
@@ -403,6 +501,7 @@ inline void BackwardUpdate(const Value* __restrict block, const int* __restrict 
     SubtractRows4x3(r0, r0 + width, r0 + 2 * width, r0 + 3 * width, q, p, padded);
   }
   for (; r < num_rows; ++r) {
+    PrefetchFactor<Pass::kBackward>(supernode, block + r * width, width);
     SubtractRow1x3(block + r * width, Row(y, rows[r]), p, padded);
   }
 }
@@ -454,36 +553,6 @@ inline void BackwardUpdateNarrow(const Value* __restrict block, const int* __res
   }
 }
 
-// Supernode sn's block of the factor (see SupernodalFactorView).
-template <typename Value>
-struct SupernodeBlock {
-  int first;              // its first column
-  int width;              // its number of columns
-  const int* rows;        // its row indices
-  std::int64_t num_rows;  // their number
-  const Value* values;    // its dense row-major (num_rows) x (width) block
-};
-
-// The factor's values as stored: double, or float32 (widened to double as they are read).
-template <typename Value>
-inline const Value* ValuesOf(const SupernodalFactorView& f);
-template <>
-inline const double* ValuesOf<double>(const SupernodalFactorView& f) {
-  return f.values;
-}
-template <>
-inline const float* ValuesOf<float>(const SupernodalFactorView& f) {
-  return f.float_values;
-}
-
-template <typename Value>
-inline SupernodeBlock<Value> BlockOf(const SupernodalFactorView& f, int sn) {
-  const int first = f.supernode_columns[sn];
-  return SupernodeBlock<Value>{
-      first, f.supernode_columns[sn + 1] - first, f.row_indices + f.row_pointers[sn],
-      f.row_pointers[sn + 1] - f.row_pointers[sn], ValuesOf<Value>(f) + f.value_pointers[sn]};
-}
-
 // Runs `pass` with the factor's value type: pass(double()) or pass(float()).
 template <typename Pass>
 inline void WithValueType(const SupernodalFactorView& f, Pass&& pass) {
@@ -501,10 +570,12 @@ inline void ForwardSupernode(const SupernodalFactorView& f, int sn, double* __re
                              double* planar_buffer) {
   const SupernodeBlock<Value> s = BlockOf<Value>(f, sn);
   const Planar p = PlanarOf(planar_buffer, s.width);
-  ForwardDiagonal(s.values, s.width, Row(y, s.first), p);
+  ForwardDiagonal(s, Row(y, s.first), p);
   if (s.width > 4) {
-    ForwardUpdate(s.values, s.rows, s.width, s.num_rows, p, y);
+    ForwardUpdate(s, p, y);
   } else {
+    PrefetchFactor<Pass::kForward>(s, s.values + s.width * s.width,
+                                   (s.num_rows - s.width) * s.width);
     WithCount<4>(s.width, [&](auto w) {
       ForwardUpdateNarrow<Value, decltype(w)::value>(s.values, s.rows, s.num_rows, p, y);
     });
@@ -526,13 +597,15 @@ inline void BackwardSupernode(const SupernodalFactorView& f, int sn, double* __r
     p.z[k] = t[2];
   }
   if (s.width > 4) {
-    BackwardUpdate(s.values, s.rows, s.width, s.num_rows, p, y);
+    BackwardUpdate(s, p, y);
   } else {
+    PrefetchFactor<Pass::kBackward>(s, s.values + s.width * s.width,
+                                    (s.num_rows - s.width) * s.width);
     WithCount<4>(s.width, [&](auto w) {
       BackwardUpdateNarrow<Value, decltype(w)::value>(s.values, s.rows, s.num_rows, p, y);
     });
   }
-  BackwardDiagonal(s.values, s.width, ys, p);
+  BackwardDiagonal(s, ys, p);
 }
 
 // The forward pass over the listed supernodes only (ascending), on solution rows `y` (aligned
@@ -658,6 +731,7 @@ inline void ForwardRowsMany(const SupernodeBlock<Value>& s, const double* __rest
   const int width = s.width;
   for (; r + kRows <= s.num_rows; r += kRows) {
     const Value* block_rows = s.values + r * width;
+    PrefetchFactor<Pass::kForward>(s, block_rows, kRows * width);
     double* target[kRows];
     BatchVec sum[kRows][kVecs];
     for (int i = 0; i < kRows; ++i) {
@@ -683,6 +757,7 @@ inline void ForwardDiagonalMany(const SupernodeBlock<Value>& s, double* __restri
   const int width = s.width;
   for (; c + kTile <= width; c += kTile) {
     const Value* tile_rows = s.values + static_cast<std::ptrdiff_t>(c) * width;
+    PrefetchFactor<Pass::kForward>(s, tile_rows, kTile * width);
     double* const tile = own + kStride * c;
     BatchVec sum[kTile][kVecs];
     for (int i = 0; i < kTile; ++i) {
@@ -735,6 +810,8 @@ inline void BackwardColumnsMany(const SupernodeBlock<Value>& s, double* __restri
     }
     std::int64_t r = width;
     const auto add_row = [&](std::int64_t row_index, BatchVec(&into)[kColumns][kVecs]) {
+      // The first strip of columns is the first to touch each row: the block's stream.
+      if (k == 0) PrefetchFactor<Pass::kBackward>(s, s.values + row_index * width, width);
       const Value* row = s.values + row_index * width + k;
       const double* solved = y + kStride * static_cast<std::ptrdiff_t>(s.rows[row_index]);
       BatchVec v[kVecs];
@@ -774,6 +851,7 @@ inline void BackwardDiagonalMany(const SupernodeBlock<Value>& s, double* __restr
   for (; c >= kTile; c -= kTile) {
     const int f = c - kTile;
     const Value* tile_rows = s.values + static_cast<std::ptrdiff_t>(f) * width;
+    PrefetchFactor<Pass::kBackward>(s, tile_rows, kTile * width);
     double* const tile = own + kStride * f;
     BatchVec solved[kTile][kVecs];
     for (int i = kTile - 1; i >= 0; --i) {
