@@ -487,22 +487,23 @@ inline void BackwardUpdate(const SupernodeBlock<Value>& supernode, const Planar&
   const std::int64_t num_rows = supernode.num_rows;
   ZeroPadding(p, width);  // not read back, but kept finite
   const int padded = RoundUp4(width);
-  std::int64_t r = width;
-  for (; r + 4 <= num_rows; r += 4) {
-    const Value* r0 = block + r * width;
+  // The last rows first: the backward pass reads the factor descending (PrefetchFactor).
+  std::int64_t r = num_rows;
+  for (; r - 4 >= width; r -= 4) {
+    const Value* r0 = block + (r - 4) * width;
     PrefetchFactor<Pass::kBackward>(supernode, r0, 4 * width);
     double q[12];
     for (int j = 0; j < 4; ++j) {
-      const double* source = Row(y, rows[r + j]);
+      const double* source = Row(y, rows[r - 4 + j]);
       q[3 * j] = source[0];
       q[3 * j + 1] = source[1];
       q[3 * j + 2] = source[2];
     }
     SubtractRows4x3(r0, r0 + width, r0 + 2 * width, r0 + 3 * width, q, p, padded);
   }
-  for (; r < num_rows; ++r) {
-    PrefetchFactor<Pass::kBackward>(supernode, block + r * width, width);
-    SubtractRow1x3(block + r * width, Row(y, rows[r]), p, padded);
+  for (; r > width; --r) {
+    PrefetchFactor<Pass::kBackward>(supernode, block + (r - 1) * width, width);
+    SubtractRow1x3(block + (r - 1) * width, Row(y, rows[r - 1]), p, padded);
   }
 }
 
@@ -808,7 +809,6 @@ inline void BackwardColumnsMany(const SupernodeBlock<Value>& s, double* __restri
         for (int j = 0; j < kVecs; ++j) sum[u][c][j] = SplatBatch(0);
       }
     }
-    std::int64_t r = width;
     const auto add_row = [&](std::int64_t row_index, BatchVec(&into)[kColumns][kVecs]) {
       // The first strip of columns is the first to touch each row: the block's stream.
       if (k == 0) PrefetchFactor<Pass::kBackward>(s, s.values + row_index * width, width);
@@ -821,10 +821,12 @@ inline void BackwardColumnsMany(const SupernodeBlock<Value>& s, double* __restri
         for (int j = 0; j < kVecs; ++j) into[c][j] += l * v[j];
       }
     };
-    for (; r + kSplits <= s.num_rows; r += kSplits) {
-      for (int u = 0; u < kSplits; ++u) add_row(r + u, sum[u]);
+    // The last rows first: the backward pass reads the factor descending (PrefetchFactor).
+    std::int64_t r = s.num_rows;
+    for (; r - kSplits >= width; r -= kSplits) {
+      for (int u = 0; u < kSplits; ++u) add_row(r - kSplits + u, sum[u]);
     }
-    for (; r < s.num_rows; ++r) add_row(r, sum[0]);
+    for (; r > width; --r) add_row(r - 1, sum[0]);
     for (int u = 1; u < kSplits; ++u) {
       for (int c = 0; c < kColumns; ++c) {
         for (int j = 0; j < kVecs; ++j) sum[0][c][j] += sum[u][c][j];
