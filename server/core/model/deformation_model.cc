@@ -485,6 +485,13 @@ struct DeformationModel::ParallelAssembly {
     const auto [first, end] = RangeOfPart(rows, a.parts, index);
     MultiplyLaplacianTransposeRows(a.model->system_, a.scratch->rotated_deltas.data(),
                                    a.scratch->solution.data(), first, end);
+    // The anchors among these rows (anchors ascend), once their rows hold the product.
+    const std::vector<int>& anchors = a.model->system_.anchors;
+    const auto anchor_at = [&](int row) {
+      return static_cast<int>(std::lower_bound(anchors.begin(), anchors.end(), row) -
+                              anchors.begin());
+    };
+    a.model->AddAnchorTargets(a.scratch, anchor_at(first), anchor_at(end));
   }
 };
 
@@ -501,8 +508,8 @@ bool DeformationModel::DeformParallel(const MaterialFactorization& factorization
   PrepareSlotRotations(scratch);
   ParallelAssembly assembly{this, &factorization, scratch, plan.parts};
   runner->Run(plan.parts, &ParallelAssembly::Rotate, &assembly);
-  runner->Run(plan.parts, &ParallelAssembly::Multiply, &assembly);
-  AddConstraintTargets(pose, scratch);
+  runner->Run(plan.parts, &ParallelAssembly::Multiply, &assembly);  // and the anchors
+  AddNodeTargets(pose, scratch);
   const auto solve_start = Clock::now();
   const Status solved = factorization.factor().Solve3Parallel(
       plan, scratch->solution.data(), scratch->solution.data(), work, runner);
@@ -517,18 +524,32 @@ bool DeformationModel::DeformParallel(const MaterialFactorization& factorization
 
 // scratch->solution's anchor and joint-node rows += weight^2 * their posed targets.
 void DeformationModel::AddConstraintTargets(const Pose& pose, DeformScratch* scratch) const {
-  const int n = mesh_.num_vertices();
+  AddAnchorTargets(scratch, 0, static_cast<int>(system_.anchors.size()));
+  AddNodeTargets(pose, scratch);
+}
+
+// An anchor's target is sum_e weight_e (R_e rest + t_e) over its bones' entries, R_e as the
+// matrix PrepareSlotRotations made of the bone's rotation (slot k < K is bone k's).
+void DeformationModel::AddAnchorTargets(DeformScratch* scratch, int first, int end) const {
   const auto& bones = scratch->bone_transforms;
+  const auto& rotations = scratch->slot_rotations;
   auto& rhs = scratch->solution;
   const double anchor2 = system_.anchor_weight * system_.anchor_weight;
-  for (size_t a = 0; a < system_.anchors.size(); ++a) {
+  for (int a = first; a < end; ++a) {
     const Eigen::Vector3d rest = system_.anchor_rest.row(a).transpose();
     Eigen::Vector3d target = Eigen::Vector3d::Zero();
     for (int e = system_.anchor_offsets[a]; e < system_.anchor_offsets[a + 1]; ++e) {
-      target += system_.anchor_weights[e] * bones[system_.anchor_bones[e]].Apply(rest);
+      const int bone = system_.anchor_bones[e];
+      target += system_.anchor_weights[e] * (rotations[bone] * rest + bones[bone].translation);
     }
     rhs.row(system_.anchors[a]) += anchor2 * target.transpose();
   }
+}
+
+void DeformationModel::AddNodeTargets(const Pose& pose, DeformScratch* scratch) const {
+  const int n = mesh_.num_vertices();
+  const auto& bones = scratch->bone_transforms;
+  auto& rhs = scratch->solution;
   const double node2 = system_.node_weight * system_.node_weight;
   for (int c = 0; c < system_.num_nodes; ++c) {
     const Eigen::Vector3d centre =

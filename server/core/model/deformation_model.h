@@ -315,6 +315,13 @@ class DeformationModel {
   void RotateDeltasOf(const MaterialFactorization& factorization, DeformScratch* scratch, int first,
                       int end) const;
   struct ParallelAssembly;  // DeformParallel's parts
+  // scratch->solution's rows of anchors [first, end) (indices into system_.anchors) +=
+  // anchor_weight^2 * their posed targets, through scratch->slot_rotations (PrepareSlotRotations
+  // first). No allocation.
+  void AddAnchorTargets(DeformScratch* scratch, int first, int end) const;
+  // The joint nodes' rows += node_weight^2 * their posed joint centres.
+  void AddNodeTargets(const Pose& pose, DeformScratch* scratch) const;
+  // AddAnchorTargets for every anchor, then AddNodeTargets.
   void AddConstraintTargets(const Pose& pose, DeformScratch* scratch) const;
 
   std::uint64_t id_ = 0;  // unique within the process, never 0 (Owns)
