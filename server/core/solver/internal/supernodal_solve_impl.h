@@ -302,12 +302,14 @@ inline SupernodeBlock<Value> BlockOf(const SupernodalFactorView& f, int sn) {
 }
 
 // Asks for the cache line at `address` into the outer caches (prefetcht2). Inline assembly on
-// x86: GCC 12 drops a loop of __builtin_prefetch behind a condition as if it did nothing.
-inline void PrefetchLine(const char* address) {
+// x86: GCC 12's mod/ref analysis counts __builtin_prefetch as no side effect, and deleted every
+// call of PrefetchFactor as a function that does nothing (none were left in the objects; with
+// -fno-ipa-modref they stay).
+inline void PrefetchLine(std::uintptr_t address) {
 #if defined(__x86_64__) || defined(__i386__)
-  asm volatile("prefetcht2 %0" : : "m"(*address));
+  asm volatile("prefetcht2 %0" : : "m"(*reinterpret_cast<const char*>(address)));
 #else
-  __builtin_prefetch(address, 0, 1);
+  __builtin_prefetch(reinterpret_cast<const void*>(address), 0, 1);
 #endif
 }
 
@@ -315,13 +317,15 @@ enum class Pass { kForward, kBackward };
 
 // Asks for the bytes at distance kPrefetchBytes from [values, values + count) of `s`'s block in
 // `pass`'s direction, when its factor streams from memory. A prefetch never faults: addresses
-// beyond the factor's ends are harmless.
+// beyond the factor's ends are harmless (computed as integers, since a pointer may not leave its
+// array).
 template <Pass kPass, typename Value>
 inline void PrefetchFactor(const SupernodeBlock<Value>& s, const Value* values,
                            std::ptrdiff_t count) {
   if (!s.prefetch) return;
-  const char* begin = reinterpret_cast<const char*>(values) +
-                      (kPass == Pass::kForward ? kPrefetchBytes : -kPrefetchBytes);
+  const std::uintptr_t begin =
+      kPass == Pass::kForward ? reinterpret_cast<std::uintptr_t>(values) + kPrefetchBytes
+                              : reinterpret_cast<std::uintptr_t>(values) - kPrefetchBytes;
   const std::ptrdiff_t bytes = count * static_cast<std::ptrdiff_t>(sizeof(Value));
   for (std::ptrdiff_t offset = 0; offset < bytes; offset += 64) PrefetchLine(begin + offset);
 }
