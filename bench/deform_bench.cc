@@ -234,6 +234,53 @@ void BM_ParallelSolve(benchmark::State& state, BenchMesh mesh, int parts) {
   state.counters["predicted_x_serial"] = plan.predicted_time_ratio;
 }
 
+// A batch of `frames_per_batch` frames' two triangular passes split over `parts` threads
+// (CholeskyFactor::SolveFramesParallel on a ThreadTeam of `parts` threads), the right-hand sides
+// those of the benchmark pose. Besides the usual counters (per batch): frame_ms, the median per
+// frame; serial_batch_ms, the same batch's SolveFrames on one thread timed in the same benchmark;
+// x_serial, their ratio; relative_difference, the largest frame's difference from Solve3's.
+void BM_ParallelBatchedSolve(benchmark::State& state, BenchMesh mesh, int frames_per_batch,
+                             int parts) {
+  auto frames = SetUpFrames(state, mesh);
+  if (!frames) return;
+  const CholeskyFactor& factor = frames->factorization->factor();
+  DeformScratch& scratch = frames->scratch;
+  const auto rhs = AssembledRightHandSide(frames.get());
+  const ParallelSolvePlan plan = factor.PlanParallel(parts);
+  if (plan.parts == 0) return state.SkipWithError("the elimination tree does not split");
+  std::vector<std::vector<double>> solved(frames_per_batch,
+                                          std::vector<double>(rhs.data(), rhs.data() + rhs.size()));
+  std::vector<const double*> in(frames_per_batch, rhs.data());
+  std::vector<double*> out;
+  for (std::vector<double>& frame : solved) out.push_back(frame.data());
+  std::vector<double> work(factor.WorkSizeFramesParallel(plan, frames_per_batch));
+  ThreadTeam team(parts);
+  const auto seconds = TimeEach(state, [&] {
+    benchmark::DoNotOptimize(factor.SolveFramesParallel(plan, in.data(), out.data(),
+                                                        frames_per_batch, work.data(), &team));
+  });
+  const std::vector<std::vector<double>> parallel_result = solved;  // (the last timed run's)
+  std::vector<double> serial_work(factor.WorkSizeMany(3 * frames_per_batch));
+  const std::vector<double> serial = TimeRuns(seconds.size(), [&] {
+    benchmark::DoNotOptimize(
+        factor.SolveFrames(in.data(), out.data(), frames_per_batch, serial_work.data()));
+  });
+  (void)factor.Solve3(rhs.data(), scratch.solution.data(), scratch.solve_work.data());
+  double difference = 0;
+  for (const std::vector<double>& frame : parallel_result) {
+    const Eigen::Map<const Eigen::VectorXd> x(frame.data(), scratch.solution.size());
+    const Eigen::Map<const Eigen::VectorXd> expected(scratch.solution.data(),
+                                                     scratch.solution.size());
+    difference = std::max(difference, (x - expected).norm() / expected.norm());
+  }
+  ReportAgainstBound(state, factor.bytes(), seconds);
+  state.counters["frames"] = frames_per_batch;
+  state.counters["frame_ms"] = Median(seconds) * 1e3 / frames_per_batch;
+  state.counters["serial_batch_ms"] = Median(serial) * 1e3;
+  state.counters["x_serial"] = Median(seconds) / Median(serial);
+  state.counters["relative_difference"] = difference;
+}
+
 // The two triangular passes with the factor's values rounded to float32 (CholeskyFactor::
 // RoundedToFloat32; the arithmetic stays double), on one thread (parts 1, Solve3) or split over
 // `parts` threads (Solve3Parallel), against the double factor's same solve timed in the same
@@ -360,6 +407,11 @@ void RegisterBenchmarks(const BenchMesh& mesh) {
         ->MinTime(1.0);
   }
   RegisterFor(mesh, "ParallelSolve/parts:2", BM_ParallelSolve, 2)->MinTime(1.0);
+  for (const int frames : {4, 8}) {
+    RegisterFor(mesh, "ParallelBatchedSolve/frames:" + std::to_string(frames) + "/parts:2",
+                BM_ParallelBatchedSolve, frames, 2)
+        ->MinTime(1.0);
+  }
   RegisterFor(mesh, "Float32Solve/parts:1", BM_Float32Solve, 1)->MinTime(1.0);
   RegisterFor(mesh, "Float32Solve/parts:2", BM_Float32Solve, 2)->MinTime(1.0);
   RegisterFor(mesh, "EigenBaselineSolve", BM_EigenBaselineSolve)->MinTime(1.0);

@@ -94,6 +94,15 @@ LoadReport BuildReport(const RunDescription& run, const LoadPlan& plan, RunOutco
     server_total.push_back(total);
     outside_server.push_back(report.latency_ms[i] - total);
   }
+  double batch_frames = 0, split = 0;
+  for (const ServerTimings& t : timings) {
+    batch_frames += std::max(t.batch_frames, 1);
+    split += t.solve_parts > 1 ? 1 : 0;
+  }
+  if (!timings.empty()) {
+    report.batch_frames_mean = batch_frames / static_cast<double>(timings.size());
+    report.split_fraction = split / static_cast<double>(timings.size());
+  }
   report.server_total = Summarize(&server_total);
   report.outside_server = Summarize(&outside_server);
   CountError(&report, "INVALID_ARGUMENT", report.poses_rejected + report.stiffness_rejected);
@@ -130,10 +139,9 @@ nlohmann::ordered_json ReportJson(const LoadReport& report) {
   out["throughput_fps"] = Round(report.throughput_fps(), 1);
   const double frames = static_cast<double>(std::max<std::uint64_t>(report.frames_received, 1));
   out["bytes_per_frame"] = Round(static_cast<double>(report.payload_bytes) / frames, 1);
-  out["bytes_per_vertex"] =
-      Round(static_cast<double>(report.payload_bytes) / frames /
-                static_cast<double>(std::max(report.run.vertices, 1u)),
-            3);
+  out["bytes_per_vertex"] = Round(static_cast<double>(report.payload_bytes) / frames /
+                                      static_cast<double>(std::max(report.run.vertices, 1u)),
+                                  3);
   out["latency_ms"] = {{"p50", Ms(report.latency.p50)}, {"p90", Ms(report.latency.p90)},
                        {"p99", Ms(report.latency.p99)}, {"p999", Ms(report.latency.p999)},
                        {"max", Ms(report.latency.max)}, {"mean", Ms(report.latency.mean)}};
@@ -154,6 +162,8 @@ nlohmann::ordered_json ReportJson(const LoadReport& report) {
   out["outside_server_ms"] = {{"p50", Ms(report.outside_server.p50)},
                               {"p99", Ms(report.outside_server.p99)},
                               {"max", Ms(report.outside_server.max)}};
+  out["server_batch_frames_mean"] = Round(report.batch_frames_mean, 3);
+  out["server_split_fraction"] = Round(report.split_fraction, 4);
   out["send_lag_max_ms"] = Ms(report.send_lag_max_ms);
   return out;
 }
@@ -191,6 +201,9 @@ std::string ReportText(const LoadReport& report) {
       "%.3f\n",
       report.server_total.p50, report.server_total.p99, report.outside_server.p50,
       report.outside_server.p99);
+  add("server passes: %.2f frames per pass over the factor (mean), %.1f%% of frames split over "
+      "threads\n",
+      report.batch_frames_mean, 100.0 * report.split_fraction);
   if (plan.stiffness_every_s > 0) {
     add("stiffness on %s every %.2f s: %llu sent, %llu applied (median refactorisation %.3f ms)\n",
         report.run.stiffness_joint.c_str(), plan.stiffness_every_s,

@@ -39,8 +39,8 @@ struct LoadReport {
   std::uint64_t stiffness_rejected = 0;
   std::uint64_t bad_frames = 0;
   std::uint64_t payload_bytes = 0;  // measured frames' positions as they travelled
-  std::string first_stream_error;  // "CODE: message" of the first failed stream
-  std::vector<double> latency_ms;  // every measured frame's, ascending
+  std::string first_stream_error;   // "CODE: message" of the first failed stream
+  std::vector<double> latency_ms;   // every measured frame's, ascending
   LatencySummary latency;
   double max_gap_ms = 0;
   std::uint64_t stiffness_sent = 0;
@@ -51,6 +51,11 @@ struct LoadReport {
   // latency (gRPC, the network and both sides' thread wake-ups).
   LatencySummary server_total;
   LatencySummary outside_server;
+  // Over measured frames: the mean frames per pass over the factor their solve was part of, and
+  // the fraction solved on several threads (the server's FrameTimings; 1 and 0 from a server
+  // that does not report them).
+  double batch_frames_mean = 1;
+  double split_fraction = 0;
   double send_lag_max_ms = 0;
 
   double delivered_fraction() const;

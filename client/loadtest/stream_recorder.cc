@@ -38,7 +38,9 @@ void StreamRecorder::OnFrame(const deform::v1::DeformFrame& frame) {
     stats_.payload_bytes += cli::FramePayloadBytes(frame);
     stats_.skipped_by_server += frame.skipped_poses();
     stats_.latency_ms.push_back(static_cast<double>(now_ns - frame.client_timestamp_ns()) * 1e-6);
-    stats_.timings.push_back({t.queue_ms(), t.rhs_ms(), t.solve_ms(), t.encode_ms()});
+    stats_.timings.push_back({t.queue_ms(), t.rhs_ms(), t.solve_ms(), t.encode_ms(),
+                              static_cast<int>(t.batch_frames()),
+                              static_cast<int>(t.solve_parts())});
   }
   if (frame.sequence() > last_settled_sequence_) {
     last_settled_sequence_ = frame.sequence();

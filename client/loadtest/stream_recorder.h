@@ -21,6 +21,8 @@ struct ServerTimings {
   double rhs_ms = 0;
   double solve_ms = 0;
   double encode_ms = 0;
+  int batch_frames = 1;  // frames solved in the same pass over the factor
+  int solve_parts = 1;   // threads the frame's solve was split over
 };
 
 // Counts and samples of one stream. A frame counts as measured when the pose it answers is one of

@@ -5,18 +5,21 @@
 
 namespace deform::service {
 
-BatchScratchPool::BatchScratchPool(const DeformationModel& model, int slots, int max_frames)
+BatchScratchPool::BatchScratchPool(const DeformationModel& model, int slots, int max_frames,
+                                   const ParallelSolvePlan* parallel)
     : max_frames_(std::clamp(max_frames, 1, DeformationModel::kMaxBatchFrames)),
       busy_(std::make_unique<std::atomic<bool>[]>(static_cast<std::size_t>(std::max(slots, 0)))) {
   scratches_.reserve(static_cast<std::size_t>(std::max(slots, 0)));
   for (int i = 0; i < slots; ++i) {
-    scratches_.push_back(model.MakeBatchScratch(max_frames_));
+    scratches_.push_back(model.MakeBatchScratch(max_frames_, parallel));
     busy_[i].store(false, std::memory_order_relaxed);
   }
 }
 
-std::size_t BatchScratchPool::Bytes(const DeformationModel& model, int slots, int max_frames) {
-  return static_cast<std::size_t>(std::max(slots, 0)) * model.BatchScratchBytes(max_frames);
+std::size_t BatchScratchPool::Bytes(const DeformationModel& model, int slots, int max_frames,
+                                    const ParallelSolvePlan* parallel) {
+  return static_cast<std::size_t>(std::max(slots, 0)) *
+         model.BatchScratchBytes(max_frames, parallel);
 }
 
 BatchScratchPool::Lease BatchScratchPool::TryAcquire() const {

@@ -18,13 +18,16 @@ namespace deform::service {
 
 class BatchScratchPool {
  public:
-  // `slots` scratches of `max_frames` frames each (DeformationModel::MakeBatchScratch).
-  BatchScratchPool(const DeformationModel& model, int slots, int max_frames);
+  // `slots` scratches of `max_frames` frames each (DeformationModel::MakeBatchScratch), with room
+  // for DeformBatchParallel with `parallel` when it is given.
+  BatchScratchPool(const DeformationModel& model, int slots, int max_frames,
+                   const ParallelSolvePlan* parallel = nullptr);
   BatchScratchPool(const BatchScratchPool&) = delete;
   BatchScratchPool& operator=(const BatchScratchPool&) = delete;
 
   // What the constructor allocates.
-  static std::size_t Bytes(const DeformationModel& model, int slots, int max_frames);
+  static std::size_t Bytes(const DeformationModel& model, int slots, int max_frames,
+                           const ParallelSolvePlan* parallel = nullptr);
 
   // One scratch for one batch; empty when every scratch is leased. Returned on destruction.
   class Lease {

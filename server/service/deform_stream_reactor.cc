@@ -47,8 +47,7 @@ void CountWritten(const v1::DeformResponse& message, ServiceMetrics* metrics) {
   const double server_ms = t.queue_ms() + t.rhs_ms() + t.solve_ms() + t.encode_ms();
   const int encoding =
       frame.has_encoded() ? frame.encoded().encoding() : v1::FRAME_ENCODING_FLOAT32;
-  metrics->FrameWritten(encoding, message.ByteSizeLong(), server_ms * 1e-3,
-                        frame.skipped_poses());
+  metrics->FrameWritten(encoding, message.ByteSizeLong(), server_ms * 1e-3, frame.skipped_poses());
 }
 
 // The reactor coordinates the stream's parts; each part states its own contract:
@@ -95,6 +94,8 @@ class DeformStreamReactor final : public StreamHandler,
   void RunUrgent() DEFORM_EXCLUDES(mutex_) override;
   void RunUrgentBatch(UrgentTask* const* others, int count) DEFORM_EXCLUDES(mutex_) override;
   const void* BatchKey() const override { return batch_key_.load(std::memory_order_relaxed); }
+  // A mesh with a parallel plan: its batches (and lone frames) split over the idle workers.
+  bool SplitsItsBatches() const override { return splits_batches_.load(std::memory_order_relaxed); }
   // A run's steps for one stream: BeginSolveRun takes the pending pose into solving_ with its
   // factorisation, stamp and frame (false: nothing to solve); RejectSolvingPose answers a pose the
   // solver refused with a notice; EndSolveRun publishes the frame (`produced`), switches in a
@@ -148,6 +149,7 @@ class DeformStreamReactor final : public StreamHandler,
 
   // Solve-task-owned (between PendingPoseSlot::BeginRun and EndRun).
   std::optional<FrameSolver> solver_;          // emplaced by HandleStart
+  std::atomic<bool> splits_batches_{false};    // SplitsItsBatches: set once, before any solve
   std::optional<PoolRunner> parallel_runner_;  // for a mesh with a parallel plan
   PoseInput solving_;
   std::shared_ptr<const MaterialFactorization> solve_factorization_;
@@ -280,6 +282,7 @@ void DeformStreamReactor::HandleStart() {
     parallel_runner_.emplace(&core_->pool);
     solver_->EnableParallel(entry_->parallel_plan.get(), &*parallel_runner_,
                             &core_->registry.open_streams());
+    splits_batches_.store(true, std::memory_order_relaxed);
   }
   spdlog::info("{} opened", log_context_);
 
@@ -368,9 +371,9 @@ void DeformStreamReactor::StartRefactorLocked(StiffnessSwitch::Update update) {
   if (!held.ok()) {
     spdlog::info("{} stiffness version {} rejected: {}", log_context_, update.version,
                  held.message());
-    outbox_.AddNotice(v1::Notice::KIND_STIFFNESS_REJECTED, 0, update.version,
-                      "stiffness version " + std::to_string(update.version) + ": " +
-                          held.message());
+    outbox_.AddNotice(
+        v1::Notice::KIND_STIFFNESS_REJECTED, 0, update.version,
+        "stiffness version " + std::to_string(update.version) + ": " + held.message());
     return;
   }
   stiffness_.RefactorStarted();

@@ -43,9 +43,10 @@ void FrameSolver::EnableParallel(const ParallelSolvePlan* plan, ParallelRunner* 
   parallel_work_.assign(model_.default_factorization()->factor().WorkSizeParallel(*plan), 0.0);
 }
 
-bool FrameSolver::SplitsALoneFrame() const {
+bool FrameSolver::SplitsNow() const {
   return parallel_plan_ != nullptr &&
-         open_streams_->load(std::memory_order_relaxed) < parallel_plan_->parts;
+         (open_streams_->load(std::memory_order_relaxed) < parallel_plan_->parts ||
+          parallel_runner_->IdleHelpers() > 0);
 }
 
 std::size_t FrameSolver::ParallelWorkBytes(const DeformationModel& model,
@@ -104,7 +105,8 @@ void FrameSolver::DeformTogether(const MaterialFactorization& factorization,
                                  FrameSolver* const* solvers, int count,
                                  const BatchScratchPool* scratches, Deformed* deformed) {
   const DeformationModel& model = solvers[0]->model_;
-  if (count == 1 && solvers[0]->SplitsALoneFrame()) {
+  const bool split = solvers[0]->SplitsNow();
+  if (count == 1 && split) {
     FrameSolver& solver = *solvers[0];
     model.DeformParallel(factorization, solver.pose_, &solver.scratch_, *solver.parallel_plan_,
                          solver.parallel_work_.data(), solver.parallel_runner_, &deformed->timings);
@@ -132,7 +134,14 @@ void FrameSolver::DeformTogether(const MaterialFactorization& factorization,
       buffers[f] = &solvers[first + f]->scratch_;
     }
     DeformTimings pass;
-    model.DeformBatch(factorization, poses.data(), buffers.data(), frames, lease.get(), &pass);
+    if (split) {
+      const FrameSolver& leader = *solvers[0];
+      model.DeformBatchParallel(factorization, poses.data(), buffers.data(), frames, lease.get(),
+                                *leader.parallel_plan_, leader.parallel_runner_, &pass);
+      deformed->solve_parts = leader.parallel_plan_->parts;
+    } else {
+      model.DeformBatch(factorization, poses.data(), buffers.data(), frames, lease.get(), &pass);
+    }
     deformed->timings.right_hand_side += pass.right_hand_side;
     deformed->timings.solve += pass.solve;
     deformed->batch_frames = std::max(deformed->batch_frames, frames);

@@ -44,11 +44,14 @@ class FrameSolver {
   // Frames in the solved order.
   explicit FrameSolver(const DeformationModel& model);
 
-  // Lets a frame solved alone run on several threads: `plan` (of the model's factor analysis) and
+  // Lets this solver's frames run on several threads: `plan` (of the model's factor analysis) and
   // `runner`, while fewer streams than the plan has parts (one per worker) are open on the
-  // service (`open_streams`, MeshRegistry::open_streams()): with as many streams as workers or
-  // more, the workers have other frames to solve, and a split solve takes about 1.3 times the
-  // workers' time of a whole one. All three must outlive the solver. Allocates the parallel
+  // service (`open_streams`, MeshRegistry::open_streams()) or, with more, while the runner has an
+  // idle worker to help (ParallelRunner::IdleHelpers): a split solve takes about 1.3 times the
+  // workers' time of a whole one alone and 1.1 to 1.2 times in a batch, which pays on a worker
+  // that is idle but not on one that has other frames to solve. A lone frame is split as
+  // DeformParallel splits it, a batch led by this solver as DeformBatchParallel does (with a
+  // batch scratch made for the plan). All three must outlive the solver. Allocates the parallel
   // solve's work: ParallelWorkBytes.
   void EnableParallel(const ParallelSolvePlan* plan, ParallelRunner* runner,
                       const std::atomic<int>* open_streams);
@@ -66,8 +69,8 @@ class FrameSolver {
   Status Prepare(const PoseInput& input);
   // Deforms the prepared poses of `solvers` (distinct, all of one model, prepared) with
   // `factorization`: together in passes of up to scratches->max_frames() over the factor when
-  // `scratches` lends a batch scratch and count > 1, a lone frame on several threads when its
-  // solver has EnableParallel, else one by one. No allocation.
+  // `scratches` lends a batch scratch and count > 1, a lone frame or a batch on several threads
+  // when the first solver has EnableParallel and splits now, else one by one. No allocation.
   struct Deformed {
     std::chrono::steady_clock::time_point start;  // when the deformation began
     std::chrono::steady_clock::time_point end;    // when it ended
@@ -89,8 +92,8 @@ class FrameSolver {
   const DeformationModel& model_;
   const std::vector<int>& client_order_;
   void Encode(v1::DeformFrame* frame);
-  // Whether a frame solved alone is split now (EnableParallel).
-  bool SplitsALoneFrame() const;
+  // Whether this solver's frame, or a batch it leads, is split now (EnableParallel).
+  bool SplitsNow() const;
   // DeformPrepared's work, without its start and end times.
   static void DeformTogether(const MaterialFactorization& factorization,
                              FrameSolver* const* solvers, int count,

@@ -169,17 +169,17 @@ StatusOr<std::shared_ptr<const MeshEntry>> MeshRegistry::Register(
   // memory may exceed its reservation by these buffers, a few right-hand sides per worker.
   // A linear response evaluates each frame alone: nothing to batch or split.
   const bool solves = model->default_factorization()->linear_response() == nullptr;
-  if (solves && solve_settings_.max_frames >= 2 && solve_settings_.slots > 0) {
-    entry->batch_scratches = std::make_unique<BatchScratchPool>(*model, solve_settings_.slots,
-                                                                solve_settings_.max_frames);
-    entry->memory_bytes +=
-        BatchScratchPool::Bytes(*model, solve_settings_.slots, solve_settings_.max_frames);
-  }
   if (solves && solve_settings_.slots >= 2 &&
       entry->factor_bytes >= solve_settings_.parallel_min_factor_bytes) {
     auto plan = std::make_unique<ParallelSolvePlan>(
         model->default_factorization()->factor().PlanParallel(solve_settings_.slots));
     if (plan->parts >= 2) entry->parallel_plan = std::move(plan);
+  }
+  if (solves && solve_settings_.max_frames >= 2 && solve_settings_.slots > 0) {
+    entry->batch_scratches = std::make_unique<BatchScratchPool>(
+        *model, solve_settings_.slots, solve_settings_.max_frames, entry->parallel_plan.get());
+    entry->memory_bytes += BatchScratchPool::Bytes(
+        *model, solve_settings_.slots, solve_settings_.max_frames, entry->parallel_plan.get());
   }
   entry->model = std::move(model);
   entry->presentation = std::move(presentation);

@@ -60,12 +60,14 @@ struct MeshEntry {
   std::size_t factor_bytes = 0;
   std::size_t memory_bytes = 0;  // model->EstimatedBytes() and batch_scratches
   MeshPresentation presentation;
-  // The buffers of batched solves of the mesh's frames (in memory_bytes); null when its frames
-  // are solved one by one (batching off, or a linear response: nothing to share).
+  // The buffers of batched solves of the mesh's frames (in memory_bytes), with room for the
+  // parallel plan's batches when there is one; null when its frames are solved one by one
+  // (batching off, or a linear response: nothing to share).
   std::unique_ptr<BatchScratchPool> batch_scratches;
-  // The split of the mesh's solve over the workers (one part each) for a lone stream's frames;
-  // null when the mesh is too small for it to pay (SolveSettings::parallel_min_factor_bytes) or
-  // there is one worker. Streams size their parallel work for it.
+  // The split of the mesh's solve over the workers (one part each) for a lone frame or a batch
+  // (FrameSolver::EnableParallel); null when the mesh is too small for it to pay
+  // (SolveSettings::parallel_min_factor_bytes) or there is one worker. Streams size their
+  // parallel work for it.
   std::unique_ptr<const ParallelSolvePlan> parallel_plan;
 
   // Vertices of frames and rest positions as clients see them (the file's).

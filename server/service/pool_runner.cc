@@ -51,6 +51,10 @@ PoolRunner::PoolRunner(WorkerPool* pool) : pool_(pool), job_(std::make_shared<Jo
 
 PoolRunner::~PoolRunner() = default;
 
+int PoolRunner::IdleHelpers() {
+  return std::min(pool_->idle_workers(), static_cast<int>(helpers_.size()));
+}
+
 void PoolRunner::Run(int count, void (*part)(void* context, int index), void* context) {
   std::unique_lock<std::mutex> lock(job_->mutex);
   job_->part = part;

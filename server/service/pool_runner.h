@@ -28,6 +28,8 @@ class PoolRunner final : public ParallelRunner {
   PoolRunner& operator=(const PoolRunner&) = delete;
 
   void Run(int count, void (*part)(void* context, int index), void* context) override;
+  // The pool's idle workers, at most this runner's helpers.
+  int IdleHelpers() override;
 
  private:
   struct Job;

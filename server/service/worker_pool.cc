@@ -20,6 +20,10 @@ WorkerPool::WorkerPool(int threads, int max_batch) {
   threads = ResolveThreads(threads);
   max_background_ = std::max(1, threads - 1);
   thread_count_ = threads;
+  {
+    MutexLock lock(&mutex_);
+    running_split_keys_.reserve(static_cast<std::size_t>(threads));
+  }
   threads_.reserve(threads);
   for (int i = 0; i < threads; ++i) threads_.emplace_back([this] { WorkerLoop(); });
 }
@@ -83,23 +87,57 @@ int WorkerPool::BatchShare(int queued, int idle_workers, int max_batch) {
   return std::clamp((queued + workers - 1) / workers, 1, std::max(max_batch, 1));
 }
 
+bool WorkerPool::WaitsForItsBatchLocked(const UrgentTask& task) {
+  if (running_split_keys_.empty() || max_batch_ <= 1) return false;
+  const void* key = task.BatchKey();
+  if (key == nullptr || !task.SplitsItsBatches()) return false;
+  if (std::find(running_split_keys_.begin(), running_split_keys_.end(), key) ==
+      running_split_keys_.end()) {
+    return false;
+  }
+  int queued = 0;  // a whole batch of the key queued runs alongside
+  int scanned = 0;
+  for (const UrgentTask* t = urgent_head_.get(); t != nullptr && scanned < kBatchScanLimit;
+       t = t->next_urgent_.get(), ++scanned) {
+    if (t->BatchKey() == key && ++queued >= max_batch_) return false;
+  }
+  return true;
+}
+
 std::shared_ptr<UrgentTask> WorkerPool::TakeUrgentLocked(std::shared_ptr<UrgentTask>* others,
-                                                         int* count) {
-  std::shared_ptr<UrgentTask> head = std::move(urgent_head_);
-  urgent_head_ = std::move(head->next_urgent_);
-  if (urgent_head_ == nullptr) urgent_tail_ = nullptr;
+                                                         int* count, const void** split_key) {
   *count = 0;
+  *split_key = nullptr;
+  // The first task that may run now, unlinked through the link that owns it.
+  std::shared_ptr<UrgentTask>* at = &urgent_head_;
+  UrgentTask* before = nullptr;
+  for (int scanned = 0; *at != nullptr && WaitsForItsBatchLocked(**at); ++scanned) {
+    if (scanned + 1 >= kBatchScanLimit) return nullptr;
+    before = at->get();
+    at = &(*at)->next_urgent_;
+  }
+  if (*at == nullptr) return nullptr;
+  std::shared_ptr<UrgentTask> head = std::move(*at);
+  *at = std::move(head->next_urgent_);
+  if (urgent_tail_ == head.get()) urgent_tail_ = before;
   const void* key = max_batch_ > 1 ? head->BatchKey() : nullptr;
   if (key == nullptr) return head;
   // The batch's share of the queued tasks with its key (BatchShare): the workers now idle will
-  // take the rest.
+  // take the rest. A split batch takes them all (header comment).
   int matching = 0;
   int scanned = 0;
   for (const UrgentTask* task = urgent_head_.get(); task != nullptr && scanned < kBatchScanLimit;
        task = task->next_urgent_.get(), ++scanned) {
     if (task->BatchKey() == key) ++matching;
   }
-  const int take = BatchShare(1 + matching, idle_workers_, max_batch_) - 1;
+  const bool splits = head->SplitsItsBatches();
+  const int take = (splits ? std::min(1 + matching, max_batch_)
+                           : BatchShare(1 + matching, idle_workers_, max_batch_)) -
+                   1;
+  if (splits) {
+    running_split_keys_.push_back(key);
+    *split_key = key;
+  }
   // Walk the queue through the links that own each task, unlinking the first `take` matches.
   std::shared_ptr<UrgentTask>* link = &urgent_head_;
   UrgentTask* previous = nullptr;
@@ -124,10 +162,13 @@ void WorkerPool::WorkerLoop() {
     // The background queue's guaranteed worker (header comment).
     const bool background_owed =
         can_run_background && running_background_ == 0 && thread_count_ > 1;
-    if (urgent_head_ != nullptr && !background_owed) {
-      std::array<std::shared_ptr<UrgentTask>, kMaxBatch - 1> others;
-      int count = 0;
-      std::shared_ptr<UrgentTask> task = TakeUrgentLocked(others.data(), &count);
+    std::array<std::shared_ptr<UrgentTask>, kMaxBatch - 1> others;
+    int count = 0;
+    const void* split_key = nullptr;  // a split batch's, marked running by TakeUrgentLocked
+    std::shared_ptr<UrgentTask> task = urgent_head_ != nullptr && !background_owed
+                                           ? TakeUrgentLocked(others.data(), &count, &split_key)
+                                           : nullptr;
+    if (task != nullptr) {
       lock.Unlock();
       if (count == 0) {
         task->RunUrgent();
@@ -140,6 +181,12 @@ void WorkerPool::WorkerLoop() {
       task = nullptr;
       for (int i = 0; i < count; ++i) others[i] = nullptr;
       lock.Lock();
+      if (split_key != nullptr) {
+        running_split_keys_.erase(
+            std::find(running_split_keys_.begin(), running_split_keys_.end(), split_key));
+        // Its key's tasks that waited may run now, on this worker or an idle one.
+        if (urgent_head_ != nullptr) wake_.NotifyOne();
+      }
       continue;
     }
     if (can_run_background) {
@@ -155,8 +202,9 @@ void WorkerPool::WorkerLoop() {
       if (!background_.empty()) wake_.NotifyOne();
       continue;
     }
-    // Stop once nothing is queued and no background task can still post more work.
-    if (stopping_ && background_.empty() && running_background_ == 0) {
+    // Stop once nothing is queued (tasks waiting for their key's split batch included: its worker
+    // wakes one of the others when it ends) and no background task can still post more work.
+    if (stopping_ && urgent_head_ == nullptr && background_.empty() && running_background_ == 0) {
       wake_.NotifyAll();
       return;
     }

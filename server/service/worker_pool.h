@@ -16,6 +16,14 @@
 // kBatchScanLimit tasks deep. Nothing waits for a batch to fill: a batch is only what is already
 // queued, so a lone task runs as soon as a worker is free, as before.
 //
+// Split batches: tasks whose key's batches split their own work over the idle workers
+// (UrgentTask::SplitsItsBatches, a big mesh's solves) run one batch of a key at a time. Their
+// batch takes every queued task of its key (up to max_batch, no share left for idle workers),
+// and while it runs the other workers leave the key's tasks queued, taking other work or waiting
+// idle, where the running batch's helpers find them; unless a whole batch (max_batch tasks) of
+// the key is queued, which then runs alongside. So the frames that arrive during a batch make the
+// next one, solved on every free core, instead of smaller batches side by side each on one core.
+//
 // Ownership: the pool holds a reference to every task it has been given (the urgent task's
 // shared_ptr, the background task's function and its captures) until the task has run, and drops
 // it outside its lock, so a task's reference can be the last one to its owner (a stream reactor).
@@ -46,6 +54,9 @@ class UrgentTask {
   // atomic); it may be stale, and RunUrgentBatch must cope with a member whose key has changed
   // since. Tasks that share a key must be of one type (RunUrgentBatch may downcast them).
   virtual const void* BatchKey() const { return nullptr; }
+  // Whether the batches of this task's key split their work over the pool's idle workers (see the
+  // pool's header); read with BatchKey, the same for every task of a key, cheap and thread-safe.
+  virtual bool SplitsItsBatches() const { return false; }
   // Runs this task and `others` (`count` tasks taken from the queue with this task's key): each
   // must get what its own RunUrgent() would give it. The default runs them one after the other.
   virtual void RunUrgentBatch(UrgentTask* const* others, int count);
@@ -102,10 +113,14 @@ class WorkerPool {
 
  private:
   void WorkerLoop() DEFORM_EXCLUDES(mutex_);
-  // Unlinks the urgent queue's head and, when it has a batch key, the queued tasks with the same
-  // key (at most max_batch_ - 1, within kBatchScanLimit) into `others`; returns the head.
-  std::shared_ptr<UrgentTask> TakeUrgentLocked(std::shared_ptr<UrgentTask>* others, int* count)
-      DEFORM_REQUIRES(mutex_);
+  // Unlinks the first urgent task that may run now (not of a split key whose batch is running,
+  // header comment) and, when it has a batch key, the queued tasks with the same key (at most
+  // max_batch_ - 1, within kBatchScanLimit) into `others`; returns the task, or null when every
+  // queued task must wait. `split_key`: the key of a split batch, now marked running, or null.
+  std::shared_ptr<UrgentTask> TakeUrgentLocked(std::shared_ptr<UrgentTask>* others, int* count,
+                                               const void** split_key) DEFORM_REQUIRES(mutex_);
+  // Whether `task` waits for its key's running split batch (header comment).
+  bool WaitsForItsBatchLocked(const UrgentTask& task) DEFORM_REQUIRES(mutex_);
 
   Mutex mutex_;
   CondVar wake_;
@@ -114,7 +129,10 @@ class WorkerPool {
   std::deque<std::function<void()>> background_ DEFORM_GUARDED_BY(mutex_);
   int running_background_ DEFORM_GUARDED_BY(mutex_) = 0;
   int idle_workers_ DEFORM_GUARDED_BY(mutex_) = 0;  // waiting for work
-  int max_background_ = 1;                          // set by the constructor, then read-only
+  // The keys of the split batches running (one entry per running batch; capacity reserved for
+  // every worker, so it never allocates).
+  std::vector<const void*> running_split_keys_ DEFORM_GUARDED_BY(mutex_);
+  int max_background_ = 1;  // set by the constructor, then read-only
   bool stopping_ DEFORM_GUARDED_BY(mutex_) = false;
 
   int thread_count_ = 0;  // set by the constructor, then read-only

@@ -517,6 +517,51 @@ TEST_F(DeformStreamTest, StreamsSolvedInOneBatchEachGetTheirOwnPosesFrame) {
   ExpectBackgroundStreamAlive();
 }
 
+// A mesh with a parallel plan (the threshold lowered to zero) on two workers: its streams' poses
+// that queue together are solved as one batch split over both workers (batch_frames > 1 and
+// solve_parts 2: the pool runs one such batch at a time, the other worker helping), and each
+// stream's frame is still its own pose's core result.
+TEST_F(DeformStreamTest, ABatchSplitOverTheWorkersGivesEachStreamItsOwnPosesFrame) {
+  service::ServerOptions options = TestServerOptions();
+  options.workers = 2;
+  options.batch_frames = 8;
+  options.parallel_solve_min_factor_bytes = 0;
+  StartServer(options);
+  constexpr int kVertices = 6000;
+  constexpr int kStreams = 6;
+  const std::string mesh_id = LoadPhantom(kVertices);
+  std::vector<std::unique_ptr<StreamRecorder>> recorders;
+  std::vector<std::unique_ptr<client::DeformStream>> streams;
+  OpenStreams(client_.get(), mesh_id, kStreams, /*keep_positions=*/true, &recorders, &streams);
+  std::vector<CoreResult> expected;  // per stream: the knee at 15 * (s + 1) degrees
+  for (int s = 0; s < kStreams; ++s) {
+    expected.push_back(CoreDeform(kVertices, "knee:flexion:" + std::to_string(15 * (s + 1))));
+  }
+  bool split_batch = false;
+  for (std::uint64_t round = 1; round <= 30 && !split_batch; ++round) {
+    for (int s = 0; s < kStreams; ++s) {
+      ASSERT_TRUE(streams[s]->SendPose(KneePose(round, 15.0 * (s + 1))));
+    }
+    for (int s = 0; s < kStreams; ++s) {
+      ASSERT_TRUE(recorders[s]->WaitForFrameWithSequence(round)) << s;
+      const v1::DeformFrame frame = recorders[s]->last_frame();
+      split_batch =
+          split_batch || (frame.timings().batch_frames() > 1 && frame.timings().solve_parts() == 2);
+      const CoreResult& core = expected[s];
+      EXPECT_LE(DistanceFromCore(client::DecodePositions(frame.positions()), core),
+                1e-6 * core.diagonal)
+          << "stream " << s << " round " << round << " batch " << frame.timings().batch_frames()
+          << " parts " << frame.timings().solve_parts();
+    }
+  }
+  EXPECT_TRUE(split_batch) << "no batch was ever split over the two workers";
+  for (auto& stream : streams) {
+    stream->Close();
+    EXPECT_TRUE(stream->Wait().ok());
+  }
+  ExpectBackgroundStreamAlive();
+}
+
 // With --batch-frames 1 every frame is solved alone.
 TEST_F(DeformStreamTest, ABatchLimitOfOneSolvesEveryFrameAlone) {
   service::ServerOptions options = TestServerOptions();
@@ -549,7 +594,10 @@ TEST_F(DeformStreamTest, ABatchLimitOfOneSolvesEveryFrameAlone) {
 // too, so the service has two streams open.
 class LoneFrameSplitTest : public DeformStreamTest {
  protected:
-  void ExpectThreeFramesSolvedIn(int workers, unsigned parts) {
+  // `parts`: every frame's solve_parts; with `until_split`, frames are solved (up to thirty) until
+  // one is split in `parts` and each one's parts is 1 or `parts` (whether a worker is idle at the
+  // moment a frame starts is up to the scheduler).
+  void ExpectThreeFramesSolvedIn(int workers, unsigned parts, bool until_split = false) {
     service::ServerOptions options = TestServerOptions();
     options.workers = workers;
     options.parallel_solve_min_factor_bytes = 0;
@@ -559,16 +607,24 @@ class LoneFrameSplitTest : public DeformStreamTest {
     StreamRecorder recorder(/*keep_positions=*/true);
     auto stream = client_->OpenStream(mesh_id, recorder.Callbacks());
     std::uint64_t sequence = 0;
-    for (const int degrees : {30, 75, 120}) {
+    bool split = false;
+    for (int i = 0; i < (until_split ? 30 : 3) && !(until_split && split); ++i) {
+      const int degrees = std::vector<int>{30, 75, 120}[i % 3];
       ASSERT_TRUE(stream->SendPose(KneePose(++sequence, degrees)));
       ASSERT_TRUE(recorder.WaitForFrameWithSequence(sequence));
       const v1::DeformFrame frame = recorder.last_frame();
-      EXPECT_EQ(frame.timings().solve_parts(), parts);
+      split = split || frame.timings().solve_parts() == parts;
+      if (until_split) {
+        EXPECT_TRUE(frame.timings().solve_parts() == 1 || frame.timings().solve_parts() == parts);
+      } else {
+        EXPECT_EQ(frame.timings().solve_parts(), parts);
+      }
       const CoreResult core = CoreDeform(kVertices, "knee:flexion:" + std::to_string(degrees));
       EXPECT_LE(DistanceFromCore(client::DecodePositions(frame.positions()), core),
                 1e-6 * core.diagonal)
           << degrees;
     }
+    EXPECT_TRUE(split) << "no frame was solved in " << parts << " parts";
     stream->Close();
     EXPECT_TRUE(stream->Wait().ok());
     ExpectBackgroundStreamAlive();
@@ -580,10 +636,16 @@ TEST_F(LoneFrameSplitTest, FramesSplitOverTheWorkersWhileFewerStreamsThanWorkers
   ExpectThreeFramesSolvedIn(/*workers=*/3, /*parts=*/3);
 }
 
-// As many streams open as workers (two of two): the cores have other streams' frames to solve, so
-// a lone frame is solved whole.
-TEST_F(LoneFrameSplitTest, FramesAreSolvedWholeWhileAsManyStreamsAsWorkersAreOpen) {
-  ExpectThreeFramesSolvedIn(/*workers=*/2, /*parts=*/1);
+// As many streams open as workers (two of two), but the other stream sends nothing, so the other
+// worker is idle when a frame starts (unless the scheduler has not yet let it wait): a lone frame
+// is split over it too.
+TEST_F(LoneFrameSplitTest, FramesSplitOverAnIdleWorkerAlsoWhileAsManyStreamsAsWorkersAreOpen) {
+  ExpectThreeFramesSolvedIn(/*workers=*/2, /*parts=*/2, /*until_split=*/true);
+}
+
+// One worker: nothing to split over, every frame solved whole.
+TEST_F(LoneFrameSplitTest, FramesAreSolvedWholeOnASingleWorker) {
+  ExpectThreeFramesSolvedIn(/*workers=*/1, /*parts=*/1);
 }
 
 // With the float32 threshold lowered to every mesh, the phantom's factor is stored in float32 (the

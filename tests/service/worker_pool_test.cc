@@ -14,8 +14,6 @@
 
 #include "tests/service/function_task.h"
 
-#include "tests/service/function_task.h"
-
 namespace deform::service {
 namespace {
 
@@ -155,6 +153,84 @@ TEST(WorkerPoolTest, ABatchIsSharedWithIdleWorkersOnlyInWorthwhileShares) {
   EXPECT_EQ(WorkerPool::BatchShare(12, 5, 16), 4);  // no more workers than shares of four
   EXPECT_EQ(WorkerPool::BatchShare(20, 0, 8), 8);   // the batch limit
   EXPECT_EQ(WorkerPool::BatchShare(20, 0, 1), 1);
+}
+
+// A task of a key whose batches split their work (a big mesh's frames): records its batch when the
+// batch ends, after `before_end` (if any) has returned.
+class SplitTask final : public UrgentTask {
+ public:
+  SplitTask(std::string name, const void* key, EventLog* log,
+            std::function<void()> before_end = nullptr)
+      : name_(std::move(name)), key_(key), log_(log), before_end_(std::move(before_end)) {}
+  void RunUrgent() override { RunUrgentBatch(nullptr, 0); }
+  const void* BatchKey() const override { return key_; }
+  bool SplitsItsBatches() const override { return true; }
+  void RunUrgentBatch(UrgentTask* const* others, int count) override {
+    if (before_end_) before_end_();
+    std::string batch = name_;
+    for (int i = 0; i < count; ++i) batch += "+" + static_cast<SplitTask*>(others[i])->name_;
+    log_->Add(batch);
+  }
+
+ private:
+  std::string name_;
+  const void* key_;
+  EventLog* log_;
+  std::function<void()> before_end_;
+};
+
+// Polls `condition` until it holds or a minute has passed.
+bool Eventually(const std::function<bool()>& condition) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (!condition()) {
+    if (std::chrono::steady_clock::now() > deadline) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  return true;
+}
+
+// While a split batch runs, the other worker leaves its key's queued tasks alone (they make the
+// next batch, all of them) but runs other work, and otherwise waits idle, where the batch's
+// helpers would find it.
+TEST(WorkerPoolTest, ASplitBatchRunsOneAtATimeWhileTheOtherWorkersWaitIdle) {
+  WorkerPool pool(2, 4);
+  EventLog log;
+  int mesh = 0;
+  Gate started, release;
+  pool.PostUrgent(std::make_shared<SplitTask>("s1", &mesh, &log, [&] {
+    started.Open();
+    release.Wait();
+  }));
+  ASSERT_TRUE(started.Wait());
+  pool.PostUrgent(std::make_shared<SplitTask>("s2", &mesh, &log));
+  pool.PostUrgent(std::make_shared<SplitTask>("s3", &mesh, &log));
+  pool.PostUrgent(std::make_shared<FunctionTask>([&] { log.Add("other"); }));
+  EXPECT_TRUE(Eventually([&] { return log.events().size() == 1; }));
+  EXPECT_TRUE(Eventually([&] { return pool.idle_workers() == 1; }));
+  EXPECT_EQ(log.events(), (std::vector<std::string>{"other"}));  // s2 and s3 still queued
+  release.Open();
+  pool.Shutdown();
+  EXPECT_EQ(log.events(), (std::vector<std::string>{"other", "s1", "s2+s3"}));
+}
+
+// A whole batch (the pool's limit) of a split key queued runs alongside the running one.
+TEST(WorkerPoolTest, AWholeBatchOfASplitKeyRunsAlongsideTheRunningOne) {
+  WorkerPool pool(2, 2);
+  EventLog log;
+  int mesh = 0;
+  Gate started, release;
+  pool.PostUrgent(std::make_shared<SplitTask>("s1", &mesh, &log, [&] {
+    started.Open();
+    release.Wait();
+  }));
+  ASSERT_TRUE(started.Wait());
+  pool.PostUrgent(std::make_shared<SplitTask>("s2", &mesh, &log));
+  pool.PostUrgent(std::make_shared<SplitTask>("s3", &mesh, &log));
+  EXPECT_TRUE(Eventually([&] { return log.events().size() == 1; }));
+  EXPECT_EQ(log.events(), (std::vector<std::string>{"s2+s3"}));
+  release.Open();
+  pool.Shutdown();
+  EXPECT_EQ(log.events(), (std::vector<std::string>{"s2+s3", "s1"}));
 }
 
 TEST(WorkerPoolTest, ALoneTaskWithAKeyRunsWithoutWaitingForOthers) {

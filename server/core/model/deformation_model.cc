@@ -342,24 +342,48 @@ bool DeformationModel::Deform(const MaterialFactorization& factorization, const 
   return true;
 }
 
-DeformBatchScratch DeformationModel::MakeBatchScratch(int max_frames) const {
+std::size_t DeformationModel::BatchSolveWorkSize(int max_frames,
+                                                 const ParallelSolvePlan* parallel) const {
+  const CholeskyFactor& factor = default_factorization_->factor();
+  const int frames = std::clamp(max_frames, 1, kMaxBatchFrames);
+  std::size_t doubles = factor.WorkSizeMany(3 * frames);
+  if (parallel != nullptr && parallel->parts >= 2) {
+    doubles = std::max(doubles, factor.WorkSizeFramesParallel(*parallel, frames));
+  }
+  return doubles;
+}
+
+DeformBatchScratch DeformationModel::MakeBatchScratch(int max_frames,
+                                                      const ParallelSolvePlan* parallel) const {
   DeformBatchScratch batch;
   batch.model_id_ = id_;
   batch.max_frames = std::clamp(max_frames, 1, kMaxBatchFrames);
-  batch.solve_work.resize(default_factorization_->factor().WorkSizeMany(3 * batch.max_frames));
+  batch.solve_work.resize(BatchSolveWorkSize(batch.max_frames, parallel));
   return batch;
+}
+
+std::size_t DeformationModel::BatchScratchBytes(int max_frames,
+                                                const ParallelSolvePlan* parallel) const {
+  return sizeof(double) * BatchSolveWorkSize(max_frames, parallel);
+}
+
+bool DeformationModel::RefusesBatch(const MaterialFactorization& factorization,
+                                    DeformScratch* const* scratches, int count,
+                                    const DeformBatchScratch& batch) const {
+  const bool valid = count >= 1 && count <= batch.max_frames && batch.model_id_ == id_;
+  assert(valid && "a batch of another model or of a size its scratch does not hold");
+  if (!valid) return true;
+  for (int f = 0; f < count; ++f) {
+    if (RefusesForeign(factorization, *scratches[f])) return true;
+  }
+  return false;
 }
 
 bool DeformationModel::DeformBatch(const MaterialFactorization& factorization,
                                    const Pose* const* poses, DeformScratch* const* scratches,
                                    int count, DeformBatchScratch* batch,
                                    DeformTimings* timings) const {
-  const bool valid = count >= 1 && count <= batch->max_frames && batch->model_id_ == id_;
-  assert(valid && "a batch of another model or of a size its scratch does not hold");
-  if (!valid) return false;
-  for (int f = 0; f < count; ++f) {
-    if (RefusesForeign(factorization, *scratches[f])) return false;
-  }
+  if (RefusesBatch(factorization, scratches, count, *batch)) return false;
   if (factorization.linear_response() != nullptr || count == 1) {
     DeformTimings sum;
     for (int f = 0; f < count; ++f) {
@@ -389,11 +413,6 @@ bool DeformationModel::DeformBatch(const MaterialFactorization& factorization,
     timings->solve = SecondsSince(solve_start);
   }
   return true;
-}
-
-std::size_t DeformationModel::BatchScratchBytes(int max_frames) const {
-  const int columns = 3 * std::clamp(max_frames, 1, kMaxBatchFrames);
-  return sizeof(double) * default_factorization_->factor().WorkSizeMany(columns);
 }
 
 bool DeformationModel::AssembleRightHandSide(const MaterialFactorization& factorization,
@@ -513,6 +532,49 @@ bool DeformationModel::DeformParallel(const MaterialFactorization& factorization
   const auto solve_start = Clock::now();
   const Status solved = factorization.factor().Solve3Parallel(
       plan, scratch->solution.data(), scratch->solution.data(), work, runner);
+  assert(solved.ok());
+  (void)solved;
+  if (timings != nullptr) {
+    timings->right_hand_side = std::chrono::duration<double>(solve_start - start).count();
+    timings->solve = SecondsSince(solve_start);
+  }
+  return true;
+}
+
+struct DeformationModel::ParallelBatchAssembly {
+  const DeformationModel* model;
+  const MaterialFactorization* factorization;
+  const Pose* const* poses;
+  DeformScratch* const* scratches;
+
+  // Frame `index`'s right-hand side, whole, on the thread that takes it.
+  static void Assemble(void* context, int index) {
+    const auto& a = *static_cast<const ParallelBatchAssembly*>(context);
+    a.model->AssembleOwnedRightHandSide(*a.factorization, *a.poses[index], a.scratches[index]);
+  }
+};
+
+bool DeformationModel::DeformBatchParallel(const MaterialFactorization& factorization,
+                                           const Pose* const* poses,
+                                           DeformScratch* const* scratches, int count,
+                                           DeformBatchScratch* batch, const ParallelSolvePlan& plan,
+                                           ParallelRunner* runner, DeformTimings* timings) const {
+  if (factorization.linear_response() != nullptr || plan.parts < 2) {
+    return DeformBatch(factorization, poses, scratches, count, batch, timings);
+  }
+  if (RefusesBatch(factorization, scratches, count, *batch)) return false;
+  const bool fits =
+      batch->solve_work.size() >= factorization.factor().WorkSizeFramesParallel(plan, count);
+  assert(fits && "a batch scratch made without this plan");
+  if (!fits) return false;
+  const auto start = Clock::now();
+  ParallelBatchAssembly assembly{this, &factorization, poses, scratches};
+  runner->Run(count, &ParallelBatchAssembly::Assemble, &assembly);
+  double* solutions[kMaxBatchFrames];
+  for (int f = 0; f < count; ++f) solutions[f] = scratches[f]->solution.data();
+  const auto solve_start = Clock::now();
+  const Status solved = factorization.factor().SolveFramesParallel(
+      plan, solutions, solutions, count, batch->solve_work.data(), runner);
   assert(solved.ok());
   (void)solved;
   if (timings != nullptr) {

@@ -101,7 +101,9 @@ struct DeformScratch {
 // batches (a worker).
 struct DeformBatchScratch {
   int max_frames = 0;
-  std::vector<double> solve_work;  // CholeskyFactor::WorkSizeMany(3 * max_frames)
+  // CholeskyFactor::WorkSizeMany(3 * max_frames), or with a parallel plan at least
+  // WorkSizeFramesParallel(plan, max_frames) as well.
+  std::vector<double> solve_work;
 
  private:
   friend class DeformationModel;
@@ -189,8 +191,10 @@ class DeformationModel {
 
   // Frames solved together at most: three columns each, CholeskyFactor::SolveMany's limit.
   static constexpr int kMaxBatchFrames = kMaxSolveColumns / 3;
-  // A batch scratch for up to `max_frames` frames, clamped to [1, kMaxBatchFrames].
-  DeformBatchScratch MakeBatchScratch(int max_frames) const;
+  // A batch scratch for up to `max_frames` frames, clamped to [1, kMaxBatchFrames]; with a
+  // `parallel` plan (of PlanParallel, parts >= 2) also for DeformBatchParallel with that plan.
+  DeformBatchScratch MakeBatchScratch(int max_frames,
+                                      const ParallelSolvePlan* parallel = nullptr) const;
   // Deforms `count` frames at once, frame f's poses[f] into scratches[f] (distinct scratches of
   // this model): each right-hand side is assembled as Deform() does, then all are solved in one
   // pass over the factor, so the factor's bytes are read once for the batch. Each frame equals
@@ -211,8 +215,19 @@ class DeformationModel {
   bool DeformParallel(const MaterialFactorization& factorization, const Pose& pose,
                       DeformScratch* scratch, const ParallelSolvePlan& plan, double* work,
                       ParallelRunner* runner, DeformTimings* timings = nullptr) const;
-  // The bytes MakeBatchScratch(max_frames) allocates.
-  std::size_t BatchScratchBytes(int max_frames) const;
+  // DeformBatch() on several threads: the frames' right-hand sides assembled side by side (each
+  // frame's on one thread), then the batched solve split by subtrees
+  // (CholeskyFactor::SolveFramesParallel), both through `runner`. `plan` as DeformParallel's, and
+  // `batch` made by MakeBatchScratch with it (or one with as many parts). Each frame equals
+  // Deform()'s to round-off (1e-12 of the diagonal, tested). With a linear response or a plan
+  // without parts it is DeformBatch(). Allocation-free; refuses what DeformBatch() refuses and a
+  // batch scratch too small for the plan.
+  bool DeformBatchParallel(const MaterialFactorization& factorization, const Pose* const* poses,
+                           DeformScratch* const* scratches, int count, DeformBatchScratch* batch,
+                           const ParallelSolvePlan& plan, ParallelRunner* runner,
+                           DeformTimings* timings = nullptr) const;
+  // The bytes MakeBatchScratch(max_frames, parallel) allocates.
+  std::size_t BatchScratchBytes(int max_frames, const ParallelSolvePlan* parallel = nullptr) const;
 
   // The two halves of the solving path of Deform(), for tests and diagnostics (they never use the
   // linear response). AssembleRightHandSide writes A^T b ((n + m) by 3) into scratch->solution;
@@ -314,7 +329,13 @@ class DeformationModel {
   void PrepareSlotRotations(DeformScratch* scratch) const;
   void RotateDeltasOf(const MaterialFactorization& factorization, DeformScratch* scratch, int first,
                       int end) const;
-  struct ParallelAssembly;  // DeformParallel's parts
+  struct ParallelAssembly;       // DeformParallel's parts
+  struct ParallelBatchAssembly;  // DeformBatchParallel's parts
+  // The doubles of a batch scratch's solve work (MakeBatchScratch).
+  std::size_t BatchSolveWorkSize(int max_frames, const ParallelSolvePlan* parallel) const;
+  // What DeformBatch and DeformBatchParallel refuse (false): see DeformBatch.
+  bool RefusesBatch(const MaterialFactorization& factorization, DeformScratch* const* scratches,
+                    int count, const DeformBatchScratch& batch) const;
   // scratch->solution's rows of anchors [first, end) (indices into system_.anchors) +=
   // anchor_weight^2 * their posed targets, through scratch->slot_rotations (PrepareSlotRotations
   // first). No allocation.

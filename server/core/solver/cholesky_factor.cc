@@ -202,6 +202,33 @@ Status CholeskyFactor::Solve3Parallel(const ParallelSolvePlan& plan, const doubl
   return Status::Ok();
 }
 
+std::size_t CholeskyFactor::WorkSizeFramesParallel(const ParallelSolvePlan& plan,
+                                                   int frames) const {
+  return symbolic_ ? static_cast<std::size_t>(
+                         ParallelSolveFramesWorkSize(symbolic_->n_, plan, std::max(frames, 1)))
+                   : 0;
+}
+
+Status CholeskyFactor::SolveFramesParallel(const ParallelSolvePlan& plan, const double* const* b,
+                                           double* const* x, int frames, double* work,
+                                           ParallelRunner* runner) const {
+  return SolveFramesParallel(plan, b, x, frames, work, runner, BestSolveKernel());
+}
+
+Status CholeskyFactor::SolveFramesParallel(const ParallelSolvePlan& plan, const double* const* b,
+                                           double* const* x, int frames, double* work,
+                                           ParallelRunner* runner, SolveKernel kernel) const {
+  if (!symbolic_) return Status::FailedPrecondition("solve with an empty factor");
+  if (plan.parts < 2) return Status::InvalidArgument("a parallel solve needs a plan with parts");
+  if (frames < 1 || 3 * frames > kMaxSolveColumns) {
+    return Status::InvalidArgument("a batched solve takes 1 to " +
+                                   std::to_string(kMaxSolveColumns / 3) + " frames, not " +
+                                   std::to_string(frames));
+  }
+  ParallelSolveFrames(View(), plan, kernel, b, x, frames, work, runner);
+  return Status::Ok();
+}
+
 SupernodalFactorView CholeskyFactor::View() const {
   const SymbolicCholesky& s = *symbolic_;
   SupernodalFactorView view;

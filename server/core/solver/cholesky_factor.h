@@ -67,6 +67,17 @@ class CholeskyFactor {
                         ParallelRunner* runner) const;
   Status Solve3Parallel(const ParallelSolvePlan& plan, const double* b, double* x, double* work,
                         ParallelRunner* runner, SolveKernel kernel) const;
+  // SolveFrames on several threads (ParallelSolveFrames) as Solve3Parallel splits Solve3: `work`
+  // holds WorkSizeFramesParallel(plan, frames) doubles. Each frame matches its Solve3 to
+  // round-off. Allocation-free; const and thread-safe. FAILED_PRECONDITION for an empty factor,
+  // INVALID_ARGUMENT for a plan without parts or a frame count out of range.
+  std::size_t WorkSizeFramesParallel(const ParallelSolvePlan& plan, int frames) const;
+  Status SolveFramesParallel(const ParallelSolvePlan& plan, const double* const* b,
+                             double* const* x, int frames, double* work,
+                             ParallelRunner* runner) const;
+  Status SolveFramesParallel(const ParallelSolvePlan& plan, const double* const* b,
+                             double* const* x, int frames, double* work, ParallelRunner* runner,
+                             SolveKernel kernel) const;
   // Doubles of scratch Solve3 needs (SolveWorkSize: a four-double row per unknown plus room for
   // the widest supernode). The same for every factor of one symbolic analysis.
   std::size_t WorkSize() const;

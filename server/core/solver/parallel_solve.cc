@@ -35,15 +35,19 @@ struct SolveContext {
   int Count(int part) const { return plan->part_offsets[part + 1] - plan->part_offsets[part]; }
 };
 
+// Calls body(column) for every column of part `part`'s supernodes.
+template <typename Body>
+void ForEachColumnOf(const SupernodalFactorView& f, const ParallelSolvePlan& plan, int part,
+                     Body&& body) {
+  for (int i = plan.part_offsets[part]; i < plan.part_offsets[part + 1]; ++i) {
+    const int s = plan.part_supernodes[i];
+    for (int col = f.supernode_columns[s]; col < f.supernode_columns[s + 1]; ++col) body(col);
+  }
+}
+
 template <typename Body>
 void ForEachColumn(const SolveContext& c, int part, Body&& body) {
-  const int* ids = c.Supernodes(part);
-  for (int i = 0; i < c.Count(part); ++i) {
-    for (int col = c.factor->supernode_columns[ids[i]];
-         col < c.factor->supernode_columns[ids[i] + 1]; ++col) {
-      body(col);
-    }
-  }
+  ForEachColumnOf(*c.factor, *c.plan, part, body);
 }
 
 void Gather(const SupernodalFactorView& f, const double* b, int row, double* y) {
@@ -92,6 +96,74 @@ void BackwardPart(void* context, int part) {
   const SupernodalFactorView& f = *c.factor;
   c.backward(f, c.Supernodes(part), c.Count(part), c.Solution(), c.Buffers(part).planar);
   ForEachColumn(c, part, [&](int col) { Scatter(f, c.Solution(), col, c.x); });
+}
+
+// ParallelSolveFrames' state: part p's batch rows at Rows(p) (part 0's are the solution's).
+struct FramesContext {
+  const SupernodalFactorView* factor;
+  const ParallelSolvePlan* plan;
+  const SolveKernelFunctions* passes;
+  const double* const* b;
+  double* const* x;
+  int frames;
+  int stride;    // doubles per batch row
+  double* work;  // aligned to a batch vector
+
+  double* Rows(int part) const {
+    return work + static_cast<std::ptrdiff_t>(part) * stride * factor->size;
+  }
+  double* Row(double* rows, int row) const {
+    return rows + static_cast<std::ptrdiff_t>(stride) * row;
+  }
+  const int* Supernodes(int part) const {
+    return plan->part_supernodes.data() + plan->part_offsets[part];
+  }
+  int Count(int part) const { return plan->part_offsets[part + 1] - plan->part_offsets[part]; }
+  // The frames' right-hand sides of unknown permutation[row] into `rows`' row, its padding zeroed.
+  void Gather(int row, double* rows) const {
+    const std::ptrdiff_t from = 3 * static_cast<std::ptrdiff_t>(factor->permutation[row]);
+    double* t = Row(rows, row);
+    for (int f = 0; f < frames; ++f) {
+      t[3 * f] = b[f][from];
+      t[3 * f + 1] = b[f][from + 1];
+      t[3 * f + 2] = b[f][from + 2];
+    }
+    std::fill(t + 3 * frames, t + stride, 0.0);
+  }
+  void Scatter(int row, const double* rows) const {
+    const std::ptrdiff_t to = 3 * static_cast<std::ptrdiff_t>(factor->permutation[row]);
+    const double* t = rows + static_cast<std::ptrdiff_t>(stride) * row;
+    for (int f = 0; f < frames; ++f) {
+      x[f][to] = t[3 * f];
+      x[f][to + 1] = t[3 * f + 1];
+      x[f][to + 2] = t[3 * f + 2];
+    }
+  }
+};
+
+// ForwardPart's batched counterpart.
+void ForwardFramesPart(void* context, int part) {
+  const FramesContext& c = *static_cast<const FramesContext*>(context);
+  double* own = c.Rows(part);
+  ForEachColumnOf(*c.factor, *c.plan, part, [&](int col) { c.Gather(col, own); });
+  if (part > 0) {
+    for (const int col : c.plan->top_columns) std::fill_n(c.Row(own, col), c.stride, 0.0);
+  }
+  c.passes->forward_list_many(*c.factor, c.Supernodes(part), c.Count(part), own, 3 * c.frames);
+  if (part > 0) {
+    double* solution = c.Rows(0);
+    ForEachColumnOf(*c.factor, *c.plan, part,
+                    [&](int col) { std::copy_n(c.Row(own, col), c.stride, c.Row(solution, col)); });
+  }
+}
+
+// BackwardPart's batched counterpart.
+void BackwardFramesPart(void* context, int part) {
+  const FramesContext& c = *static_cast<const FramesContext*>(context);
+  double* solution = c.Rows(0);
+  c.passes->backward_list_many(*c.factor, c.Supernodes(part), c.Count(part), solution,
+                               3 * c.frames);
+  ForEachColumnOf(*c.factor, *c.plan, part, [&](int col) { c.Scatter(col, solution); });
 }
 
 }  // namespace
@@ -274,6 +346,42 @@ void ParallelSolve3(const SupernodalFactorView& f, const ParallelSolvePlan& plan
   c.backward(f, plan.top.data(), top, solution, planar);
   for (const int col : plan.top_columns) Scatter(f, solution, col, x);
   runner->Run(plan.parts, &BackwardPart, &c);
+}
+
+std::int64_t ParallelSolveFramesWorkSize(int size, const ParallelSolvePlan& plan, int frames) {
+  return plan.parts * (SolveManyWorkSize(size, 3 * frames) - kSolveBatchLanes) + kSolveBatchLanes;
+}
+
+void ParallelSolveFrames(const SupernodalFactorView& f, const ParallelSolvePlan& plan,
+                         SolveKernel kernel, const double* const* b, double* const* x, int frames,
+                         double* work, ParallelRunner* runner) {
+  const SolveKernelFunctions& passes = SolveKernelFunctionsFor(kernel);
+  constexpr std::uintptr_t kAlignment = kSolveBatchLanes * sizeof(double);
+  const std::uintptr_t misalignment = reinterpret_cast<std::uintptr_t>(work) % kAlignment;
+  FramesContext c{&f,
+                  &plan,
+                  &passes,
+                  b,
+                  x,
+                  frames,
+                  BatchRowStride(passes.batch_lanes, 3 * frames),
+                  work + (misalignment ? (kAlignment - misalignment) / sizeof(double) : 0)};
+  double* solution = c.Rows(0);
+  for (const int col : plan.top_columns) c.Gather(col, solution);
+  runner->Run(plan.parts, &ForwardFramesPart, &c);
+  for (int part = 1; part < plan.parts; ++part) {
+    const double* other = c.Rows(part);
+    for (const int col : plan.top_columns) {
+      double* target = c.Row(solution, col);
+      const double* source = other + static_cast<std::ptrdiff_t>(c.stride) * col;
+      for (int k = 0; k < 3 * frames; ++k) target[k] += source[k];
+    }
+  }
+  const int top = static_cast<int>(plan.top.size());
+  passes.forward_list_many(f, plan.top.data(), top, solution, 3 * frames);
+  passes.backward_list_many(f, plan.top.data(), top, solution, 3 * frames);
+  for (const int col : plan.top_columns) c.Scatter(col, solution);
+  runner->Run(plan.parts, &BackwardFramesPart, &c);
 }
 
 }  // namespace deform

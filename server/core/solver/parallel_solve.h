@@ -1,4 +1,5 @@
-// The three-column triangular solve of one right-hand side on several threads.
+// The triangular solves on several threads: the three-column solve of one right-hand side, and the
+// batched solve of several frames.
 //
 // The supernodal elimination tree's disjoint subtrees are independent: in the forward pass
 // (L y = b) a supernode updates only its ancestors' rows, in the backward pass (L^T x = y) it reads
@@ -31,6 +32,9 @@ class ParallelRunner {
   // Calls part(context, i) exactly once for every i in [0, count), on the calling thread or
   // others, and returns once every call has returned. Allocation-free in the implementations here.
   virtual void Run(int count, void (*part)(void* context, int index), void* context) = 0;
+  // How many other threads could take parts at this moment (a hint: it may change as soon as it
+  // is read); callers split work only when it pays, e.g. when another thread is free.
+  virtual int IdleHelpers() { return 0; }
 
  protected:
   ~ParallelRunner() = default;
@@ -54,6 +58,7 @@ class ThreadTeam final : public ParallelRunner {
   ThreadTeam(const ThreadTeam&) = delete;
   ThreadTeam& operator=(const ThreadTeam&) = delete;
   void Run(int count, void (*part)(void* context, int index), void* context) override;
+  int IdleHelpers() override { return static_cast<int>(helpers_.size()); }
 
  private:
   void Help();
@@ -102,5 +107,17 @@ std::int64_t ParallelSolveWorkSize(int size, const ParallelSolvePlan& plan);
 void ParallelSolve3(const SupernodalFactorView& factor, const ParallelSolvePlan& plan,
                     SolveKernel kernel, const double* b, double* x, double* work,
                     ParallelRunner* runner);
+
+// Doubles of work ParallelSolveFrames needs for `frames` frames: per part a batch row per unknown
+// (as wide as any kernel's: SolveManyWorkSize's), and slack to align the rows.
+std::int64_t ParallelSolveFramesWorkSize(int size, const ParallelSolvePlan& plan, int frames);
+
+// The batched solve of `frames` frames (1 to kMaxSolveColumns / 3; b[f] and x[f] as
+// SolveFramesFunction's) split as ParallelSolve3 splits Solve3: the parts' subtrees on `runner`'s
+// threads, each on batch rows of its own (part 0 on the solution's), the top on the calling thread.
+// Each frame equals its Solve3 to round-off (the sums run in another order). Allocation-free.
+void ParallelSolveFrames(const SupernodalFactorView& factor, const ParallelSolvePlan& plan,
+                         SolveKernel kernel, const double* const* b, double* const* x, int frames,
+                         double* work, ParallelRunner* runner);
 
 }  // namespace deform

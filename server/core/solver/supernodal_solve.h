@@ -91,6 +91,15 @@ SolveKernel BestSolveKernel();
 using SupernodeListPass = void (*)(const SupernodalFactorView& factor, const int* supernodes,
                                    int count, double* y, double* planar_buffer);
 
+// The same for the batched passes: solution rows of `columns` right-hand sides, each row padded
+// to BatchRowStride(batch_lanes, columns) doubles (the kernel's batch_lanes) and aligned to it.
+using SupernodeListManyPass = void (*)(const SupernodalFactorView& factor, const int* supernodes,
+                                       int count, double* y, int columns);
+// Doubles per solution row of a batch of `columns` with `lanes` doubles per batch vector.
+inline int BatchRowStride(int lanes, int columns) {
+  return lanes * ((columns + lanes - 1) / lanes);
+}
+
 // One kernel's passes: supernodal_solve_impl.h compiled for its instruction set.
 struct SolveKernelFunctions {
   Solve3Function solve3;
@@ -98,6 +107,9 @@ struct SolveKernelFunctions {
   SolveFramesFunction solve_frames;
   SupernodeListPass forward_list;
   SupernodeListPass backward_list;
+  int batch_lanes;  // doubles per batch vector (at most kSolveBatchLanes)
+  SupernodeListManyPass forward_list_many;
+  SupernodeListManyPass backward_list_many;
 };
 // The kernel's passes; it must be available.
 const SolveKernelFunctions& SolveKernelFunctionsFor(SolveKernel kernel);

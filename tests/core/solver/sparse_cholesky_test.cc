@@ -391,6 +391,98 @@ TEST_P(SolveKernelTest, ParallelSolveMatchesSolve3) {
             StatusCode::kFailedPrecondition);
 }
 
+// The parallel batched solve: for every frame count and number of parts, on threads or on one,
+// each frame equals its Solve3 to 1e-12 of its norm, in place too (x[f] == b[f]); the work is
+// poisoned (a NaN read would show); a plan without parts or a frame count out of range is
+// refused with nothing written.
+TEST_P(SolveKernelTest, ParallelFramesMatchSolve3) {
+  if (!SolveKernelAvailable(GetParam())) {
+    GTEST_SKIP() << SolveKernelName(GetParam()) << " is not available on this build or CPU";
+  }
+  using Rhs = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+  constexpr int kMostFrames = kMaxSolveColumns / 3;
+  ThreadPerPartRunner threads;
+  SerialRunner serial;
+  std::vector<std::pair<std::string, ColMajorMatrix>> cases;
+  for (const int n : {37, 303, 2000})
+    cases.emplace_back("random " + std::to_string(n), RandomSpdMatrix(n, 4, 600 + n));
+  cases.emplace_back("grid 50", GridMatrix(50));
+  for (const auto& [name, a] : cases) {
+    auto symbolic = SymbolicCholesky::Analyze(a, Ordering::kMetis);
+    ASSERT_TRUE(symbolic.ok()) << symbolic.status().ToString();
+    auto factor = CholeskyFactor::Factorize(*symbolic, a);
+    ASSERT_TRUE(factor.ok()) << factor.status().ToString();
+    const int n = static_cast<int>(a.rows());
+    std::vector<Rhs> b, expected;
+    std::vector<double> work3(factor->WorkSize());
+    for (int f = 0; f < kMostFrames; ++f) {
+      b.push_back(Rhs::Random(n, 3));
+      expected.emplace_back(n, 3);
+      ASSERT_TRUE(factor->Solve3(b[f].data(), expected[f].data(), work3.data(), GetParam()).ok());
+    }
+    for (const int parts : {2, 3}) {
+      const ParallelSolvePlan plan = factor->PlanParallel(parts);
+      ASSERT_EQ(plan.parts, parts) << name;
+      for (int frames = 1; frames <= kMostFrames; ++frames) {
+        std::vector<double> work(factor->WorkSizeFramesParallel(plan, frames), std::nan(""));
+        for (ParallelRunner* runner :
+             {static_cast<ParallelRunner*>(&threads), static_cast<ParallelRunner*>(&serial)}) {
+          std::vector<Rhs> x(b.begin(), b.begin() + frames);
+          std::vector<const double*> in;
+          std::vector<double*> out;
+          for (int f = 0; f < frames; ++f) {
+            in.push_back(b[f].data());
+            out.push_back(x[f].data());
+            x[f].setConstant(std::nan(""));
+          }
+          ASSERT_TRUE(factor
+                          ->SolveFramesParallel(plan, in.data(), out.data(), frames, work.data(),
+                                                runner, GetParam())
+                          .ok());
+          for (int f = 0; f < frames; ++f) {
+            EXPECT_LE((x[f] - expected[f]).norm(), 1e-12 * expected[f].norm())
+                << name << ", " << parts << " parts, frame " << f << " of " << frames;
+          }
+          std::vector<Rhs> in_place(b.begin(), b.begin() + frames);
+          std::vector<double*> both;
+          for (Rhs& frame : in_place) both.push_back(frame.data());
+          ASSERT_TRUE(factor
+                          ->SolveFramesParallel(plan, both.data(), both.data(), frames, work.data(),
+                                                runner, GetParam())
+                          .ok());
+          for (int f = 0; f < frames; ++f) {
+            EXPECT_LE((in_place[f] - expected[f]).norm(), 1e-12 * expected[f].norm())
+                << name << ", in place, frame " << f << " of " << frames;
+          }
+        }
+      }
+    }
+    const ParallelSolvePlan plan = factor->PlanParallel(2);
+    std::vector<double> work(factor->WorkSizeFramesParallel(plan, kMostFrames));
+    Rhs untouched = b[0];
+    std::vector<double*> both(kMostFrames + 1, untouched.data());
+    EXPECT_EQ(
+        factor->SolveFramesParallel(plan, both.data(), both.data(), 0, work.data(), &serial).code(),
+        StatusCode::kInvalidArgument);
+    EXPECT_EQ(factor
+                  ->SolveFramesParallel(plan, both.data(), both.data(), kMostFrames + 1,
+                                        work.data(), &serial)
+                  .code(),
+              StatusCode::kInvalidArgument);
+    EXPECT_EQ(factor
+                  ->SolveFramesParallel(ParallelSolvePlan(), both.data(), both.data(), 1,
+                                        work.data(), &serial)
+                  .code(),
+              StatusCode::kInvalidArgument);
+    EXPECT_EQ((untouched - b[0]).norm(), 0) << name;
+  }
+  double* none[1] = {nullptr};
+  EXPECT_EQ(CholeskyFactor()
+                .SolveFramesParallel(ParallelSolvePlan(), none, none, 1, nullptr, &serial)
+                .code(),
+            StatusCode::kFailedPrecondition);
+}
+
 // A float32 factor (RoundedToFloat32): every pass (three columns, many columns, the parallel
 // parts) reads the same rounded values, so they agree with each other to 1e-12 as the double ones
 // do; against the double factor they differ by the rounding only (well within 1e-5 on these
@@ -444,6 +536,16 @@ TEST_P(SolveKernelTest, Float32FactorSolvesWithItsRoundedValues) {
         rounded.Solve3Parallel(plan, b.data(), parallel.data(), work.data(), &threads, GetParam())
             .ok());
     EXPECT_LE((parallel - x).norm(), 1e-12 * x.norm()) << name;
+    // The parallel batched solve on threads: two frames.
+    std::vector<double> frames_work(rounded.WorkSizeFramesParallel(plan, 2), std::nan(""));
+    Rhs first(n, 3), second(n, 3);
+    const double* in[2] = {b.data(), b.data()};
+    double* out[2] = {first.data(), second.data()};
+    ASSERT_TRUE(
+        rounded.SolveFramesParallel(plan, in, out, 2, frames_work.data(), &threads, GetParam())
+            .ok());
+    EXPECT_LE((first - x).norm(), 1e-12 * x.norm()) << name;
+    EXPECT_LE((second - x).norm(), 1e-12 * x.norm()) << name;
   }
   EXPECT_FALSE(CholeskyFactor().RoundedToFloat32().stores_float32());
   EXPECT_EQ(CholeskyFactor().RoundedToFloat32().size(), 0);

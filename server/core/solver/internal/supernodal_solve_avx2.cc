@@ -6,7 +6,8 @@ namespace deform {
 
 // Declared (and picked) in supernodal_solve.cc.
 extern const SolveKernelFunctions kAvx2FmaSolveKernel;
-const SolveKernelFunctions kAvx2FmaSolveKernel = {&Solve3Impl, &SolveManyImpl, &SolveFramesImpl,
-                                                  &ForwardListImpl, &BackwardListImpl};
+const SolveKernelFunctions kAvx2FmaSolveKernel = {
+    &Solve3Impl,       &SolveManyImpl, &SolveFramesImpl,     &ForwardListImpl,
+    &BackwardListImpl, kBatchLanes,    &ForwardListManyImpl, &BackwardListManyImpl};
 
 }  // namespace deform

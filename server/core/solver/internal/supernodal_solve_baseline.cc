@@ -5,7 +5,8 @@ namespace deform {
 
 // Declared (and picked) in supernodal_solve.cc.
 extern const SolveKernelFunctions kBaselineSolveKernel;
-const SolveKernelFunctions kBaselineSolveKernel = {&Solve3Impl, &SolveManyImpl, &SolveFramesImpl,
-                                                   &ForwardListImpl, &BackwardListImpl};
+const SolveKernelFunctions kBaselineSolveKernel = {
+    &Solve3Impl,       &SolveManyImpl, &SolveFramesImpl,     &ForwardListImpl,
+    &BackwardListImpl, kBatchLanes,    &ForwardListManyImpl, &BackwardListManyImpl};
 
 }  // namespace deform

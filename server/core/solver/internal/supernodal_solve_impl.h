@@ -323,9 +323,9 @@ template <Pass kPass, typename Value>
 inline void PrefetchFactor(const SupernodeBlock<Value>& s, const Value* values,
                            std::ptrdiff_t count) {
   if (!s.prefetch) return;
-  const std::uintptr_t begin =
-      kPass == Pass::kForward ? reinterpret_cast<std::uintptr_t>(values) + kPrefetchBytes
-                              : reinterpret_cast<std::uintptr_t>(values) - kPrefetchBytes;
+  const std::uintptr_t begin = kPass == Pass::kForward
+                                   ? reinterpret_cast<std::uintptr_t>(values) + kPrefetchBytes
+                                   : reinterpret_cast<std::uintptr_t>(values) - kPrefetchBytes;
   const std::ptrdiff_t bytes = count * static_cast<std::ptrdiff_t>(sizeof(Value));
   for (std::ptrdiff_t offset = 0; offset < bytes; offset += 64) PrefetchLine(begin + offset);
 }
@@ -968,6 +968,35 @@ void SolveFramesImpl(const SupernodalFactorView& f, const double* const* b, doub
             target[2] = row[3 * frame + 2];
           }
         });
+  });
+}
+
+// One direction's batched pass over the listed supernodes only (forward: ascending, backward:
+// taken in descending order), on solution rows of BatchVecsFor(columns) batch vectors each: the
+// parallel batched solve's parts (parallel_solve.h).
+void ForwardListManyImpl(const SupernodalFactorView& f, const int* supernodes, int count, double* y,
+                         int columns) {
+  WithCount<BatchVecsFor(kMaxSolveColumns)>(BatchVecsFor(columns), [&](auto vecs) {
+    constexpr int kVecs = decltype(vecs)::value;
+    WithValueType(f, [&](auto value) {
+      using Value = decltype(value);
+      for (int i = 0; i < count; ++i) {
+        ForwardSupernodeMany<Value, kVecs>(BlockOf<Value>(f, supernodes[i]), y);
+      }
+    });
+  });
+}
+
+void BackwardListManyImpl(const SupernodalFactorView& f, const int* supernodes, int count,
+                          double* y, int columns) {
+  WithCount<BatchVecsFor(kMaxSolveColumns)>(BatchVecsFor(columns), [&](auto vecs) {
+    constexpr int kVecs = decltype(vecs)::value;
+    WithValueType(f, [&](auto value) {
+      using Value = decltype(value);
+      for (int i = count - 1; i >= 0; --i) {
+        BackwardSupernodeMany<Value, kVecs>(BlockOf<Value>(f, supernodes[i]), y);
+      }
+    });
   });
 }
 
