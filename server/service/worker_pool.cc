@@ -23,6 +23,7 @@ WorkerPool::WorkerPool(int threads, int max_batch) {
   {
     MutexLock lock(&mutex_);
     running_split_keys_.reserve(static_cast<std::size_t>(threads));
+    running_split_queued_.reserve(static_cast<std::size_t>(threads));
   }
   threads_.reserve(threads);
   for (int i = 0; i < threads; ++i) threads_.emplace_back([this] { WorkerLoop(); });
@@ -87,21 +88,27 @@ int WorkerPool::BatchShare(int queued, int idle_workers, int max_batch) {
   return std::clamp((queued + workers - 1) / workers, 1, std::max(max_batch, 1));
 }
 
+void WorkerPool::CountQueuedOfRunningLocked() {
+  running_split_queued_.assign(running_split_keys_.size(), 0);  // within the reserved capacity
+  if (running_split_keys_.empty()) return;
+  int scanned = 0;
+  for (const UrgentTask* t = urgent_head_.get(); t != nullptr && scanned < kBatchScanLimit;
+       t = t->next_urgent_.get(), ++scanned) {
+    const void* key = t->BatchKey();
+    for (std::size_t i = 0; i < running_split_keys_.size(); ++i) {
+      if (running_split_keys_[i] == key) ++running_split_queued_[i];
+    }
+  }
+}
+
 bool WorkerPool::WaitsForItsBatchLocked(const UrgentTask& task) {
   if (running_split_keys_.empty() || max_batch_ <= 1) return false;
   const void* key = task.BatchKey();
   if (key == nullptr || !task.SplitsItsBatches()) return false;
-  if (std::find(running_split_keys_.begin(), running_split_keys_.end(), key) ==
-      running_split_keys_.end()) {
-    return false;
-  }
-  int queued = 0;  // a whole batch of the key queued runs alongside
-  int scanned = 0;
-  for (const UrgentTask* t = urgent_head_.get(); t != nullptr && scanned < kBatchScanLimit;
-       t = t->next_urgent_.get(), ++scanned) {
-    if (t->BatchKey() == key && ++queued >= max_batch_) return false;
-  }
-  return true;
+  const auto running = std::find(running_split_keys_.begin(), running_split_keys_.end(), key);
+  if (running == running_split_keys_.end()) return false;
+  // A whole batch of the key queued runs alongside.
+  return running_split_queued_[running - running_split_keys_.begin()] < max_batch_;
 }
 
 std::shared_ptr<UrgentTask> WorkerPool::TakeUrgentLocked(std::shared_ptr<UrgentTask>* others,
@@ -109,6 +116,7 @@ std::shared_ptr<UrgentTask> WorkerPool::TakeUrgentLocked(std::shared_ptr<UrgentT
   *count = 0;
   *split_key = nullptr;
   // The first task that may run now, unlinked through the link that owns it.
+  CountQueuedOfRunningLocked();
   std::shared_ptr<UrgentTask>* at = &urgent_head_;
   UrgentTask* before = nullptr;
   for (int scanned = 0; *at != nullptr && WaitsForItsBatchLocked(**at); ++scanned) {

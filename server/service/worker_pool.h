@@ -119,7 +119,11 @@ class WorkerPool {
   // queued task must wait. `split_key`: the key of a split batch, now marked running, or null.
   std::shared_ptr<UrgentTask> TakeUrgentLocked(std::shared_ptr<UrgentTask>* others, int* count,
                                                const void** split_key) DEFORM_REQUIRES(mutex_);
-  // Whether `task` waits for its key's running split batch (header comment).
+  // Counts the queued tasks of each running split batch's key (within kBatchScanLimit) into
+  // running_split_queued_: one pass over the queue for all of them.
+  void CountQueuedOfRunningLocked() DEFORM_REQUIRES(mutex_);
+  // Whether `task` waits for its key's running split batch (header comment), by the counts of
+  // CountQueuedOfRunningLocked.
   bool WaitsForItsBatchLocked(const UrgentTask& task) DEFORM_REQUIRES(mutex_);
 
   Mutex mutex_;
@@ -132,6 +136,8 @@ class WorkerPool {
   // The keys of the split batches running (one entry per running batch; capacity reserved for
   // every worker, so it never allocates).
   std::vector<const void*> running_split_keys_ DEFORM_GUARDED_BY(mutex_);
+  // Per running split key, its tasks queued (CountQueuedOfRunningLocked); the same capacity.
+  std::vector<int> running_split_queued_ DEFORM_GUARDED_BY(mutex_);
   int max_background_ = 1;  // set by the constructor, then read-only
   bool stopping_ DEFORM_GUARDED_BY(mutex_) = false;
 

@@ -26,6 +26,14 @@ double SecondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
+// A deformation's timings (when asked for): the right-hand side from `start` to `solve_start`,
+// the solve from then to now.
+void RecordTimings(Clock::time_point start, Clock::time_point solve_start, DeformTimings* timings) {
+  if (timings == nullptr) return;
+  timings->right_hand_side = std::chrono::duration<double>(solve_start - start).count();
+  timings->solve = SecondsSince(solve_start);
+}
+
 // Model ids: unique within the process, never 0 (the id of no model).
 std::uint64_t NextModelId() {
   static std::atomic<std::uint64_t> next{1};
@@ -335,10 +343,7 @@ bool DeformationModel::Deform(const MaterialFactorization& factorization, const 
     solve_start = Clock::now();
     SolveOwnedInPlace(factorization, scratch);
   }
-  if (timings != nullptr) {
-    timings->right_hand_side = std::chrono::duration<double>(solve_start - start).count();
-    timings->solve = SecondsSince(solve_start);
-  }
+  RecordTimings(start, solve_start, timings);
   return true;
 }
 
@@ -408,10 +413,7 @@ bool DeformationModel::DeformBatch(const MaterialFactorization& factorization,
       factorization.factor().SolveFrames(solutions, solutions, count, batch->solve_work.data());
   assert(solved.ok());
   (void)solved;
-  if (timings != nullptr) {
-    timings->right_hand_side = std::chrono::duration<double>(solve_start - start).count();
-    timings->solve = SecondsSince(solve_start);
-  }
+  RecordTimings(start, solve_start, timings);
   return true;
 }
 
@@ -534,10 +536,7 @@ bool DeformationModel::DeformParallel(const MaterialFactorization& factorization
       plan, scratch->solution.data(), scratch->solution.data(), work, runner);
   assert(solved.ok());
   (void)solved;
-  if (timings != nullptr) {
-    timings->right_hand_side = std::chrono::duration<double>(solve_start - start).count();
-    timings->solve = SecondsSince(solve_start);
-  }
+  RecordTimings(start, solve_start, timings);
   return true;
 }
 
@@ -577,10 +576,7 @@ bool DeformationModel::DeformBatchParallel(const MaterialFactorization& factoriz
       plan, solutions, solutions, count, batch->solve_work.data(), runner);
   assert(solved.ok());
   (void)solved;
-  if (timings != nullptr) {
-    timings->right_hand_side = std::chrono::duration<double>(solve_start - start).count();
-    timings->solve = SecondsSince(solve_start);
-  }
+  RecordTimings(start, solve_start, timings);
   return true;
 }
 

@@ -8,6 +8,19 @@
 #include "internal/row_pattern.h"
 
 namespace deform {
+namespace {
+
+// INVALID_ARGUMENT unless a batch of `frames` frames fits a batched solve's columns.
+Status CheckFrameCount(int frames) {
+  if (frames < 1 || 3 * frames > kMaxSolveColumns) {
+    return Status::InvalidArgument("a batched solve takes 1 to " +
+                                   std::to_string(kMaxSolveColumns / 3) + " frames, not " +
+                                   std::to_string(frames));
+  }
+  return Status::Ok();
+}
+
+}  // namespace
 
 StatusOr<CholeskyFactor> CholeskyFactor::Factorize(std::shared_ptr<const SymbolicCholesky> symbolic,
                                                    const ColMajorMatrix& a,
@@ -171,11 +184,7 @@ Status CholeskyFactor::SolveFrames(const double* const* b, double* const* x, int
 Status CholeskyFactor::SolveFrames(const double* const* b, double* const* x, int frames,
                                    double* work, SolveKernel kernel) const {
   if (!symbolic_) return Status::FailedPrecondition("the Cholesky factor is empty");
-  if (frames < 1 || 3 * frames > kMaxSolveColumns) {
-    return Status::InvalidArgument("a batched solve takes 1 to " +
-                                   std::to_string(kMaxSolveColumns / 3) + " frames, not " +
-                                   std::to_string(frames));
-  }
+  DEFORM_RETURN_IF_ERROR(CheckFrameCount(frames));
   SolveKernelFunctionsFor(kernel).solve_frames(View(), b, x, frames, work);
   return Status::Ok();
 }
@@ -220,11 +229,7 @@ Status CholeskyFactor::SolveFramesParallel(const ParallelSolvePlan& plan, const 
                                            ParallelRunner* runner, SolveKernel kernel) const {
   if (!symbolic_) return Status::FailedPrecondition("solve with an empty factor");
   if (plan.parts < 2) return Status::InvalidArgument("a parallel solve needs a plan with parts");
-  if (frames < 1 || 3 * frames > kMaxSolveColumns) {
-    return Status::InvalidArgument("a batched solve takes 1 to " +
-                                   std::to_string(kMaxSolveColumns / 3) + " frames, not " +
-                                   std::to_string(frames));
-  }
+  DEFORM_RETURN_IF_ERROR(CheckFrameCount(frames));
   ParallelSolveFrames(View(), plan, kernel, b, x, frames, work, runner);
   return Status::Ok();
 }

@@ -8,6 +8,14 @@
 namespace deform {
 namespace {
 
+// Part `part`'s supernodes (ascending) and their count.
+const int* PartSupernodes(const ParallelSolvePlan& plan, int part) {
+  return plan.part_supernodes.data() + plan.part_offsets[part];
+}
+int PartCount(const ParallelSolvePlan& plan, int part) {
+  return plan.part_offsets[part + 1] - plan.part_offsets[part];
+}
+
 // Part p's solution rows and planar buffer in the aligned work.
 struct PartBuffers {
   double* y;
@@ -29,10 +37,6 @@ struct SolveContext {
     return {base, base + kSolveRowStride * static_cast<std::int64_t>(factor->size)};
   }
   double* Solution() const { return work; }
-  const int* Supernodes(int part) const {
-    return plan->part_supernodes.data() + plan->part_offsets[part];
-  }
-  int Count(int part) const { return plan->part_offsets[part + 1] - plan->part_offsets[part]; }
 };
 
 // Calls body(column) for every column of part `part`'s supernodes.
@@ -43,11 +47,6 @@ void ForEachColumnOf(const SupernodalFactorView& f, const ParallelSolvePlan& pla
     const int s = plan.part_supernodes[i];
     for (int col = f.supernode_columns[s]; col < f.supernode_columns[s + 1]; ++col) body(col);
   }
-}
-
-template <typename Body>
-void ForEachColumn(const SolveContext& c, int part, Body&& body) {
-  ForEachColumnOf(*c.factor, *c.plan, part, body);
 }
 
 void Gather(const SupernodalFactorView& f, const double* b, int row, double* y) {
@@ -73,17 +72,17 @@ void ForwardPart(void* context, int part) {
   const SolveContext& c = *static_cast<const SolveContext*>(context);
   const SupernodalFactorView& f = *c.factor;
   const PartBuffers own = c.Buffers(part);
-  ForEachColumn(c, part, [&](int col) { Gather(f, c.b, col, own.y); });
+  ForEachColumnOf(f, *c.plan, part, [&](int col) { Gather(f, c.b, col, own.y); });
   if (part > 0) {
     for (const int col : c.plan->top_columns) {
       double* t = own.y + kSolveRowStride * static_cast<std::ptrdiff_t>(col);
       t[0] = t[1] = t[2] = t[3] = 0;
     }
   }
-  c.forward(f, c.Supernodes(part), c.Count(part), own.y, own.planar);
+  c.forward(f, PartSupernodes(*c.plan, part), PartCount(*c.plan, part), own.y, own.planar);
   if (part > 0) {
     double* solution = c.Solution();
-    ForEachColumn(c, part, [&](int col) {
+    ForEachColumnOf(f, *c.plan, part, [&](int col) {
       const std::ptrdiff_t at = kSolveRowStride * static_cast<std::ptrdiff_t>(col);
       std::copy(own.y + at, own.y + at + kSolveRowStride, solution + at);
     });
@@ -94,8 +93,9 @@ void ForwardPart(void* context, int part) {
 void BackwardPart(void* context, int part) {
   const SolveContext& c = *static_cast<const SolveContext*>(context);
   const SupernodalFactorView& f = *c.factor;
-  c.backward(f, c.Supernodes(part), c.Count(part), c.Solution(), c.Buffers(part).planar);
-  ForEachColumn(c, part, [&](int col) { Scatter(f, c.Solution(), col, c.x); });
+  c.backward(f, PartSupernodes(*c.plan, part), PartCount(*c.plan, part), c.Solution(),
+             c.Buffers(part).planar);
+  ForEachColumnOf(f, *c.plan, part, [&](int col) { Scatter(f, c.Solution(), col, c.x); });
 }
 
 // ParallelSolveFrames' state: part p's batch rows at Rows(p) (part 0's are the solution's).
@@ -112,13 +112,10 @@ struct FramesContext {
   double* Rows(int part) const {
     return work + static_cast<std::ptrdiff_t>(part) * stride * factor->size;
   }
-  double* Row(double* rows, int row) const {
+  template <typename Value>  // double or const double
+  Value* Row(Value* rows, int row) const {
     return rows + static_cast<std::ptrdiff_t>(stride) * row;
   }
-  const int* Supernodes(int part) const {
-    return plan->part_supernodes.data() + plan->part_offsets[part];
-  }
-  int Count(int part) const { return plan->part_offsets[part + 1] - plan->part_offsets[part]; }
   // The frames' right-hand sides of unknown permutation[row] into `rows`' row, its padding zeroed.
   void Gather(int row, double* rows) const {
     const std::ptrdiff_t from = 3 * static_cast<std::ptrdiff_t>(factor->permutation[row]);
@@ -132,7 +129,7 @@ struct FramesContext {
   }
   void Scatter(int row, const double* rows) const {
     const std::ptrdiff_t to = 3 * static_cast<std::ptrdiff_t>(factor->permutation[row]);
-    const double* t = rows + static_cast<std::ptrdiff_t>(stride) * row;
+    const double* t = Row(rows, row);
     for (int f = 0; f < frames; ++f) {
       x[f][to] = t[3 * f];
       x[f][to + 1] = t[3 * f + 1];
@@ -149,7 +146,8 @@ void ForwardFramesPart(void* context, int part) {
   if (part > 0) {
     for (const int col : c.plan->top_columns) std::fill_n(c.Row(own, col), c.stride, 0.0);
   }
-  c.passes->forward_list_many(*c.factor, c.Supernodes(part), c.Count(part), own, 3 * c.frames);
+  c.passes->forward_list_many(*c.factor, PartSupernodes(*c.plan, part), PartCount(*c.plan, part),
+                              own, 3 * c.frames);
   if (part > 0) {
     double* solution = c.Rows(0);
     ForEachColumnOf(*c.factor, *c.plan, part,
@@ -161,8 +159,8 @@ void ForwardFramesPart(void* context, int part) {
 void BackwardFramesPart(void* context, int part) {
   const FramesContext& c = *static_cast<const FramesContext*>(context);
   double* solution = c.Rows(0);
-  c.passes->backward_list_many(*c.factor, c.Supernodes(part), c.Count(part), solution,
-                               3 * c.frames);
+  c.passes->backward_list_many(*c.factor, PartSupernodes(*c.plan, part), PartCount(*c.plan, part),
+                               solution, 3 * c.frames);
   ForEachColumnOf(*c.factor, *c.plan, part, [&](int col) { c.Scatter(col, solution); });
 }
 
@@ -373,7 +371,7 @@ void ParallelSolveFrames(const SupernodalFactorView& f, const ParallelSolvePlan&
     const double* other = c.Rows(part);
     for (const int col : plan.top_columns) {
       double* target = c.Row(solution, col);
-      const double* source = other + static_cast<std::ptrdiff_t>(c.stride) * col;
+      const double* source = c.Row(other, col);
       for (int k = 0; k < 3 * frames; ++k) target[k] += source[k];
     }
   }

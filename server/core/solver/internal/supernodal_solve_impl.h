@@ -971,32 +971,35 @@ void SolveFramesImpl(const SupernodalFactorView& f, const double* const* b, doub
   });
 }
 
+// Runs body(vecs, value) with the batch vectors a row of `columns` takes (a Count) and the
+// factor's value type (a double or a float).
+template <typename Body>
+inline void WithBatchShape(const SupernodalFactorView& f, int columns, Body&& body) {
+  WithCount<BatchVecsFor(kMaxSolveColumns)>(BatchVecsFor(columns), [&](auto vecs) {
+    WithValueType(f, [&](auto value) { body(vecs, value); });
+  });
+}
+
 // One direction's batched pass over the listed supernodes only (forward: ascending, backward:
 // taken in descending order), on solution rows of BatchVecsFor(columns) batch vectors each: the
 // parallel batched solve's parts (parallel_solve.h).
 void ForwardListManyImpl(const SupernodalFactorView& f, const int* supernodes, int count, double* y,
                          int columns) {
-  WithCount<BatchVecsFor(kMaxSolveColumns)>(BatchVecsFor(columns), [&](auto vecs) {
-    constexpr int kVecs = decltype(vecs)::value;
-    WithValueType(f, [&](auto value) {
-      using Value = decltype(value);
-      for (int i = 0; i < count; ++i) {
-        ForwardSupernodeMany<Value, kVecs>(BlockOf<Value>(f, supernodes[i]), y);
-      }
-    });
+  WithBatchShape(f, columns, [&](auto vecs, auto value) {
+    using Value = decltype(value);
+    for (int i = 0; i < count; ++i) {
+      ForwardSupernodeMany<Value, decltype(vecs)::value>(BlockOf<Value>(f, supernodes[i]), y);
+    }
   });
 }
 
 void BackwardListManyImpl(const SupernodalFactorView& f, const int* supernodes, int count,
                           double* y, int columns) {
-  WithCount<BatchVecsFor(kMaxSolveColumns)>(BatchVecsFor(columns), [&](auto vecs) {
-    constexpr int kVecs = decltype(vecs)::value;
-    WithValueType(f, [&](auto value) {
-      using Value = decltype(value);
-      for (int i = count - 1; i >= 0; --i) {
-        BackwardSupernodeMany<Value, kVecs>(BlockOf<Value>(f, supernodes[i]), y);
-      }
-    });
+  WithBatchShape(f, columns, [&](auto vecs, auto value) {
+    using Value = decltype(value);
+    for (int i = count - 1; i >= 0; --i) {
+      BackwardSupernodeMany<Value, decltype(vecs)::value>(BlockOf<Value>(f, supernodes[i]), y);
+    }
   });
 }
 
