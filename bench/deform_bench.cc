@@ -168,6 +168,67 @@ std::vector<double> TimeSolve3(const CholeskyFactor& factor, const Rhs& rhs, Def
   });
 }
 
+// Writes one double per cache line of a buffer far larger than any cache (256 MiB), so that what
+// a frame reads next comes from memory.
+void EvictCaches() {
+  static std::vector<double> buffer(std::size_t{32} << 20, 1.0);
+  for (std::size_t i = 0; i < buffer.size(); i += 8) buffer[i] += 1.0;
+  benchmark::DoNotOptimize(buffer.data());
+}
+
+// TimeEach with the caches emptied (EvictCaches, untimed) before each run.
+template <typename Frame>
+std::vector<double> TimeEachCold(benchmark::State& state, Frame&& frame) {
+  std::vector<double> seconds;
+  for (auto _ : state) {
+    state.PauseTiming();
+    EvictCaches();
+    state.ResumeTiming();
+    const auto start = Clock::now();
+    frame();
+    seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
+  }
+  return seconds;
+}
+
+// The two triangular passes of a lone frame (frames 1: Solve3) or of a batch (SolveFrames) with
+// the caches emptied before each run: what a solve costs when the factor, the right-hand sides
+// and the solution rows come from memory, as in a service whose frames are far apart or whose
+// other work (and a shared machine's neighbours) evicts them between solves. With `float32`, the
+// factor rounded to float32 (RoundedToFloat32). Besides the usual counters (the bounds those of
+// the factor solved): hot_ms, the same solve's median back to back (cache-resident where the
+// factor fits) timed in the same benchmark, and x_hot, their ratio.
+void BM_ColdSolve(benchmark::State& state, BenchMesh mesh, int frames_per_batch, bool float32) {
+  auto frames = SetUpFrames(state, mesh);
+  if (!frames) return;
+  const CholeskyFactor& exact = frames->factorization->factor();
+  const CholeskyFactor rounded = float32 ? exact.RoundedToFloat32() : CholeskyFactor();
+  const CholeskyFactor& factor = float32 ? rounded : exact;
+  DeformScratch& scratch = frames->scratch;
+  const auto rhs = AssembledRightHandSide(frames.get());
+  std::vector<std::vector<double>> solved(frames_per_batch,
+                                          std::vector<double>(rhs.data(), rhs.data() + rhs.size()));
+  std::vector<const double*> in(frames_per_batch, rhs.data());
+  std::vector<double*> out;
+  for (std::vector<double>& frame : solved) out.push_back(frame.data());
+  std::vector<double> batch_work(factor.WorkSizeMany(3 * frames_per_batch));
+  const auto solve = [&] {
+    if (frames_per_batch == 1) {
+      benchmark::DoNotOptimize(
+          factor.Solve3(rhs.data(), scratch.solution.data(), scratch.solve_work.data()));
+    } else {
+      benchmark::DoNotOptimize(
+          factor.SolveFrames(in.data(), out.data(), frames_per_batch, batch_work.data()));
+    }
+  };
+  const auto seconds = TimeEachCold(state, solve);
+  const std::vector<double> hot = TimeRuns(seconds.size(), solve);
+  ReportAgainstBound(state, factor.bytes(), seconds);
+  state.counters["frames"] = frames_per_batch;
+  state.counters["hot_ms"] = Median(hot) * 1e3;
+  state.counters["x_hot"] = Median(seconds) / Median(hot);
+}
+
 // `frames` frames' two triangular passes in one batch with `kernel` (CholeskyFactor::SolveFrames,
 // as DeformBatch runs them: each frame's right-hand side and solution in arrays of their own), the
 // right-hand sides those of the benchmark pose. Besides the counters of the other solves
@@ -393,6 +454,15 @@ void RegisterBenchmarks(const BenchMesh& mesh) {
   RegisterFor(mesh, "LinearBlendFrame", BM_LinearBlendFrame)->MinTime(1.0);
   RegisterFor(mesh, "RightHandSide", BM_RightHandSide)->MinTime(0.5);
   RegisterFor(mesh, "TriangularSolve", BM_TriangularSolve, BestSolveKernel())->MinTime(1.0);
+  for (const int frames : {1, 8}) {
+    for (const bool float32 : {false, true}) {
+      RegisterFor(mesh,
+                  std::string(float32 ? "ColdFloat32Solve" : "ColdSolve") +
+                      "/frames:" + std::to_string(frames),
+                  BM_ColdSolve, frames, float32)
+          ->MinTime(1.0);
+    }
+  }
   if (BestSolveKernel() != SolveKernel::kBaseline) {
     RegisterFor(mesh, "TriangularSolveBaselineKernel", BM_TriangularSolve, SolveKernel::kBaseline)
         ->MinTime(1.0);

@@ -255,11 +255,15 @@ inline void SubtractRow1x3(const Value* __restrict row, const double* __restrict
 // distance and the hint were chosen by measurement (deform_bench's TriangularSolve and
 // BatchedSolve on the arm; 8 to 64 KB measured alike).
 constexpr std::ptrdiff_t kPrefetchBytes = 16384;
-// A factor that fits a last-level cache (32 MB on the machines measured) is not prefetched: it
-// stays there between solves, and the prefetches only cost issue slots (the 1.6k leg's solve 5-10%
-// slower with them; the 26k leg's 25 MB no faster in deform_bench and, at eight streams in the
-// service, 97.2-99.2% of frames delivered against 97.9-99.9% without).
-constexpr std::int64_t kPrefetchMinFactorBytes = std::int64_t{32} << 20;
+// A factor that fits a core's own cache (2 MiB of L2 on the machines measured) is not
+// prefetched: it stays there between solves, and the prefetches only cost issue slots (the 1.6k
+// leg's 0.7 MB solve 5-10% slower with them). A larger one is, although it may fit the shared
+// last-level cache: whether it is still there at the next frame depends on what else ran in
+// between (the service's other work, a shared machine's neighbours). deform_bench's ColdSolve on
+// the 26k leg's 25 MB factor, caches emptied before each solve: 4.0-4.7 ms with the prefetches
+// against 6.8 without (DRAM bound 4.7-5.9 ms), a batch of eight 9.3-10.4 against 13.5-13.8; back
+// to back (cache-resident) alike.
+constexpr std::int64_t kPrefetchMinFactorBytes = std::int64_t{4} << 20;
 
 template <typename Value>
 inline bool StreamsFromMemory(const SupernodalFactorView& f) {
