@@ -122,6 +122,7 @@ Status DeformationModel::Precompute(const SkinWeights* weights, const CancelToke
   }
   DEFORM_RETURN_IF_ERROR(EndPhase(cancel, "the harmonic weights"));
   system_ = BuildLaplacianSystem(mesh_, adjacency, regions_, rigid_bones_, bone_weights_, options_);
+  rigid_rows_ = RigidRows::Find(system_, bone_weights_);
   DEFORM_RETURN_IF_ERROR(EndPhase(cancel, "the Laplacian system"));
   if (options_.rotation_blend == RotationBlend::kLinear) {
     linear_blend_plan_ = std::make_shared<const LinearBlendPlan>(LinearBlendPlan::Build(
@@ -205,6 +206,7 @@ StatusOr<std::shared_ptr<const MaterialFactorization>> DeformationModel::Factori
   result->model_id_ = id_;
   DEFORM_ASSIGN_OR_RETURN(const Eigen::VectorXd row_weights, RowWeights(stiffness));
   result->row_weights_squared_ = row_weights.array().square();
+  result->rigid_row_sums_ = RigidRowSums(system_, rigid_rows_, result->row_weights_squared_);
   DEFORM_ASSIGN_OR_RETURN(
       result->factor_,
       CholeskyFactor::Factorize(
@@ -254,14 +256,16 @@ std::size_t DeformationModel::EstimateBytesBeforeBuild(int num_vertices, int num
 }
 
 std::size_t DeformationModel::EstimatedBytes() const {
-  const LinearPoseResponse* response = default_factorization_->linear_response();
-  return default_factorization_->factor().bytes() + (response ? response->bytes() : 0) +
-         GeometryBytes(mesh_.num_vertices(), mesh_.num_triangles());
+  const MaterialFactorization& f = *default_factorization_;
+  const LinearPoseResponse* response = f.linear_response();
+  return f.factor().bytes() + (response ? response->bytes() : 0) + f.rigid_row_sums_bytes() +
+         rigid_rows_.bytes() + GeometryBytes(mesh_.num_vertices(), mesh_.num_triangles());
 }
 
 std::size_t DeformationModel::FactorizationBytes() const {
   const LinearPoseResponse* response = default_factorization_->linear_response();
-  return default_factorization_->factor().bytes_as_built() + (response ? response->bytes() : 0);
+  return default_factorization_->factor().bytes_as_built() + (response ? response->bytes() : 0) +
+         default_factorization_->rigid_row_sums_bytes();
 }
 
 std::size_t DeformationModel::ScratchBytes() const {
@@ -436,7 +440,10 @@ void DeformationModel::AssembleOwnedRightHandSide(const MaterialFactorization& f
   ForwardKinematics(skeleton_, pose, &scratch->bone_transforms);
   RotateDeltas(factorization, scratch);
   // A^T b = L'^T r + anchor_weight^2 c + node_weight^2 o.
-  MultiplyLaplacianTranspose(system_, scratch->rotated_deltas.data(), scratch->solution.data());
+  MultiplyRotatedRows(system_, rigid_rows_, factorization.rigid_row_sums_.data(),
+                      scratch->slot_rotations.data(), scratch->rotated_deltas.data(),
+                      scratch->solution.data(), 0,
+                      static_cast<int>(system_.laplacian_transpose.outerSize()));
   AddConstraintTargets(pose, scratch);
 }
 
@@ -464,7 +471,9 @@ void DeformationModel::RotateDeltasOf(const MaterialFactorization& factorization
   const auto& w2 = factorization.row_weights_squared_;
   auto& r = scratch->rotated_deltas;
   const auto& rotations = scratch->slot_rotations;
+  const unsigned char* read = rigid_rows_.delta_read.data();
   for (int i = first; i < end; ++i) {
+    if (!read[i]) continue;  // only rigid rows, through their sums, use this vertex
     const int begin = bw.offsets[i], stop = bw.offsets[i + 1];
     const Eigen::Vector3d delta = system_.rest_deltas.row(i).transpose();
     if (stop - begin == 1) {  // most vertices: wholly one bone's
@@ -504,8 +513,9 @@ struct DeformationModel::ParallelAssembly {
     const auto& a = *static_cast<const ParallelAssembly*>(context);
     const int rows = static_cast<int>(a.model->system_.laplacian_transpose.outerSize());
     const auto [first, end] = RangeOfPart(rows, a.parts, index);
-    MultiplyLaplacianTransposeRows(a.model->system_, a.scratch->rotated_deltas.data(),
-                                   a.scratch->solution.data(), first, end);
+    MultiplyRotatedRows(a.model->system_, a.model->rigid_rows_,
+                        a.factorization->rigid_row_sums_.data(), a.scratch->slot_rotations.data(),
+                        a.scratch->rotated_deltas.data(), a.scratch->solution.data(), first, end);
     // The anchors among these rows (anchors ascend), once their rows hold the product.
     const std::vector<int>& anchors = a.model->system_.anchors;
     const auto anchor_at = [&](int row) {

@@ -40,6 +40,7 @@
 #include "core/model/linear_blend_plan.h"
 #include "core/model/linear_pose_response.h"
 #include "core/model/model_options.h"
+#include "core/model/rigid_rows.h"
 #include "core/model/stiffness.h"
 #include "core/solver/sparse_cholesky.h"
 
@@ -66,10 +67,13 @@ class MaterialFactorization {
   // 0-120 degrees stays within 1.5 times the rest pose's, at most 2.0e-7 of the diagonal).
   double float32_probe_error() const { return float32_probe_error_; }
   static constexpr double kFloat32ProbeTolerance = 2.5e-7;
+  // The bytes of its rigid rows' sums (rigid_rows.h: 3 doubles per row of L'^T).
+  std::size_t rigid_row_sums_bytes() const { return rigid_row_sums_.size() * sizeof(double); }
 
  private:
   friend class DeformationModel;
   Eigen::VectorXd row_weights_squared_;  // w_i^2 (n) for the stiffness it was built for
+  std::vector<double> rigid_row_sums_;   // RigidRowSums for those weights ((n + m) by 3)
   CholeskyFactor factor_;
   std::unique_ptr<const LinearPoseResponse> linear_response_;
   double factor_seconds_ = 0;
@@ -84,7 +88,9 @@ struct DeformScratch {
   // K, the same rotations as matrices, then (linear blend) the knots' (linear_blend_plan.h)
   std::vector<Eigen::Matrix3d> slot_rotations;
   Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> solution;        // (n + m) by 3
-  Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> rotated_deltas;  // n by 3
+  // n by 3: r = w^2 T delta of the vertices the general rows of L'^T read (rigid_rows.h); the
+  // others' rows are never written.
+  Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> rotated_deltas;
   std::vector<double> solve_work;  // CholeskyFactor::WorkSize()
 
   // The deformed vertex positions of the last Deform() (n by 3, a view into `solution`).
@@ -277,10 +283,10 @@ class DeformationModel {
   // The memory a model holds, estimated; the one formula behind every memory budget, calibrated
   // against the growth of a server's resident memory when it loads the model (the 133k-vertex
   // arm: 266 MiB measured; README, "Limits").
-  // EstimatedBytes(), once built: the default factorisation's factor and linear response as they
-  // are, plus kBytesPerVertex per vertex (rest and differential coordinates, Laplacian rows in both
-  // orientations, bone weights, region data, the normal matrix's pattern the symbolic analysis
-  // keeps) and kBytesPerTriangle per triangle.
+  // EstimatedBytes(), once built: the default factorisation's factor, linear response and rigid
+  // rows' sums as they are, the rigid rows' bones, plus kBytesPerVertex per vertex (rest and
+  // differential coordinates, Laplacian rows in both orientations, bone weights, region data, the
+  // normal matrix's pattern the symbolic analysis keeps) and kBytesPerTriangle per triangle.
   // EstimateBytesBeforeBuild(), from the mesh's size alone (admission: what a load is refused on
   // before anything is allocated): the same, with the factor predicted as
   // kFactorBytesPerVertexLog2 * n * log2(n) (the nested-dissection fill of a surface mesh; above
@@ -291,8 +297,8 @@ class DeformationModel {
   static std::size_t EstimateBytesBeforeBuild(int num_vertices, int num_triangles);
   std::size_t EstimatedBytes() const;
   // The bytes one more factorisation for other stiffness (Factorize) holds: the default
-  // factorisation's factor and linear response (same sparsity, same sizes), the factor as it is
-  // built (in double, also where it is then stored in float32).
+  // factorisation's factor, linear response and rigid rows' sums (same sparsity, same sizes), the
+  // factor as it is built (in double, also where it is then stored in float32).
   std::size_t FactorizationBytes() const;
   // The bytes MakeScratch() allocates: one stream's solve buffers.
   std::size_t ScratchBytes() const;
@@ -323,7 +329,8 @@ class DeformationModel {
   // The vertex rows' weights w_i for `stiffness` (all 1 with uniform_material).
   StatusOr<Eigen::VectorXd> RowWeights(const Stiffness& stiffness) const;
   // The steps of AssembleRightHandSide: r = w^2 T delta into scratch->rotated_deltas (after the
-  // forward kinematics), then the anchors' and joint nodes' targets into scratch->solution.
+  // forward kinematics; only the rows the general rows of L'^T read, rigid_rows.h), then L'^T r
+  // and the anchors' and joint nodes' targets into scratch->solution.
   void RotateDeltas(const MaterialFactorization& factorization, DeformScratch* scratch) const;
   // RotateDeltas in two steps, the second by vertex range (a parallel assembly splits it).
   void PrepareSlotRotations(DeformScratch* scratch) const;
@@ -359,6 +366,7 @@ class DeformationModel {
   std::optional<SkinWeights> given_weights_;
   BindingReport binding_report_;
   LaplacianSystem system_;  // L', the rest deltas, the anchors and joint nodes
+  RigidRows rigid_rows_;    // the rows of L'^T r one bone's rotation determines
   std::shared_ptr<const SymbolicCholesky> symbolic_;
   std::shared_ptr<const MaterialFactorization> default_factorization_;
   double precompute_seconds_ = 0;

@@ -50,39 +50,11 @@ Positions RestDeltas(const TriangleMesh& mesh, const JointRegions& regions,
   return laplacian * rest_with_nodes;
 }
 
-// out = m r for a row-major sparse m and n by 3 row-major r and out. Two partial sums per row, so
-// consecutive entries do not wait on each other's adds.
-void MultiplySparseBy3(const Eigen::SparseMatrix<double, Eigen::RowMajor, int>& m,
-                       const double* __restrict r, double* __restrict out, int first_row,
-                       int end_row) {
-  const int* columns = m.innerIndexPtr();
-  const double* values = m.valuePtr();
-  const int* row_begin = m.outerIndexPtr();
+// out = m r for a row-major sparse m and n by 3 row-major r and out.
+void MultiplySparseBy3(const RowMajorSparseMatrix& m, const double* __restrict r,
+                       double* __restrict out, int first_row, int end_row) {
   for (int row = first_row; row < end_row; ++row) {
-    double a0 = 0, a1 = 0, a2 = 0, b0 = 0, b1 = 0, b2 = 0;
-    int p = row_begin[row];
-    const int end = row_begin[row + 1];
-    for (; p + 2 <= end; p += 2) {
-      const double* x = r + 3 * static_cast<std::ptrdiff_t>(columns[p]);
-      const double* y = r + 3 * static_cast<std::ptrdiff_t>(columns[p + 1]);
-      const double u = values[p], v = values[p + 1];
-      a0 += u * x[0];
-      a1 += u * x[1];
-      a2 += u * x[2];
-      b0 += v * y[0];
-      b1 += v * y[1];
-      b2 += v * y[2];
-    }
-    if (p < end) {
-      const double* x = r + 3 * static_cast<std::ptrdiff_t>(columns[p]);
-      a0 += values[p] * x[0];
-      a1 += values[p] * x[1];
-      a2 += values[p] * x[2];
-    }
-    double* target = out + 3 * static_cast<std::ptrdiff_t>(row);
-    target[0] = a0 + b0;
-    target[1] = a1 + b1;
-    target[2] = a2 + b2;
+    SparseRowTimes3(m, r, row, out + 3 * static_cast<std::ptrdiff_t>(row));
   }
 }
 
@@ -151,11 +123,6 @@ Eigen::SparseMatrix<double> NormalMatrixPattern(const LaplacianSystem& system) {
 void MultiplyLaplacianTranspose(const LaplacianSystem& system, const double* r, double* out) {
   MultiplySparseBy3(system.laplacian_transpose, r, out, 0,
                     static_cast<int>(system.laplacian_transpose.outerSize()));
-}
-
-void MultiplyLaplacianTransposeRows(const LaplacianSystem& system, const double* r, double* out,
-                                    int first_row, int end_row) {
-  MultiplySparseBy3(system.laplacian_transpose, r, out, first_row, end_row);
 }
 
 }  // namespace deform

@@ -58,17 +58,46 @@ LaplacianSystem BuildLaplacianSystem(const TriangleMesh& mesh, const VertexAdjac
                                      const std::vector<int>& fixed_bone, const BoneWeights& weights,
                                      const ModelOptions& options);
 
+// Row `row` of m r into target[0..2], for a row-major sparse m and an n by 3 row-major r. Two
+// partial sums, so that consecutive entries do not wait on each other's adds. Inline: the
+// right-hand side's products call it once per row.
+inline void SparseRowTimes3(const RowMajorSparseMatrix& m, const double* __restrict r, int row,
+                            double* __restrict target) {
+  const int* columns = m.innerIndexPtr();
+  const double* values = m.valuePtr();
+  double a0 = 0, a1 = 0, a2 = 0, b0 = 0, b1 = 0, b2 = 0;
+  int p = m.outerIndexPtr()[row];
+  const int end = m.outerIndexPtr()[row + 1];
+  for (; p + 2 <= end; p += 2) {
+    const double* x = r + 3 * static_cast<std::ptrdiff_t>(columns[p]);
+    const double* y = r + 3 * static_cast<std::ptrdiff_t>(columns[p + 1]);
+    const double u = values[p], v = values[p + 1];
+    a0 += u * x[0];
+    a1 += u * x[1];
+    a2 += u * x[2];
+    b0 += v * y[0];
+    b1 += v * y[1];
+    b2 += v * y[2];
+  }
+  if (p < end) {
+    const double* x = r + 3 * static_cast<std::ptrdiff_t>(columns[p]);
+    a0 += values[p] * x[0];
+    a1 += values[p] * x[1];
+    a2 += values[p] * x[2];
+  }
+  target[0] = a0 + b0;
+  target[1] = a1 + b1;
+  target[2] = a2 + b2;
+}
+
 // A^T A ((n + m) square, column-major, compressed) for the vertex rows' squared weights w_i^2 (n).
 Eigen::SparseMatrix<double> NormalMatrix(const LaplacianSystem& system,
                                          const Eigen::VectorXd& row_weights_squared);
 // A matrix with the pattern of every NormalMatrix of `system` (for the symbolic analysis).
 Eigen::SparseMatrix<double> NormalMatrixPattern(const LaplacianSystem& system);
 
-// out = L'^T r: `r` is n by 3 and `out` (n + m) by 3, both row-major. No allocation.
+// out = L'^T r: `r` is n by 3 and `out` (n + m) by 3, both row-major. No allocation. (A frame's
+// right-hand side takes it through MultiplyRotatedRows, rigid_rows.h.)
 void MultiplyLaplacianTranspose(const LaplacianSystem& system, const double* r, double* out);
-// Rows [first_row, end_row) of the same product (the rows are independent: a parallel assembly
-// gives each thread its own range).
-void MultiplyLaplacianTransposeRows(const LaplacianSystem& system, const double* r, double* out,
-                                    int first_row, int end_row);
 
 }  // namespace deform

@@ -536,7 +536,12 @@ TEST(DeformationModel, EstimatedBytesAddTheFactorToTheGeometry) {
       model->mesh().num_vertices(), model->mesh().num_triangles());
   const std::size_t geometry = DeformationModel::kBytesPerVertex * model->mesh().num_vertices() +
                                DeformationModel::kBytesPerTriangle * model->mesh().num_triangles();
-  EXPECT_EQ(model->EstimatedBytes(), geometry + model->default_factorization()->factor().bytes());
+  // The rigid rows' sums (3 doubles a row of L'^T) and bones (an int a row, a byte a vertex).
+  const std::size_t n = model->mesh().num_vertices();
+  const std::size_t rows = n + model->num_joint_nodes();
+  const std::size_t rigid_rows = rows * 3 * sizeof(double) + rows * sizeof(int) + n;
+  EXPECT_EQ(model->EstimatedBytes(),
+            geometry + model->default_factorization()->factor().bytes() + rigid_rows);
   // Before the build the factor is predicted, from above: admission errs towards refusing.
   EXPECT_GT(before, geometry + model->default_factorization()->factor().bytes());
 }
@@ -555,7 +560,10 @@ TEST(DeformationModel, ScratchAndFactorizationBytesAreWhatAStreamAllocates) {
   stiffer.joint_materials.push_back({1, JointMaterial{9.0, 2.5, 6.0}});  // the knee
   auto other = model->Factorize(stiffer);
   ASSERT_TRUE(other.ok()) << other.status().ToString();
-  EXPECT_EQ(model->FactorizationBytes(), (*other)->factor().bytes());
+  const std::size_t rows = model->mesh().num_vertices() + model->num_joint_nodes();
+  EXPECT_EQ((*other)->rigid_row_sums_bytes(), rows * 3 * sizeof(double));
+  EXPECT_EQ(model->FactorizationBytes(),
+            (*other)->factor().bytes() + (*other)->rigid_row_sums_bytes());
 }
 
 TEST(DeformationModel, BuildPhasesAreTheCancellablePhasesInOrder) {
