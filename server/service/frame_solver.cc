@@ -43,9 +43,9 @@ void FrameSolver::EnableParallel(const ParallelSolvePlan* plan, ParallelRunner* 
   parallel_work_.assign(model_.default_factorization()->factor().WorkSizeParallel(*plan), 0.0);
 }
 
-bool FrameSolver::SplitsNow() const {
+bool FrameSolver::SplitsNow(int frames) const {
   return parallel_plan_ != nullptr &&
-         (open_streams_->load(std::memory_order_relaxed) < parallel_plan_->parts ||
+         (frames > 1 || open_streams_->load(std::memory_order_relaxed) < parallel_plan_->parts ||
           parallel_runner_->IdleHelpers() > 0);
 }
 
@@ -105,7 +105,7 @@ void FrameSolver::DeformTogether(const MaterialFactorization& factorization,
                                  FrameSolver* const* solvers, int count,
                                  const BatchScratchPool* scratches, Deformed* deformed) {
   const DeformationModel& model = solvers[0]->model_;
-  const bool split = solvers[0]->SplitsNow();
+  const bool split = solvers[0]->SplitsNow(count);
   if (count == 1 && split) {
     FrameSolver& solver = *solvers[0];
     model.DeformParallel(factorization, solver.pose_, &solver.scratch_, *solver.parallel_plan_,

@@ -45,14 +45,16 @@ class FrameSolver {
   explicit FrameSolver(const DeformationModel& model);
 
   // Lets this solver's frames run on several threads: `plan` (of the model's factor analysis) and
-  // `runner`, while fewer streams than the plan has parts (one per worker) are open on the
-  // service (`open_streams`, MeshRegistry::open_streams()) or, with more, while the runner has an
-  // idle worker to help (ParallelRunner::IdleHelpers): a split solve takes about 1.3 times the
-  // workers' time of a whole one alone and 1.1 to 1.2 times in a batch, which pays on a worker
-  // that is idle but not on one that has other frames to solve. A lone frame is split as
-  // DeformParallel splits it, a batch led by this solver as DeformBatchParallel does (with a
-  // batch scratch made for the plan). All three must outlive the solver. Allocates the parallel
-  // solve's work: ParallelWorkBytes.
+  // `runner`. A batch led by this solver is always split (as DeformBatchParallel splits it, with
+  // a batch scratch made for the plan): the pool runs one batch of such a mesh at a time, so the
+  // other workers are free unless other meshes' work holds them, and one that frees up during
+  // the batch joins it (PoolRunner). A lone frame is split (as DeformParallel splits it) while
+  // fewer streams than the plan has parts (one per worker) are open on the service
+  // (`open_streams`, MeshRegistry::open_streams()) or, with more, while the runner has an idle
+  // worker (ParallelRunner::IdleHelpers): a split solve takes about 1.3 times the workers' time
+  // of a whole one alone, which pays on a worker that is idle but not on one that has other
+  // frames to solve. All three must outlive the solver. Allocates the parallel solve's work:
+  // ParallelWorkBytes.
   void EnableParallel(const ParallelSolvePlan* plan, ParallelRunner* runner,
                       const std::atomic<int>* open_streams);
   static std::size_t ParallelWorkBytes(const DeformationModel& model,
@@ -92,8 +94,9 @@ class FrameSolver {
   const DeformationModel& model_;
   const std::vector<int>& client_order_;
   void Encode(v1::DeformFrame* frame);
-  // Whether this solver's frame, or a batch it leads, is split now (EnableParallel).
-  bool SplitsNow() const;
+  // Whether this solver's frame (`frames` 1), or a batch of `frames` it leads, is split now
+  // (EnableParallel).
+  bool SplitsNow(int frames) const;
   // DeformPrepared's work, without its start and end times.
   static void DeformTogether(const MaterialFactorization& factorization,
                              FrameSolver* const* solvers, int count,

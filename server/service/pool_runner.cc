@@ -62,7 +62,7 @@ void PoolRunner::Run(int count, void (*part)(void* context, int index), void* co
   job_->count = count;
   job_->next = 0;
   job_->finished = 0;
-  int wanted = std::min(count - 1, pool_->idle_workers());
+  int wanted = count - 1;
   for (const std::shared_ptr<Helper>& helper : helpers_) {
     if (wanted <= 0) break;
     if (helper->queued) continue;  // still queued from an earlier computation: it will help

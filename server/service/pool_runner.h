@@ -1,8 +1,9 @@
 // A ParallelRunner (core/solver/parallel_solve.h) on the service's worker pool: the parts of one
-// computation (a big mesh's frame: its right-hand side and solve) are taken by the calling worker
-// and by helper tasks posted for the workers idle at that moment, so a lone stream of a large mesh
-// gets every free core and a busy pool costs nothing: with no worker idle the caller runs every
-// part itself, and a helper that starts late finds the parts taken.
+// computation (a big mesh's frame or batch: right-hand sides and solve) are taken by the calling
+// worker and by helper tasks posted for the other workers, busy or not: an idle worker takes parts
+// at once, a busy one once it frees up while parts are left (a batch's solve outlasts the other
+// worker's task more often than not), and a helper that starts after the last part finds nothing
+// and returns. With no other worker free the caller runs every part itself and does not wait.
 //
 // One runner per stream (its helpers are its own tasks, posted at most once at a time, allocated
 // with the runner). Run is called by one thread at a time (the stream's solve task) and allocates

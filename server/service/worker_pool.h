@@ -20,9 +20,10 @@
 // (UrgentTask::SplitsItsBatches, a big mesh's solves) run one batch of a key at a time. Their
 // batch takes every queued task of its key (up to max_batch, no share left for idle workers),
 // and while it runs the other workers leave the key's tasks queued, taking other work or waiting
-// idle, where the running batch's helpers find them; unless a whole batch (max_batch tasks) of
-// the key is queued, which then runs alongside. So the frames that arrive during a batch make the
-// next one, solved on every free core, instead of smaller batches side by side each on one core.
+// idle, where the running batch's helpers (posted to the queue when it began) find them; unless a
+// whole batch (max_batch tasks) of the key is queued, which then runs alongside. So the frames that
+// arrive during a batch make the next one, solved on every free core, instead of smaller batches
+// side by side each on one core.
 //
 // Ownership: the pool holds a reference to every task it has been given (the urgent task's
 // shared_ptr, the background task's function and its captures) until the task has run, and drops

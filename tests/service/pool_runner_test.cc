@@ -118,5 +118,47 @@ TEST(PoolRunnerTest, ABusyPoolLeavesEveryPartToTheCaller) {
   pool.Shutdown();
 }
 
+// A worker busy when Run begins still helps once it frees up: its helper was posted all the same.
+// The first part frees the busy worker, then waits until the second part has started elsewhere
+// (on one thread it would wait out its timeout and the test fails).
+TEST(PoolRunnerTest, AWorkerBusyWhenRunBeginsTakesPartsOnceItFreesUp) {
+  WorkerPool pool(2);
+  PoolRunner runner(&pool);
+  struct Late {
+    std::mutex mutex;
+    std::condition_variable cv;
+    bool busy = false, release = false, second_started = false;
+    std::thread::id caller, second;
+    static void Run(void* context, int index) {
+      auto* l = static_cast<Late*>(context);
+      std::unique_lock<std::mutex> lock(l->mutex);
+      if (index == 0) {
+        l->caller = std::this_thread::get_id();
+        l->release = true;
+        l->cv.notify_all();
+        l->cv.wait_for(lock, std::chrono::seconds(10), [&] { return l->second_started; });
+      } else {
+        l->second = std::this_thread::get_id();
+        l->second_started = true;
+        l->cv.notify_all();
+      }
+    }
+  } late;
+  pool.PostUrgent(std::make_shared<FunctionTask>([&] {
+    std::unique_lock<std::mutex> lock(late.mutex);
+    late.busy = true;
+    late.cv.notify_all();
+    late.cv.wait(lock, [&] { return late.release; });
+  }));
+  {
+    std::unique_lock<std::mutex> lock(late.mutex);
+    ASSERT_TRUE(late.cv.wait_for(lock, std::chrono::seconds(60), [&] { return late.busy; }));
+  }
+  RunOnWorker(&pool, [&] { runner.Run(2, &Late::Run, &late); });
+  EXPECT_TRUE(late.second_started);
+  EXPECT_NE(late.second, late.caller) << "the second part waited for the caller";
+  pool.Shutdown();
+}
+
 }  // namespace
 }  // namespace deform::service

@@ -12,8 +12,9 @@
 // concurrently (each writes only its own rows). The sums run in another order than Solve3's, so
 // the result equals Solve3's to round-off (1e-12 of the solution's norm, tested).
 //
-// Who runs the parts is the caller's ParallelRunner: the service's runs them on idle workers of
-// its pool and the rest on the calling thread; SerialRunner runs them all on the calling thread.
+// Who runs the parts is the caller's ParallelRunner: the service's runs them on the workers of
+// its pool that are free (or free up) while parts are left and the rest on the calling thread;
+// SerialRunner runs them all on the calling thread.
 #pragma once
 
 #include <condition_variable>
