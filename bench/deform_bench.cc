@@ -168,6 +168,20 @@ std::vector<double> TimeSolve3(const CholeskyFactor& factor, const Rhs& rhs, Def
   });
 }
 
+// `count` copies of a right-hand side, each in an array of its own as DeformBatch solves them
+// (in place), with the input and output pointers SolveFrames takes.
+struct FramesInArrays {
+  template <typename Rhs>
+  FramesInArrays(const Rhs& rhs, int count)
+      : solved(count, std::vector<double>(rhs.data(), rhs.data() + rhs.size())),
+        in(count, rhs.data()) {
+    for (std::vector<double>& frame : solved) out.push_back(frame.data());
+  }
+  std::vector<std::vector<double>> solved;
+  std::vector<const double*> in;
+  std::vector<double*> out;
+};
+
 // Writes one double per cache line of a buffer far larger than any cache (256 MiB), so that what
 // a frame reads next comes from memory.
 void EvictCaches() {
@@ -206,19 +220,15 @@ void BM_ColdSolve(benchmark::State& state, BenchMesh mesh, int frames_per_batch,
   const CholeskyFactor& factor = float32 ? rounded : exact;
   DeformScratch& scratch = frames->scratch;
   const auto rhs = AssembledRightHandSide(frames.get());
-  std::vector<std::vector<double>> solved(frames_per_batch,
-                                          std::vector<double>(rhs.data(), rhs.data() + rhs.size()));
-  std::vector<const double*> in(frames_per_batch, rhs.data());
-  std::vector<double*> out;
-  for (std::vector<double>& frame : solved) out.push_back(frame.data());
+  FramesInArrays batch(rhs, frames_per_batch);
   std::vector<double> batch_work(factor.WorkSizeMany(3 * frames_per_batch));
   const auto solve = [&] {
     if (frames_per_batch == 1) {
       benchmark::DoNotOptimize(
           factor.Solve3(rhs.data(), scratch.solution.data(), scratch.solve_work.data()));
     } else {
-      benchmark::DoNotOptimize(
-          factor.SolveFrames(in.data(), out.data(), frames_per_batch, batch_work.data()));
+      benchmark::DoNotOptimize(factor.SolveFrames(batch.in.data(), batch.out.data(),
+                                                  frames_per_batch, batch_work.data()));
     }
   };
   const auto seconds = TimeEachCold(state, solve);
@@ -243,16 +253,11 @@ void BM_BatchedSolve(benchmark::State& state, BenchMesh mesh, int frames_per_bat
   const CholeskyFactor& factor = frames->factorization->factor();
   DeformScratch& scratch = frames->scratch;
   const auto rhs = AssembledRightHandSide(frames.get());
-  // Each frame's right-hand side and solution in arrays of their own, as DeformBatch solves them.
-  std::vector<std::vector<double>> solved(frames_per_batch,
-                                          std::vector<double>(rhs.data(), rhs.data() + rhs.size()));
-  std::vector<const double*> in(frames_per_batch, rhs.data());
-  std::vector<double*> out;
-  for (std::vector<double>& frame : solved) out.push_back(frame.data());
+  FramesInArrays batch(rhs, frames_per_batch);
   std::vector<double> work(factor.WorkSizeMany(3 * frames_per_batch));
   const auto seconds = TimeEach(state, [&] {
-    benchmark::DoNotOptimize(
-        factor.SolveFrames(in.data(), out.data(), frames_per_batch, work.data(), kernel));
+    benchmark::DoNotOptimize(factor.SolveFrames(batch.in.data(), batch.out.data(), frames_per_batch,
+                                                work.data(), kernel));
   });
   const std::vector<double> unbatched = TimeSolve3(factor, rhs, &scratch, seconds.size());
   ReportAgainstBound(state, factor.bytes(), seconds);
@@ -309,22 +314,18 @@ void BM_ParallelBatchedSolve(benchmark::State& state, BenchMesh mesh, int frames
   const auto rhs = AssembledRightHandSide(frames.get());
   const ParallelSolvePlan plan = factor.PlanParallel(parts);
   if (plan.parts == 0) return state.SkipWithError("the elimination tree does not split");
-  std::vector<std::vector<double>> solved(frames_per_batch,
-                                          std::vector<double>(rhs.data(), rhs.data() + rhs.size()));
-  std::vector<const double*> in(frames_per_batch, rhs.data());
-  std::vector<double*> out;
-  for (std::vector<double>& frame : solved) out.push_back(frame.data());
+  FramesInArrays batch(rhs, frames_per_batch);
   std::vector<double> work(factor.WorkSizeFramesParallel(plan, frames_per_batch));
   ThreadTeam team(parts);
   const auto seconds = TimeEach(state, [&] {
-    benchmark::DoNotOptimize(factor.SolveFramesParallel(plan, in.data(), out.data(),
+    benchmark::DoNotOptimize(factor.SolveFramesParallel(plan, batch.in.data(), batch.out.data(),
                                                         frames_per_batch, work.data(), &team));
   });
-  const std::vector<std::vector<double>> parallel_result = solved;  // (the last timed run's)
+  const std::vector<std::vector<double>> parallel_result = batch.solved;  // (the last timed run's)
   std::vector<double> serial_work(factor.WorkSizeMany(3 * frames_per_batch));
   const std::vector<double> serial = TimeRuns(seconds.size(), [&] {
-    benchmark::DoNotOptimize(
-        factor.SolveFrames(in.data(), out.data(), frames_per_batch, serial_work.data()));
+    benchmark::DoNotOptimize(factor.SolveFrames(batch.in.data(), batch.out.data(), frames_per_batch,
+                                                serial_work.data()));
   });
   (void)factor.Solve3(rhs.data(), scratch.solution.data(), scratch.solve_work.data());
   double difference = 0;
