@@ -40,10 +40,6 @@ int RigidRows::rigid_row_count() const {
       std::count_if(bone_of_row.begin(), bone_of_row.end(), [](int b) { return b >= 0; }));
 }
 
-int RigidRows::read_delta_count() const {
-  return static_cast<int>(std::count(delta_read.begin(), delta_read.end(), 1));
-}
-
 std::size_t RigidRows::bytes() const {
   return bone_of_row.size() * sizeof(int) + delta_read.size();
 }
