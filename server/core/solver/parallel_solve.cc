@@ -67,7 +67,8 @@ void Scatter(const SupernodalFactorView& f, const double* y, int row, double* x)
 }
 
 // A part's forward pass: its rows gathered into its buffer (part 0: the solution), the top rows of
-// another part's buffer zeroed, its supernodes eliminated, its rows copied to the solution.
+// another part's buffer zeroed, its supernodes eliminated (another part's rows stay in its buffer
+// for its backward pass).
 void ForwardPart(void* context, int part) {
   const SolveContext& c = *static_cast<const SolveContext*>(context);
   const SupernodalFactorView& f = *c.factor;
@@ -80,22 +81,24 @@ void ForwardPart(void* context, int part) {
     }
   }
   c.forward(f, PartSupernodes(*c.plan, part), PartCount(*c.plan, part), own.y, own.planar);
-  if (part > 0) {
-    double* solution = c.Solution();
-    ForEachColumnOf(f, *c.plan, part, [&](int col) {
-      const std::ptrdiff_t at = kSolveRowStride * static_cast<std::ptrdiff_t>(col);
-      std::copy(own.y + at, own.y + at + kSolveRowStride, solution + at);
-    });
-  }
 }
 
-// A part's backward pass on the solution, its rows then written to x.
+// A part's backward pass on its own rows (part 0: the solution's; another part's first takes the
+// top's solved rows from the solution), its rows then written to x. A part's supernodes read only
+// their own rows and the top's.
 void BackwardPart(void* context, int part) {
   const SolveContext& c = *static_cast<const SolveContext*>(context);
   const SupernodalFactorView& f = *c.factor;
-  c.backward(f, PartSupernodes(*c.plan, part), PartCount(*c.plan, part), c.Solution(),
-             c.Buffers(part).planar);
-  ForEachColumnOf(f, *c.plan, part, [&](int col) { Scatter(f, c.Solution(), col, c.x); });
+  const PartBuffers own = c.Buffers(part);
+  if (part > 0) {
+    const double* solution = c.Solution();
+    for (const int col : c.plan->top_columns) {
+      const std::ptrdiff_t at = kSolveRowStride * static_cast<std::ptrdiff_t>(col);
+      std::copy(solution + at, solution + at + kSolveRowStride, own.y + at);
+    }
+  }
+  c.backward(f, PartSupernodes(*c.plan, part), PartCount(*c.plan, part), own.y, own.planar);
+  ForEachColumnOf(f, *c.plan, part, [&](int col) { Scatter(f, own.y, col, c.x); });
 }
 
 // ParallelSolveFrames' state: part p's batch rows at Rows(p) (part 0's are the solution's).
@@ -148,20 +151,21 @@ void ForwardFramesPart(void* context, int part) {
   }
   c.passes->forward_list_many(*c.factor, PartSupernodes(*c.plan, part), PartCount(*c.plan, part),
                               own, 3 * c.frames);
-  if (part > 0) {
-    double* solution = c.Rows(0);
-    ForEachColumnOf(*c.factor, *c.plan, part,
-                    [&](int col) { std::copy_n(c.Row(own, col), c.stride, c.Row(solution, col)); });
-  }
 }
 
 // BackwardPart's batched counterpart.
 void BackwardFramesPart(void* context, int part) {
   const FramesContext& c = *static_cast<const FramesContext*>(context);
-  double* solution = c.Rows(0);
+  double* own = c.Rows(part);
+  if (part > 0) {
+    const double* solution = c.Rows(0);
+    for (const int col : c.plan->top_columns) {
+      std::copy_n(c.Row(solution, col), c.stride, c.Row(own, col));
+    }
+  }
   c.passes->backward_list_many(*c.factor, PartSupernodes(*c.plan, part), PartCount(*c.plan, part),
-                               solution, 3 * c.frames);
-  ForEachColumnOf(*c.factor, *c.plan, part, [&](int col) { c.Scatter(col, solution); });
+                               own, 3 * c.frames);
+  ForEachColumnOf(*c.factor, *c.plan, part, [&](int col) { c.Scatter(col, own); });
 }
 
 }  // namespace

@@ -6,11 +6,13 @@
 // only theirs. A plan (PlanParallelSolve) splits the tree into `parts` groups of whole subtrees of
 // about equal cost (the factor's values they hold) and the top: every supernode above them, the
 // top separators of the nested-dissection ordering. The solve runs the parts' forward passes
-// concurrently (part 0 on the solution, each other part on its own copy whose top rows start at
-// zero, added into the solution's top rows afterwards, so no two threads write one row), then the
-// top's forward and backward passes on the calling thread, then the parts' backward passes
-// concurrently (each writes only its own rows). The sums run in another order than Solve3's, so
-// the result equals Solve3's to round-off (1e-12 of the solution's norm, tested).
+// concurrently (part 0 on the solution, each other part on rows of its own whose top rows start
+// at zero, added into the solution's top rows afterwards, so no two threads write one row), then
+// the top's forward and backward passes on the calling thread, then the parts' backward passes
+// concurrently, each where its forward pass left its rows (another part's rows first take the
+// top's solved rows: a part's supernodes read only their own rows and the top's; no part's rows
+// are copied to the solution), each writing only its own rows of x. The sums run in another order
+// than Solve3's, so the result equals Solve3's to round-off (1e-12 of the solution's norm, tested).
 //
 // Who runs the parts is the caller's ParallelRunner: the service's runs them on the workers of
 // its pool that are free (or free up) while parts are left and the rest on the calling thread;
