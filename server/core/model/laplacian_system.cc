@@ -50,14 +50,6 @@ Positions RestDeltas(const TriangleMesh& mesh, const JointRegions& regions,
   return laplacian * rest_with_nodes;
 }
 
-// out = m r for a row-major sparse m and n by 3 row-major r and out.
-void MultiplySparseBy3(const RowMajorSparseMatrix& m, const double* __restrict r,
-                       double* __restrict out, int first_row, int end_row) {
-  for (int row = first_row; row < end_row; ++row) {
-    SparseRowTimes3(m, r, row, out + 3 * static_cast<std::ptrdiff_t>(row));
-  }
-}
-
 }  // namespace
 
 LaplacianSystem BuildLaplacianSystem(const TriangleMesh& mesh, const VertexAdjacency& adjacency,
@@ -121,8 +113,10 @@ Eigen::SparseMatrix<double> NormalMatrixPattern(const LaplacianSystem& system) {
 }
 
 void MultiplyLaplacianTranspose(const LaplacianSystem& system, const double* r, double* out) {
-  MultiplySparseBy3(system.laplacian_transpose, r, out, 0,
-                    static_cast<int>(system.laplacian_transpose.outerSize()));
+  const RowMajorSparseMatrix& lt = system.laplacian_transpose;
+  for (int row = 0; row < static_cast<int>(lt.outerSize()); ++row) {
+    SparseRowTimes3(lt, r, row, out + 3 * static_cast<std::ptrdiff_t>(row));
+  }
 }
 
 }  // namespace deform
