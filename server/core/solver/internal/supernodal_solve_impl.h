@@ -334,6 +334,35 @@ inline void PrefetchFactor(const SupernodeBlock<Value>& s, const Value* values,
   for (std::ptrdiff_t offset = 0; offset < bytes; offset += 64) PrefetchLine(begin + offset);
 }
 
+// PrefetchFactor's lines asked for one at a time through a loop instead of all at once: Step(k)
+// asks for the k-th line, Rest(steps) for those the loop's `steps` steps left. The batched passes
+// spread theirs (a line per step of a block's loop, which reads about a line a step; in the
+// backward pass a line per row of each strip of columns): asked all at the start of a block, they
+// held up the loads behind them. deform_bench on the 26k leg, alternately: BatchedSolve of one
+// frame 2.65-2.72 against 3.17-3.21 ms, of four 3.63-3.73 against 4.08-4.10, ParallelBatchedSolve
+// of four 2.24-2.47 against 2.55-2.70. The three-column passes keep the burst: spread (two lines a
+// step among seven loads), the 26k leg's TriangularSolve took 2.41-2.47 against 2.32-2.35 ms.
+struct SpreadPrefetch {
+  std::uintptr_t begin = 0;
+  std::ptrdiff_t lines = 0;
+  template <Pass kPass, typename Value>
+  static SpreadPrefetch Of(const SupernodeBlock<Value>& s, const Value* values,
+                           std::ptrdiff_t count) {
+    if (!s.prefetch) return {};
+    const std::uintptr_t at = reinterpret_cast<std::uintptr_t>(values);
+    return {kPass == Pass::kForward ? at + kPrefetchBytes : at - kPrefetchBytes,
+            (count * static_cast<std::ptrdiff_t>(sizeof(Value)) + 63) / 64};
+  }
+  void Step(std::ptrdiff_t k) const {
+    if (k < lines) PrefetchLine(begin + 64 * static_cast<std::uintptr_t>(k));
+  }
+  void Rest(std::ptrdiff_t steps) const {
+    for (std::ptrdiff_t k = steps; k < lines; ++k) {
+      PrefetchLine(begin + 64 * static_cast<std::uintptr_t>(k));
+    }
+  }
+};
+
 // The solution rows during the solve (supernodal_solve.h).
 constexpr int kRowStride = kSolveRowStride;
 
@@ -720,9 +749,11 @@ constexpr int BlockFor(int vecs) {
 // kRows rows of a supernode's block (`width` values each) whose sums are held in registers.
 template <typename Value, int kVecs, int kRows>
 inline void SubtractSolvedColumns(const Value* __restrict rows, int width, int count,
-                                  const double* __restrict own, BatchVec (&sum)[kRows][kVecs]) {
+                                  const double* __restrict own, BatchVec (&sum)[kRows][kVecs],
+                                  const SpreadPrefetch& prefetch = {}) {
   constexpr int kStride = kBatchLanes * kVecs;
   for (int k = 0; k < count; ++k) {
+    prefetch.Step(k);
     const double* known = own + kStride * k;
     BatchVec v[kVecs];
     for (int j = 0; j < kVecs; ++j) v[j] = LoadBatch(known + kBatchLanes * j);
@@ -731,6 +762,7 @@ inline void SubtractSolvedColumns(const Value* __restrict rows, int width, int c
       for (int j = 0; j < kVecs; ++j) sum[i][j] -= l * v[j];
     }
   }
+  prefetch.Rest(count);
 }
 
 // Rows [r, num_rows) of the block below the diagonal, kRows at a time while they last, then in
@@ -742,14 +774,14 @@ inline void ForwardRowsMany(const SupernodeBlock<Value>& s, const double* __rest
   const int width = s.width;
   for (; r + kRows <= s.num_rows; r += kRows) {
     const Value* block_rows = s.values + r * width;
-    PrefetchFactor<Pass::kForward>(s, block_rows, kRows * width);
+    const auto prefetch = SpreadPrefetch::Of<Pass::kForward>(s, block_rows, kRows * width);
     double* target[kRows];
     BatchVec sum[kRows][kVecs];
     for (int i = 0; i < kRows; ++i) {
       target[i] = y + kStride * static_cast<std::ptrdiff_t>(s.rows[r + i]);
       for (int j = 0; j < kVecs; ++j) sum[i][j] = LoadBatch(target[i] + kBatchLanes * j);
     }
-    SubtractSolvedColumns<Value, kVecs, kRows>(block_rows, width, width, own, sum);
+    SubtractSolvedColumns<Value, kVecs, kRows>(block_rows, width, width, own, sum, prefetch);
     for (int i = 0; i < kRows; ++i) {
       for (int j = 0; j < kVecs; ++j) StoreBatch(target[i] + kBatchLanes * j, sum[i][j]);
     }
@@ -768,13 +800,13 @@ inline void ForwardDiagonalMany(const SupernodeBlock<Value>& s, double* __restri
   const int width = s.width;
   for (; c + kTile <= width; c += kTile) {
     const Value* tile_rows = s.values + static_cast<std::ptrdiff_t>(c) * width;
-    PrefetchFactor<Pass::kForward>(s, tile_rows, kTile * width);
+    const auto prefetch = SpreadPrefetch::Of<Pass::kForward>(s, tile_rows, kTile * width);
     double* const tile = own + kStride * c;
     BatchVec sum[kTile][kVecs];
     for (int i = 0; i < kTile; ++i) {
       for (int j = 0; j < kVecs; ++j) sum[i][j] = LoadBatch(tile + kStride * i + kBatchLanes * j);
     }
-    SubtractSolvedColumns<Value, kVecs, kTile>(tile_rows, width, c, own, sum);
+    SubtractSolvedColumns<Value, kVecs, kTile>(tile_rows, width, c, own, sum, prefetch);
     for (int i = 0; i < kTile; ++i) {
       const Value* row = tile_rows + i * width;
       for (int m = 0; m < i; ++m) {
@@ -820,9 +852,9 @@ inline void BackwardColumnsMany(const SupernodeBlock<Value>& s, double* __restri
       }
     }
     const auto add_row = [&](std::int64_t row_index, BatchVec(&into)[kColumns][kVecs]) {
-      // The first strip of columns is the first to touch each row: the block's stream.
-      if (k == 0) PrefetchFactor<Pass::kBackward>(s, s.values + row_index * width, width);
       const Value* row = s.values + row_index * width + k;
+      // The block's stream below, a line a row as each strip of columns reads its own.
+      if (s.prefetch) PrefetchLine(reinterpret_cast<std::uintptr_t>(row) - kPrefetchBytes);
       const double* solved = y + kStride * static_cast<std::ptrdiff_t>(s.rows[row_index]);
       BatchVec v[kVecs];
       for (int j = 0; j < kVecs; ++j) v[j] = LoadBatch(solved + kBatchLanes * j);
@@ -863,7 +895,7 @@ inline void BackwardDiagonalMany(const SupernodeBlock<Value>& s, double* __restr
   for (; c >= kTile; c -= kTile) {
     const int f = c - kTile;
     const Value* tile_rows = s.values + static_cast<std::ptrdiff_t>(f) * width;
-    PrefetchFactor<Pass::kBackward>(s, tile_rows, kTile * width);
+    const auto prefetch = SpreadPrefetch::Of<Pass::kBackward>(s, tile_rows, kTile * width);
     double* const tile = own + kStride * f;
     BatchVec solved[kTile][kVecs];
     for (int i = kTile - 1; i >= 0; --i) {
@@ -881,6 +913,7 @@ inline void BackwardDiagonalMany(const SupernodeBlock<Value>& s, double* __restr
       }
     }
     for (int k = 0; k < f; ++k) {
+      prefetch.Step(k);
       double* above = own + kStride * k;
       BatchVec sum[kVecs];
       for (int j = 0; j < kVecs; ++j) sum[j] = LoadBatch(above + kBatchLanes * j);
@@ -890,6 +923,7 @@ inline void BackwardDiagonalMany(const SupernodeBlock<Value>& s, double* __restr
       }
       for (int j = 0; j < kVecs; ++j) StoreBatch(above + kBatchLanes * j, sum[j]);
     }
+    prefetch.Rest(f);
   }
   if constexpr (kTile > 1) BackwardDiagonalMany<Value, kVecs, kTile / 2>(s, own, c);
 }
