@@ -279,6 +279,17 @@ ParallelSolvePlan PlanParallelSolve(const SupernodalFactorView& f, int parts) {
     candidates.insert(candidates.end(), children[split].begin(), children[split].end());
   }
   if (*std::min_element(load.begin(), load.end()) <= 0) return plan;  // nothing to run alongside
+  // The heaviest part first: a runner's calling thread takes the parts in order and its helpers
+  // start a wake-up later, so theirs should be the lighter. deform_bench on the 26k leg (whose
+  // top separator leaves subtrees 7% apart), alternately with the parts in packing order:
+  // ParallelSolve 1.42-1.47 against 1.59-1.60 ms, ParallelBatchedSolve of four frames 2.30-2.36
+  // against 2.43-2.46, of eight 3.21-3.25 against 3.33-3.38.
+  std::vector<int> order(parts);
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return load[a] > load[b]; });
+  std::vector<std::vector<int>> heaviest_first;
+  for (const int b : order) heaviest_first.push_back(std::move(bins[b]));
+  bins = std::move(heaviest_first);
   // Each bin's subtrees, whole, ascending.
   plan.parts = parts;
   plan.part_offsets.push_back(0);

@@ -85,6 +85,8 @@ class ThreadTeam final : public ParallelRunner {
 struct ParallelSolvePlan {
   int parts = 0;
   // Part p's supernodes, ascending: part_supernodes[part_offsets[p] .. part_offsets[p + 1]).
+  // The heaviest part (by the factor's values) is part 0, which a runner's calling thread takes
+  // first: its helpers start a wake-up later.
   std::vector<int> part_offsets;
   std::vector<int> part_supernodes;
   std::vector<int> top;          // the other supernodes, ascending
