@@ -319,29 +319,19 @@ inline void PrefetchLine(std::uintptr_t address) {
 
 enum class Pass { kForward, kBackward };
 
-// Asks for the bytes at distance kPrefetchBytes from [values, values + count) of `s`'s block in
-// `pass`'s direction, when its factor streams from memory. A prefetch never faults: addresses
-// beyond the factor's ends are harmless (computed as integers, since a pointer may not leave its
-// array).
-template <Pass kPass, typename Value>
-inline void PrefetchFactor(const SupernodeBlock<Value>& s, const Value* values,
-                           std::ptrdiff_t count) {
-  if (!s.prefetch) return;
-  const std::uintptr_t begin = kPass == Pass::kForward
-                                   ? reinterpret_cast<std::uintptr_t>(values) + kPrefetchBytes
-                                   : reinterpret_cast<std::uintptr_t>(values) - kPrefetchBytes;
-  const std::ptrdiff_t bytes = count * static_cast<std::ptrdiff_t>(sizeof(Value));
-  for (std::ptrdiff_t offset = 0; offset < bytes; offset += 64) PrefetchLine(begin + offset);
-}
-
-// PrefetchFactor's lines asked for one at a time through a loop instead of all at once: Step(k)
-// asks for the k-th line, Rest(steps) for those the loop's `steps` steps left. The batched passes
-// spread theirs (a line per step of a block's loop, which reads about a line a step; in the
-// backward pass a line per row of each strip of columns): asked all at the start of a block, they
-// held up the loads behind them. deform_bench on the 26k leg, alternately: BatchedSolve of one
-// frame 2.65-2.72 against 3.17-3.21 ms, of four 3.63-3.73 against 4.08-4.10, ParallelBatchedSolve
-// of four 2.24-2.47 against 2.55-2.70. The three-column passes keep the burst: spread (two lines a
-// step among seven loads), the 26k leg's TriangularSolve took 2.41-2.47 against 2.32-2.35 ms.
+// The factor's lines at distance kPrefetchBytes from [values, values + count) of `s`'s block in
+// `pass`'s direction (none when its factor does not stream from memory), asked for all at once
+// (PrefetchFactor) or one at a time through a loop: Step(k) asks for the k-th line, Rest(steps)
+// for those the loop's `steps` steps left. A prefetch never faults: addresses beyond the
+// factor's ends are harmless (computed as integers, since a pointer may not leave its array).
+//
+// The batched passes spread theirs (a line per step of a block's loop, which reads about a line a
+// step; in the backward pass a line per row of each strip of columns): asked all at the start of
+// a block, they held up the loads behind them. deform_bench on the 26k leg, alternately:
+// BatchedSolve of one frame 2.65-2.72 against 3.17-3.21 ms, of four 3.63-3.73 against 4.08-4.10,
+// ParallelBatchedSolve of four 2.24-2.47 against 2.55-2.70. The three-column passes keep the
+// burst: spread (two lines a step among seven loads), the 26k leg's TriangularSolve took
+// 2.41-2.47 against 2.32-2.35 ms.
 struct SpreadPrefetch {
   std::uintptr_t begin = 0;
   std::ptrdiff_t lines = 0;
@@ -362,6 +352,13 @@ struct SpreadPrefetch {
     }
   }
 };
+
+// All of SpreadPrefetch's lines at once.
+template <Pass kPass, typename Value>
+inline void PrefetchFactor(const SupernodeBlock<Value>& s, const Value* values,
+                           std::ptrdiff_t count) {
+  SpreadPrefetch::Of<kPass>(s, values, count).Rest(0);
+}
 
 // The solution rows during the solve (supernodal_solve.h).
 constexpr int kRowStride = kSolveRowStride;
@@ -854,7 +851,7 @@ inline void BackwardColumnsMany(const SupernodeBlock<Value>& s, double* __restri
     const auto add_row = [&](std::int64_t row_index, BatchVec(&into)[kColumns][kVecs]) {
       const Value* row = s.values + row_index * width + k;
       // The block's stream below, a line a row as each strip of columns reads its own.
-      if (s.prefetch) PrefetchLine(reinterpret_cast<std::uintptr_t>(row) - kPrefetchBytes);
+      SpreadPrefetch::Of<Pass::kBackward>(s, row, 1).Step(0);
       const double* solved = y + kStride * static_cast<std::ptrdiff_t>(s.rows[row_index]);
       BatchVec v[kVecs];
       for (int j = 0; j < kVecs; ++j) v[j] = LoadBatch(solved + kBatchLanes * j);
