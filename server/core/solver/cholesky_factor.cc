@@ -241,6 +241,7 @@ SupernodalFactorView CholeskyFactor::View() const {
   view.num_supernodes = static_cast<int>(s.supernode_columns_.size()) - 1;
   view.supernode_columns = s.supernode_columns_.data();
   view.permutation = s.permutation_.data();
+  view.inverse_permutation = s.inverse_permutation_.data();
   view.row_pointers = row_pointers_.data();
   view.value_pointers = value_pointers_.data();
   view.row_indices = row_indices_.data();

@@ -39,14 +39,18 @@ struct SolveContext {
   double* Solution() const { return work; }
 };
 
-// Calls body(column) for every column of part `part`'s supernodes.
+// Calls body(row) for every row of part `part`'s supernodes, in the order of their unknowns.
 template <typename Body>
-void ForEachColumnOf(const SupernodalFactorView& f, const ParallelSolvePlan& plan, int part,
-                     Body&& body) {
-  for (int i = plan.part_offsets[part]; i < plan.part_offsets[part + 1]; ++i) {
-    const int s = plan.part_supernodes[i];
-    for (int col = f.supernode_columns[s]; col < f.supernode_columns[s + 1]; ++col) body(col);
+void ForEachRowOf(const ParallelSolvePlan& plan, int part, Body&& body) {
+  for (int i = plan.part_row_offsets[part]; i < plan.part_row_offsets[part + 1]; ++i) {
+    body(plan.part_rows[i]);
   }
+}
+
+// `rows` sorted by the unknown each holds.
+void SortByUnknown(const SupernodalFactorView& f, std::vector<int>::iterator first,
+                   std::vector<int>::iterator last) {
+  std::sort(first, last, [&](int a, int b) { return f.permutation[a] < f.permutation[b]; });
 }
 
 void Gather(const SupernodalFactorView& f, const double* b, int row, double* y) {
@@ -73,7 +77,7 @@ void ForwardPart(void* context, int part) {
   const SolveContext& c = *static_cast<const SolveContext*>(context);
   const SupernodalFactorView& f = *c.factor;
   const PartBuffers own = c.Buffers(part);
-  ForEachColumnOf(f, *c.plan, part, [&](int col) { Gather(f, c.b, col, own.y); });
+  ForEachRowOf(*c.plan, part, [&](int col) { Gather(f, c.b, col, own.y); });
   if (part > 0) {
     for (const int col : c.plan->top_columns) {
       double* t = own.y + kSolveRowStride * static_cast<std::ptrdiff_t>(col);
@@ -98,7 +102,7 @@ void BackwardPart(void* context, int part) {
     }
   }
   c.backward(f, PartSupernodes(*c.plan, part), PartCount(*c.plan, part), own.y, own.planar);
-  ForEachColumnOf(f, *c.plan, part, [&](int col) { Scatter(f, own.y, col, c.x); });
+  ForEachRowOf(*c.plan, part, [&](int col) { Scatter(f, own.y, col, c.x); });
 }
 
 // ParallelSolveFrames' state: part p's batch rows at Rows(p) (part 0's are the solution's).
@@ -145,7 +149,7 @@ struct FramesContext {
 void ForwardFramesPart(void* context, int part) {
   const FramesContext& c = *static_cast<const FramesContext*>(context);
   double* own = c.Rows(part);
-  ForEachColumnOf(*c.factor, *c.plan, part, [&](int col) { c.Gather(col, own); });
+  ForEachRowOf(*c.plan, part, [&](int col) { c.Gather(col, own); });
   if (part > 0) {
     for (const int col : c.plan->top_columns) std::fill_n(c.Row(own, col), c.stride, 0.0);
   }
@@ -165,7 +169,7 @@ void BackwardFramesPart(void* context, int part) {
   }
   c.passes->backward_list_many(*c.factor, PartSupernodes(*c.plan, part), PartCount(*c.plan, part),
                                own, 3 * c.frames);
-  ForEachColumnOf(*c.factor, *c.plan, part, [&](int col) { c.Scatter(col, own); });
+  ForEachRowOf(*c.plan, part, [&](int col) { c.Scatter(col, own); });
 }
 
 }  // namespace
@@ -309,6 +313,19 @@ ParallelSolvePlan PlanParallelSolve(const SupernodalFactorView& f, int parts) {
               plan.part_supernodes.end());
     plan.part_offsets.push_back(static_cast<int>(plan.part_supernodes.size()));
   }
+  plan.part_row_offsets.push_back(0);
+  for (int p = 0; p < parts; ++p) {
+    const std::size_t first = plan.part_rows.size();
+    for (int i = plan.part_offsets[p]; i < plan.part_offsets[p + 1]; ++i) {
+      const int s = plan.part_supernodes[i];
+      for (int col = f.supernode_columns[s]; col < f.supernode_columns[s + 1]; ++col) {
+        plan.part_rows.push_back(col);
+      }
+    }
+    SortByUnknown(f, plan.part_rows.begin() + static_cast<std::ptrdiff_t>(first),
+                  plan.part_rows.end());
+    plan.part_row_offsets.push_back(static_cast<int>(plan.part_rows.size()));
+  }
   std::sort(top.begin(), top.end());
   plan.top = top;
   double top_cost = 0;
@@ -319,6 +336,7 @@ ParallelSolvePlan PlanParallelSolve(const SupernodalFactorView& f, int parts) {
       plan.top_columns.push_back(col);
     }
   }
+  SortByUnknown(f, plan.top_columns.begin(), plan.top_columns.end());
   plan.widest_supernode = widest;
   plan.top_share = total > 0 ? top_cost / total : 0;
   plan.predicted_time_ratio =

@@ -89,8 +89,16 @@ struct ParallelSolvePlan {
   // first: its helpers start a wake-up later.
   std::vector<int> part_offsets;
   std::vector<int> part_supernodes;
-  std::vector<int> top;          // the other supernodes, ascending
-  std::vector<int> top_columns;  // the top's unknowns (permuted order)
+  std::vector<int> top;  // the other supernodes, ascending
+  // The top's rows (permuted order), in the order of the unknowns they hold (permutation[row]
+  // ascending), as part_rows holds the parts'.
+  std::vector<int> top_columns;
+  // Part p's rows: part_rows[part_row_offsets[p] .. part_row_offsets[p + 1]), in the order of the
+  // unknowns they hold, so a part gathers its right-hand sides and scatters its solution in the
+  // order they lie in memory (one pass each way over b and x; the rows, one or two cache lines
+  // each, are the scattered side).
+  std::vector<int> part_row_offsets;
+  std::vector<int> part_rows;
   int widest_supernode = 0;
   // The factor's values in the top (solved on one thread), and the time predicted against Solve3
   // ((top + largest part) / whole), both by the values read.

@@ -13,9 +13,11 @@ namespace deform {
 // row_indices[row_pointers[s] .. row_pointers[s + 1]) (its own columns first, then the rows below,
 // ascending), and its values a dense row-major (#rows) x (width) block at
 // values[value_pointers[s]], zero above the diagonal, and `values` is followed by at least
-// kSolveValuePadding readable zeros. permutation[new] = old. A float32 factor sets `float_values`
-// (same layout and padding) instead of `values`: exactly one of the two is set. The passes read
-// float32 values widened to double and do all their arithmetic in double either way.
+// kSolveValuePadding readable zeros. permutation[new] = old, inverse_permutation[old] = new (the
+// passes gather the right-hand sides and scatter the solution in the unknowns' order, reading and
+// writing b and x once through, the solution rows being the scattered side). A float32 factor sets
+// `float_values` (same layout and padding) instead of `values`: exactly one of the two is set. The
+// passes read float32 values widened to double and do all their arithmetic in double either way.
 inline constexpr int kSolveValuePadding = 3;
 
 struct SupernodalFactorView {
@@ -23,6 +25,7 @@ struct SupernodalFactorView {
   int num_supernodes = 0;
   const int* supernode_columns = nullptr;
   const int* permutation = nullptr;
+  const int* inverse_permutation = nullptr;
   const std::int64_t* row_pointers = nullptr;
   const std::int64_t* value_pointers = nullptr;
   const int* row_indices = nullptr;

@@ -172,8 +172,9 @@ StatusOr<std::shared_ptr<const SymbolicCholesky>> SymbolicCholesky::Analyze(cons
 
 Status SymbolicCholesky::AnalyzePermutedPattern(const ColMajorMatrix& a) {
   const int n = n_;
-  std::vector<int> inverse(n);
-  for (int i = 0; i < n; ++i) inverse[permutation_[i]] = i;
+  inverse_permutation_.assign(n, 0);
+  for (int i = 0; i < n; ++i) inverse_permutation_[permutation_[i]] = i;
+  const std::vector<int>& inverse = inverse_permutation_;
   a_nonzeros_ = a.nonZeros();
   a_column_pointers_.assign(a.outerIndexPtr(), a.outerIndexPtr() + n + 1);
   a_row_indices_.assign(a.innerIndexPtr(), a.innerIndexPtr() + a.nonZeros());

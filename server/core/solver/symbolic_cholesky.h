@@ -31,12 +31,14 @@ class SymbolicCholesky {
 
  private:
   friend class CholeskyFactor;
-  // Fills the pattern of C and the map from A's entries (after permutation_ is set).
+  // Sets inverse_permutation_, the pattern of C and the map from A's entries (after permutation_
+  // is set).
   Status AnalyzePermutedPattern(const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& a);
 
   int n_ = 0;
   Ordering ordering_ = Ordering::kMetis;
-  std::vector<int> permutation_;  // permutation_[new] = old
+  std::vector<int> permutation_;          // permutation_[new] = old
+  std::vector<int> inverse_permutation_;  // inverse_permutation_[old] = new
   // Upper triangle of C = P A P^T, column-major, rows ascending in each column.
   std::vector<int> c_column_pointers_;
   std::vector<int> c_row_indices_;

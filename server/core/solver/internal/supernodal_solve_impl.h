@@ -671,9 +671,9 @@ void Solve3Impl(const SupernodalFactorView& f, const double* b, double* x, doubl
   // The solution rows start at the first 32-byte boundary of `work`.
   double* __restrict y = AlignedTo(work, kRowStride);
   double* const planar_buffer = y + kRowStride * static_cast<std::ptrdiff_t>(n);
-  for (int i = 0; i < n; ++i) {
-    const double* source = b + 3 * static_cast<std::ptrdiff_t>(f.permutation[i]);
-    double* t = Row(y, i);
+  for (int unknown = 0; unknown < n; ++unknown) {
+    const double* source = b + 3 * static_cast<std::ptrdiff_t>(unknown);
+    double* t = Row(y, f.inverse_permutation[unknown]);
     t[0] = source[0];
     t[1] = source[1];
     t[2] = source[2];
@@ -686,9 +686,9 @@ void Solve3Impl(const SupernodalFactorView& f, const double* b, double* x, doubl
       BackwardSupernode<Value>(f, sn, y, planar_buffer);
     }
   });
-  for (int i = 0; i < n; ++i) {
-    double* target = x + 3 * static_cast<std::ptrdiff_t>(f.permutation[i]);
-    const double* t = Row(y, i);
+  for (int unknown = 0; unknown < n; ++unknown) {
+    double* target = x + 3 * static_cast<std::ptrdiff_t>(unknown);
+    const double* t = Row(y, f.inverse_permutation[unknown]);
     target[0] = t[0];
     target[1] = t[1];
     target[2] = t[2];
@@ -936,18 +936,18 @@ inline void BackwardSupernodeMany(const SupernodeBlock<Value>& s, double* __rest
   BackwardDiagonalMany<Value, kVecs, BlockFor(kVecs)>(s, own, s.width);
 }
 
-// The batched passes on solution rows of kVecs batch vectors: gather(row, i) fills row i
-// (its first columns; the rest is zeroed here) from the right-hand sides of unknown
-// permutation[i], scatter(row, i) takes the solution back out.
+// The batched passes on solution rows of kVecs batch vectors: gather(row, unknown) fills the row
+// of `unknown` (its first columns; the rest is zeroed here) from that unknown's right-hand sides,
+// scatter(row, unknown) takes its solution back out; both in the unknowns' order.
 template <int kVecs, typename Gather, typename Scatter>
 void SolveRowsWithWidth(const SupernodalFactorView& f, int columns, double* work, Gather&& gather,
                         Scatter&& scatter) {
   constexpr int kStride = kBatchLanes * kVecs;
   const int n = f.size;
   double* __restrict y = AlignedTo(work, kBatchLanes);  // at a whole batch vector's boundary
-  for (int i = 0; i < n; ++i) {
-    double* t = y + kStride * static_cast<std::ptrdiff_t>(i);
-    gather(t, f.permutation[i]);
+  for (int unknown = 0; unknown < n; ++unknown) {
+    double* t = y + kStride * static_cast<std::ptrdiff_t>(f.inverse_permutation[unknown]);
+    gather(t, unknown);
     for (int c = columns; c < kStride; ++c) t[c] = 0;
   }
   WithValueType(f, [&](auto value) {
@@ -959,8 +959,8 @@ void SolveRowsWithWidth(const SupernodalFactorView& f, int columns, double* work
       BackwardSupernodeMany<Value, kVecs>(BlockOf<Value>(f, sn), y);
     }
   });
-  for (int i = 0; i < n; ++i) {
-    scatter(y + kStride * static_cast<std::ptrdiff_t>(i), f.permutation[i]);
+  for (int unknown = 0; unknown < n; ++unknown) {
+    scatter(y + kStride * static_cast<std::ptrdiff_t>(f.inverse_permutation[unknown]), unknown);
   }
 }
 
