@@ -47,7 +47,7 @@ void ForEachRowOf(const ParallelSolvePlan& plan, int part, Body&& body) {
   }
 }
 
-// `rows` sorted by the unknown each holds.
+// The rows [first, last) sorted by the unknown each holds.
 void SortByUnknown(const SupernodalFactorView& f, std::vector<int>::iterator first,
                    std::vector<int>::iterator last) {
   std::sort(first, last, [&](int a, int b) { return f.permutation[a] < f.permutation[b]; });
@@ -77,7 +77,7 @@ void ForwardPart(void* context, int part) {
   const SolveContext& c = *static_cast<const SolveContext*>(context);
   const SupernodalFactorView& f = *c.factor;
   const PartBuffers own = c.Buffers(part);
-  ForEachRowOf(*c.plan, part, [&](int col) { Gather(f, c.b, col, own.y); });
+  ForEachRowOf(*c.plan, part, [&](int row) { Gather(f, c.b, row, own.y); });
   if (part > 0) {
     for (const int col : c.plan->top_columns) {
       double* t = own.y + kSolveRowStride * static_cast<std::ptrdiff_t>(col);
@@ -102,7 +102,7 @@ void BackwardPart(void* context, int part) {
     }
   }
   c.backward(f, PartSupernodes(*c.plan, part), PartCount(*c.plan, part), own.y, own.planar);
-  ForEachRowOf(*c.plan, part, [&](int col) { Scatter(f, own.y, col, c.x); });
+  ForEachRowOf(*c.plan, part, [&](int row) { Scatter(f, own.y, row, c.x); });
 }
 
 // ParallelSolveFrames' state: part p's batch rows at Rows(p) (part 0's are the solution's).
@@ -149,7 +149,7 @@ struct FramesContext {
 void ForwardFramesPart(void* context, int part) {
   const FramesContext& c = *static_cast<const FramesContext*>(context);
   double* own = c.Rows(part);
-  ForEachRowOf(*c.plan, part, [&](int col) { c.Gather(col, own); });
+  ForEachRowOf(*c.plan, part, [&](int row) { c.Gather(row, own); });
   if (part > 0) {
     for (const int col : c.plan->top_columns) std::fill_n(c.Row(own, col), c.stride, 0.0);
   }
@@ -169,7 +169,7 @@ void BackwardFramesPart(void* context, int part) {
   }
   c.passes->backward_list_many(*c.factor, PartSupernodes(*c.plan, part), PartCount(*c.plan, part),
                                own, 3 * c.frames);
-  ForEachRowOf(*c.plan, part, [&](int col) { c.Scatter(col, own); });
+  ForEachRowOf(*c.plan, part, [&](int row) { c.Scatter(row, own); });
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <string>
@@ -363,6 +364,13 @@ TEST_P(SolveKernelTest, ParallelSolveMatchesSolve3) {
       const ParallelSolvePlan plan = factor->PlanParallel(parts);
       if (plan.parts == 0) continue;  // too small to split (the 2-unknown case)
       EXPECT_EQ(plan.parts, parts);
+      // The parts' rows and the top's partition the unknowns' rows.
+      std::vector<int> owners(n, 0);
+      for (const int row : plan.part_rows) ++owners[row];
+      for (const int row : plan.top_columns) ++owners[row];
+      EXPECT_EQ(std::count(owners.begin(), owners.end(), 1), n) << c.name << ", " << parts;
+      ASSERT_EQ(plan.part_row_offsets.size(), static_cast<std::size_t>(parts) + 1);
+      EXPECT_EQ(plan.part_row_offsets.back(), static_cast<int>(plan.part_rows.size()));
       if (c.name == "grid 70" && parts == 2) {
         EXPECT_LT(plan.top_share, 0.3) << parts;
         EXPECT_LT(plan.predicted_time_ratio, 0.8) << parts;
