@@ -1,16 +1,15 @@
 #include "service/load_request.h"
 
-#include <utility>
-
 #include <algorithm>
 #include <climits>
+#include <utility>
 
 #include "core/geometry/skeleton.h"
 #include "core/io/declared_mesh_size.h"
-#include "core/model/deformation_model.h"
 #include "core/io/phantom.h"
 #include "core/io/rig_import.h"
 #include "core/io/skeleton_io.h"
+#include "core/model/deformation_model.h"
 #include "service/load_header.h"
 #include "service/proto_conversion.h"
 
@@ -40,7 +39,17 @@ Status ParseUpload(const v1::UploadSource& upload, std::string* mesh_bytes,
     job->mesh = std::move(rig->mesh);
     job->skeleton = std::move(rig->skeleton);
     job->weights = std::move(rig->weights);
+    // Frames, rest positions and vertex indices go through this map: every entry must name a
+    // vertex of the mesh (ReadGltf's contract, checked here where it starts to matter).
+    const int vertices = job->mesh.num_vertices();
+    for (const int m : rig->file_vertex_to_mesh) {
+      if (m < 0 || m >= vertices) {
+        return Status::Internal("glTF: a file vertex maps to vertex " + std::to_string(m) +
+                                " of a " + std::to_string(vertices) + "-vertex mesh");
+      }
+    }
     job->presentation.file_vertex_to_mesh = std::move(rig->file_vertex_to_mesh);
+    job->presentation.unused_file_vertices = std::move(rig->unused_file_vertices);
     job->presentation.units = std::move(rig->units);
     job->presentation.up_axis = std::move(rig->up_axis);
     return Status::Ok();
@@ -107,9 +116,8 @@ StatusOr<std::size_t> DeclaredLoadBytes(const v1::LoadMeshHeader& header,
   const auto clamp = [](std::size_t count) {
     return static_cast<int>(std::min<std::size_t>(count, INT_MAX));
   };
-  return mesh_bytes.size() +
-         DeformationModel::EstimateBytesBeforeBuild(clamp(declared->vertices),
-                                                    clamp(declared->faces));
+  return mesh_bytes.size() + DeformationModel::EstimateBytesBeforeBuild(clamp(declared->vertices),
+                                                                        clamp(declared->faces));
 }
 
 }  // namespace deform::service

@@ -70,6 +70,10 @@ StatusOr<std::shared_ptr<const MeshEntry>> Build(MeshRegistry* registry,
   for (const std::string& warning : entry->model->binding_report().warnings) {
     spdlog::warn("mesh={} binding: {}", entry->id, EscapeForLog(warning));
   }
+  if (!entry->presentation.unused_file_vertices.empty()) {
+    spdlog::warn("mesh={} {} file vertices used by no triangle follow the used vertex before them",
+                 entry->id, entry->presentation.unused_file_vertices.size());
+  }
   return entry;
 }
 

@@ -44,8 +44,12 @@ namespace deform::service {
 // up axis (from a glTF rig; empty for the other formats).
 struct MeshPresentation {
   // Per vertex in the file's order (the order of frames, rest positions and vertex indices in the
-  // API), its vertex of the solved mesh; empty when they are the same.
+  // API), its vertex of the solved mesh (every entry one of them: RigImport); empty when they are
+  // the same.
   std::vector<int> file_vertex_to_mesh;
+  // Of those, the ones no triangle uses (ascending): GetMeshInfo's triangles never name them, and
+  // the summary warns of them.
+  std::vector<int> unused_file_vertices;
   std::string units;
   std::string up_axis;
 };

@@ -188,6 +188,11 @@ void FillMeshSummary(const MeshEntry& entry, v1::MeshSummary* summary) {
   summary->set_binding(model.weights_given() ? v1::BINDING_WEIGHTS : v1::BINDING_THROUGH_BODY);
   summary->clear_warnings();
   for (const std::string& warning : model.binding_report().warnings) summary->add_warnings(warning);
+  if (const std::size_t unused = entry.presentation.unused_file_vertices.size(); unused > 0) {
+    summary->add_warnings(std::to_string(unused) +
+                          " of the file's vertices are used by no triangle: each follows the used "
+                          "vertex before it in the file (frames give it that vertex's position)");
+  }
   summary->set_units(entry.presentation.units);
   summary->set_up_axis(entry.presentation.up_axis);
 }
@@ -198,9 +203,16 @@ void FillMeshGeometry(const MeshEntry& entry, v1::GetMeshInfoResponse* info) {
   std::string* positions = info->mutable_rest_positions();
   positions->resize(static_cast<std::size_t>(entry.client_vertex_count()) * 3 * 4);
   EncodeInClientOrder(mesh.vertices.data(), mesh.num_vertices(), order, positions->data());
-  // Triangles name client vertices: each solved vertex by the first file vertex welded into it.
+  // Triangles name client vertices: each solved vertex by the first file vertex welded into it
+  // (never one that no triangle uses and that only follows it).
   std::vector<int> client_of(mesh.num_vertices(), -1);
-  for (int f = static_cast<int>(order.size()) - 1; f >= 0; --f) client_of[order[f]] = f;
+  const std::vector<int>& unused = entry.presentation.unused_file_vertices;
+  auto next_unused = unused.rbegin();
+  for (int f = static_cast<int>(order.size()) - 1; f >= 0; --f) {
+    while (next_unused != unused.rend() && *next_unused > f) ++next_unused;
+    if (next_unused != unused.rend() && *next_unused == f) continue;
+    client_of[order[f]] = f;
+  }
   std::string* triangles = info->mutable_triangles();
   const std::size_t indices = static_cast<std::size_t>(mesh.num_triangles()) * 3;
   triangles->resize(indices * 4);

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <iterator>
 #include <optional>
@@ -112,6 +113,103 @@ TEST_F(RigUploadTest, GltfRigDeformsLikeTheSameRigAsObjJsonAndWeights) {
     worst = std::max(worst, static_cast<double>(std::abs(from_gltf[c] - from_files[c])));
   }
   EXPECT_LT(worst, 1e-6 * diagonal);
+  ExpectBackgroundStreamAlive();
+}
+
+// A glTF whose vertex buffer holds vertices no triangle uses (the first, one in the middle, the
+// last), as exporters leave them: it loads with a warning; the rest geometry and the frames of
+// every encoding give each of them the position of the used vertex before it in the file (the
+// first used one, for the first), and GetMeshInfo's triangles name only used vertices.
+TEST_F(RigUploadTest, GltfVerticesNoTriangleUsesFollowTheUsedVertexBeforeThem) {
+  StartServer();
+  auto phantom = MakeKneePhantom(600);
+  ASSERT_TRUE(phantom.ok());
+  const auto [weights, csv] = PhantomWeights(*phantom);
+  const int n = phantom->mesh.num_vertices();
+  // File order: a stray, vertices [0, n / 2), a stray, [n / 2, n), a stray.
+  const std::vector<int> strays = {0, n / 2 + 1, n + 2};
+  TriangleMesh loose;
+  loose.vertices.resize(n + 3, 3);
+  SkinWeights loose_weights;
+  loose_weights.num_bones = weights.num_bones;
+  std::vector<int> file_of(static_cast<std::size_t>(n));
+  for (int f = 0, v = 0; f < n + 3; ++f) {
+    if (std::find(strays.begin(), strays.end(), f) != strays.end()) {
+      loose.vertices.row(f) = Eigen::RowVector3d(0.5, 0.5, 0.5);  // away from every used vertex
+      loose_weights.AddVertex({0}, {1.0});
+      continue;
+    }
+    file_of[static_cast<std::size_t>(v)] = f;
+    loose.vertices.row(f) = phantom->mesh.vertices.row(v);
+    loose_weights.AddVertex(std::vector<int>(weights.bones.begin() + weights.offsets[v],
+                                             weights.bones.begin() + weights.offsets[v + 1]),
+                            std::vector<double>(weights.weights.begin() + weights.offsets[v],
+                                                weights.weights.begin() + weights.offsets[v + 1]));
+    ++v;
+  }
+  loose.triangles = phantom->mesh.triangles;
+  for (Eigen::Index k = 0; k < loose.triangles.size(); ++k) {
+    loose.triangles.data()[k] = file_of[static_cast<std::size_t>(loose.triangles.data()[k])];
+  }
+  auto glb = WriteGltf(loose, phantom->skeleton, loose_weights, GltfContainer::kGlb);
+  ASSERT_TRUE(glb.ok()) << glb.status().ToString();
+  v1::LoadMeshHeader header;
+  header.mutable_upload()->set_format(v1::MESH_FORMAT_GLTF);
+  v1::MeshSummary summary;
+  const grpc::Status loaded = client_->LoadMesh(header, *glb, &summary);
+  ASSERT_TRUE(loaded.ok()) << loaded.error_message();
+  EXPECT_EQ(summary.vertex_count(), static_cast<std::uint32_t>(n + 3));
+  EXPECT_EQ(summary.solved_vertex_count(), static_cast<std::uint32_t>(n));
+  EXPECT_THAT(summary.warnings(), ::testing::Contains(HasSubstr("3 of the file's vertices")));
+
+  // The file vertex whose position each stray takes: the one before it, the next for the first.
+  const auto followed = [&](int f) { return f == 0 ? 1 : f - 1; };
+  const auto expect_strays_follow = [&](const std::vector<float>& positions, const char* what) {
+    ASSERT_EQ(positions.size(), 3u * (n + 3)) << what;
+    for (const float value : positions) ASSERT_TRUE(std::isfinite(value)) << what;
+    for (const int f : strays) {
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_EQ(positions[3 * f + c], positions[3 * followed(f) + c])
+            << what << ": file vertex " << f;
+      }
+    }
+  };
+  v1::GetMeshInfoResponse info;
+  ASSERT_TRUE(client_->GetMeshInfo(summary.mesh_id(), true, &info).ok());
+  const std::vector<float> rest = client::DecodePositions(info.rest_positions());
+  expect_strays_follow(rest, "rest positions");
+  for (int v = 0; v < n; ++v) {
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_FLOAT_EQ(rest[3 * file_of[static_cast<std::size_t>(v)] + c],
+                      static_cast<float>(phantom->mesh.vertices(v, c)));
+    }
+  }
+  ASSERT_EQ(info.triangles().size(), 4u * 3 * phantom->mesh.num_triangles());
+  for (std::size_t k = 0; k < info.triangles().size() / 4; ++k) {
+    std::uint32_t vertex = 0;
+    std::memcpy(&vertex, info.triangles().data() + 4 * k, 4);  // little-endian hosts
+    EXPECT_EQ(vertex, static_cast<std::uint32_t>(loose.triangles.data()[k])) << "corner " << k;
+  }
+  const std::string spec = "knee:x:80,knee:y:10";
+  expect_strays_follow(FrameFor(*client_, summary.mesh_id(), spec), "float32 frame");
+  for (const v1::FrameEncoding encoding :
+       {v1::FRAME_ENCODING_QUANTIZED, v1::FRAME_ENCODING_PREDICTED}) {
+    test_support::StreamRecorder recorder(/*keep_positions=*/true);
+    client::DeformClient::StreamOptions options;
+    options.encoding = encoding;
+    auto stream = client_->OpenStream(summary.mesh_id(), recorder.Callbacks(), options);
+    v1::PoseUpdate pose;
+    std::string error;
+    ASSERT_TRUE(client::ParsePoseAngles(spec, &pose, &error)) << error;
+    pose.set_sequence(1);
+    ASSERT_TRUE(stream->SendPose(pose));
+    ASSERT_TRUE(recorder.WaitForFrameWithSequence(1));
+    stream->Close();
+    EXPECT_TRUE(stream->Wait().ok());
+    const std::vector<float> decoded = client::DecodePositions(recorder.last_frame().positions());
+    ASSERT_EQ(decoded.size(), 3u * (n + 3)) << "encoding " << encoding;
+    for (const float value : decoded) ASSERT_TRUE(std::isfinite(value)) << "encoding " << encoding;
+  }
   ExpectBackgroundStreamAlive();
 }
 

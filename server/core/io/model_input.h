@@ -19,8 +19,8 @@ struct ModelInput {
   // Skinning weights over `skeleton`'s bones for every vertex of `mesh`, normalised
   // (NormalizeSkinWeights); from a weights file or a glTF rig, absent otherwise.
   std::optional<SkinWeights> weights;
-  // For a glTF rig: per vertex in the file's own order, its vertex of `mesh` (or -1; see
-  // RigImport). Empty when the mesh's vertices are the file's (OBJ, PLY, STL, OFF, the phantom).
+  // For a glTF rig: per vertex in the file's own order, its vertex of `mesh` (see RigImport).
+  // Empty when the mesh's vertices are the file's (OBJ, PLY, STL, OFF, the phantom).
   std::vector<int> file_vertex_to_mesh;
   std::string units;        // "metre" for glTF; empty when the file does not say (OBJ...)
   std::string up_axis;      // "+Y" for glTF; empty when the file does not say

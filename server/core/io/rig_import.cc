@@ -115,6 +115,7 @@ StatusOr<RigImport> ReadGltfUnguarded(std::string_view bytes, const MeshLimits& 
   result.skeleton = rig.skeleton;
   result.weights = std::move(welded.weights);
   result.file_vertex_to_mesh = std::move(welded.file_vertex_to_mesh);
+  result.unused_file_vertices = std::move(welded.unused_vertices);
   return result;
 }
 

@@ -28,7 +28,9 @@
 //   - Weights: a glTF joint's weight goes to the bone that starts at its skeleton joint; where
 //     several start there, to the one nearest the vertex; normalised (NormalizeSkinWeights).
 //   - Welding: vertices that glTF splits at seams (exactly equal position, weights equal within
-//     1e-6) become one vertex of the mesh; vertices no triangle uses are dropped.
+//     1e-6) become one vertex of the mesh; vertices no triangle uses are dropped from it, and each
+//     follows the used vertex before it in the file (the first used one, for those before it):
+//     frames give it that vertex's position, so an engine's whole vertex buffer stays defined.
 #pragma once
 
 #include <string>
@@ -47,11 +49,13 @@ struct RigImport {
   Skeleton skeleton;    // the skin's joints (plus any "<name>_end" joints) and their bones
   SkinWeights weights;  // on the welded vertices, bone indices in skeleton bone order; normalised
   // For each vertex in the file's own order (all primitives of the skinned mesh concatenated, as
-  // an engine holds them): its vertex in `mesh`, or -1 if no triangle uses it. Frames computed on
-  // `mesh` return to the file's order through this.
+  // an engine holds them): its vertex in `mesh` (always one: a vertex no triangle uses follows
+  // the used vertex before it, see Welding above). Frames computed on `mesh` return to the file's
+  // order through this.
   std::vector<int> file_vertex_to_mesh;
-  std::string units = "metre";  // glTF's units (the spec says metres)
-  std::string up_axis = "+Y";   // glTF's up axis
+  std::vector<int> unused_file_vertices;  // file vertices no triangle uses, ascending
+  std::string units = "metre";   // glTF's units (the spec says metres)
+  std::string up_axis = "+Y";    // glTF's up axis
 };
 
 // Parses a whole .gltf (JSON, buffers as data URIs) or .glb (told by its "glTF" magic) held in

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <map>
 #include <string>
@@ -199,15 +200,86 @@ TEST(ReadGltf, ConcatenatesPrimitivesOfEveryAccessorForm) {
   EXPECT_EQ(read->mesh.num_triangles(), tube.mesh.num_triangles());
   EXPECT_EQ(read->file_vertex_to_mesh.size(),
             static_cast<std::size_t>(all.vertex_count() + soup.vertex_count()));
-  // Each file vertex maps to a mesh vertex at its own position.
+  // Each file vertex maps to a mesh vertex at its own position: primitive 0's copies of the
+  // upper vertices, which its triangles do not use, are welded to the soup's, which use them.
+  EXPECT_TRUE(read->unused_file_vertices.empty());
   for (std::size_t f = 0; f < read->file_vertex_to_mesh.size(); ++f) {
     const int m = read->file_vertex_to_mesh[f];
-    if (m < 0) continue;  // a vertex of primitive 0's copy that its triangles do not use
+    ASSERT_GE(m, 0);
     const float* p = f < static_cast<std::size_t>(all.vertex_count())
                          ? &all.positions[3 * f]
                          : &soup.positions[3 * (f - all.vertex_count())];
     for (int c = 0; c < 3; ++c) EXPECT_FLOAT_EQ(read->mesh.vertices(m, c), p[c]);
   }
+}
+
+// A primitive whose vertex buffer holds vertices no triangle uses (first, in the middle, last):
+// the mesh drops them, and in the file's order each follows the used vertex before it (those
+// before every used vertex, the first used one), so every file vertex has a mesh vertex.
+TEST(ReadGltf, VerticesNoTriangleUsesFollowTheUsedVertexBeforeThem) {
+  const TestRig tube = Tube(6, 4);
+  const PrimitiveData tight = RigidTubePrimitive(tube);
+  const int n = tight.vertex_count();
+  // File order: two strays, the tube's first half, a stray, the second half, a stray.
+  PrimitiveData loose;
+  std::vector<int> file_of_tube_vertex(static_cast<std::size_t>(n));
+  const auto add_vertex = [&](const PrimitiveData& from, int v) {
+    loose.positions.insert(loose.positions.end(), from.positions.begin() + 3 * v,
+                           from.positions.begin() + 3 * v + 3);
+    loose.joints.insert(loose.joints.end(), from.joints.begin() + 4 * v,
+                        from.joints.begin() + 4 * v + 4);
+    loose.weights.insert(loose.weights.end(), from.weights.begin() + 4 * v,
+                         from.weights.begin() + 4 * v + 4);
+  };
+  PrimitiveData stray;  // far from the tube, where no tube vertex is
+  stray.positions = {5.0f, 5.0f, 5.0f};
+  stray.joints = {0, 0, 0, 0};
+  stray.weights = {1.0f, 0.0f, 0.0f, 0.0f};
+  std::vector<bool> is_stray;
+  for (int v = 0; v < n; ++v) {
+    if (v == 0) {
+      add_vertex(stray, 0);
+      add_vertex(stray, 0);
+      is_stray.insert(is_stray.end(), {true, true});
+    }
+    if (v == n / 2) {
+      add_vertex(stray, 0);
+      is_stray.push_back(true);
+    }
+    file_of_tube_vertex[static_cast<std::size_t>(v)] = loose.vertex_count();
+    add_vertex(tight, v);
+    is_stray.push_back(false);
+  }
+  add_vertex(stray, 0);
+  is_stray.push_back(true);
+  for (const std::uint32_t v : tight.indices) {
+    loose.indices.push_back(static_cast<std::uint32_t>(file_of_tube_vertex[v]));
+  }
+  GltfBuilder builder = ChainRig({{0, 0, 0}, {0, 1, 0}, {0, 2, 0}}, {loose});
+  auto read = ReadGltf(builder.ToGlb());
+  ASSERT_TRUE(read.ok()) << read.status().ToString();
+  ASSERT_EQ(read->mesh.num_vertices(), n);
+  ASSERT_EQ(read->file_vertex_to_mesh.size(), is_stray.size());
+  std::vector<int> strays;
+  for (std::size_t f = 0; f < is_stray.size(); ++f) {
+    if (is_stray[f]) strays.push_back(static_cast<int>(f));
+  }
+  EXPECT_EQ(read->unused_file_vertices, strays);
+  EXPECT_EQ(strays.size(), 4u);
+  const std::vector<int>& map = read->file_vertex_to_mesh;
+  for (int v = 0; v < n; ++v) {
+    const int m = map[static_cast<std::size_t>(file_of_tube_vertex[static_cast<std::size_t>(v)])];
+    for (int c = 0; c < 3; ++c)
+      EXPECT_FLOAT_EQ(read->mesh.vertices(m, c), tube.mesh.vertices(v, c));
+  }
+  const int first_used = file_of_tube_vertex[0];
+  for (std::size_t f = 0; f < map.size(); ++f) {
+    if (!is_stray[f]) continue;
+    const int followed =
+        static_cast<int>(f) < first_used ? map[static_cast<std::size_t>(first_used)] : map[f - 1];
+    EXPECT_EQ(map[f], followed) << "file vertex " << f;
+  }
+  EXPECT_EQ(map.back(), map[map.size() - 2]);
 }
 
 TEST(ReadGltf, GivesALeafJointWithWeightsAnEndBone) {

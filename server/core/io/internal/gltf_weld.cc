@@ -50,6 +50,28 @@ bool SameWeights(const SkinWeights& weights, int a, int b) {
   return true;
 }
 
+// Gives each unused file vertex (-1 in `map`) the mesh vertex of the used one before it in the
+// file, or of the first used one for those before every used vertex; lists them.
+void FollowUsedVertices(std::vector<int>* map, std::vector<int>* unused) {
+  int followed = -1;
+  for (const int m : *map) {
+    if (m >= 0) {
+      followed = m;  // the first used vertex, for the unused ones at the file's start
+      break;
+    }
+  }
+  unused->clear();
+  for (std::size_t f = 0; f < map->size(); ++f) {
+    int& m = (*map)[f];
+    if (m >= 0) {
+      followed = m;
+    } else {
+      m = followed;
+      unused->push_back(static_cast<int>(f));
+    }
+  }
+}
+
 }  // namespace
 
 WeldedMesh WeldSeams(const Positions& positions, const SkinWeights& weights,
@@ -108,6 +130,7 @@ WeldedMesh WeldSeams(const Positions& positions, const SkinWeights& weights,
           result.file_vertex_to_mesh[static_cast<std::size_t>(triangles(t, c))];
     }
   }
+  FollowUsedVertices(&result.file_vertex_to_mesh, &result.unused_vertices);
   return result;
 }
 

@@ -21,8 +21,12 @@ inline constexpr double kWeldWeightTolerance = 1e-6;
 struct WeldedMesh {
   TriangleMesh mesh;
   SkinWeights weights;
-  // Per file vertex: its welded vertex, or -1 for a vertex that no triangle uses (dropped).
+  // Per file vertex: its welded vertex. A vertex that no triangle uses is dropped from the mesh
+  // and follows the used vertex before it in the file (the first used one, for those before it),
+  // so every entry names a vertex of `mesh` (all -1 only when no triangle uses any vertex: the
+  // mesh is then empty, which ValidateMesh refuses).
   std::vector<int> file_vertex_to_mesh;
+  std::vector<int> unused_vertices;  // the file vertices no triangle uses, ascending
 };
 
 // `positions` and `weights` (normalised: entries sorted by bone) in file order; `triangles` index
