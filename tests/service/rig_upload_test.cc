@@ -27,10 +27,14 @@ using ::testing::HasSubstr;
 
 class RigUploadTest : public test_support::ServiceTest {};
 
+// The positions of the frame of pose `spec` (decoded by the library from `encoding`).
 std::vector<float> FrameFor(client::DeformClient& client, const std::string& mesh_id,
-                            const std::string& spec) {
+                            const std::string& spec,
+                            v1::FrameEncoding encoding = v1::FRAME_ENCODING_FLOAT32) {
   test_support::StreamRecorder recorder(/*keep_positions=*/true);
-  auto stream = client.OpenStream(mesh_id, recorder.Callbacks());
+  client::DeformClient::StreamOptions options;
+  options.encoding = encoding;
+  auto stream = client.OpenStream(mesh_id, recorder.Callbacks(), options);
   v1::PoseUpdate pose;
   std::string error;
   EXPECT_TRUE(client::ParsePoseAngles(spec, &pose, &error)) << error;
@@ -194,19 +198,7 @@ TEST_F(RigUploadTest, GltfVerticesNoTriangleUsesFollowTheUsedVertexBeforeThem) {
   expect_strays_follow(FrameFor(*client_, summary.mesh_id(), spec), "float32 frame");
   for (const v1::FrameEncoding encoding :
        {v1::FRAME_ENCODING_QUANTIZED, v1::FRAME_ENCODING_PREDICTED}) {
-    test_support::StreamRecorder recorder(/*keep_positions=*/true);
-    client::DeformClient::StreamOptions options;
-    options.encoding = encoding;
-    auto stream = client_->OpenStream(summary.mesh_id(), recorder.Callbacks(), options);
-    v1::PoseUpdate pose;
-    std::string error;
-    ASSERT_TRUE(client::ParsePoseAngles(spec, &pose, &error)) << error;
-    pose.set_sequence(1);
-    ASSERT_TRUE(stream->SendPose(pose));
-    ASSERT_TRUE(recorder.WaitForFrameWithSequence(1));
-    stream->Close();
-    EXPECT_TRUE(stream->Wait().ok());
-    const std::vector<float> decoded = client::DecodePositions(recorder.last_frame().positions());
+    const std::vector<float> decoded = FrameFor(*client_, summary.mesh_id(), spec, encoding);
     ASSERT_EQ(decoded.size(), 3u * (n + 3)) << "encoding " << encoding;
     for (const float value : decoded) ASSERT_TRUE(std::isfinite(value)) << "encoding " << encoding;
   }
