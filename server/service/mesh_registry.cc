@@ -182,6 +182,9 @@ StatusOr<std::shared_ptr<const MeshEntry>> MeshRegistry::Register(
         *model, solve_settings_.slots, solve_settings_.max_frames, entry->parallel_plan.get());
   }
   entry->model = std::move(model);
+  // The file-order maps (4 bytes per file vertex, and per unused one) are the mesh's too.
+  entry->memory_bytes += sizeof(int) * (presentation.file_vertex_to_mesh.size() +
+                                        presentation.unused_file_vertices.size());
   entry->presentation = std::move(presentation);
 
   MutexLock lock(&mutex_);

@@ -62,7 +62,7 @@ struct MeshEntry {
   double precompute_ms = 0;
   double factor_ms = 0;
   std::size_t factor_bytes = 0;
-  std::size_t memory_bytes = 0;  // model->EstimatedBytes() and batch_scratches
+  std::size_t memory_bytes = 0;  // model->EstimatedBytes(), batch_scratches, the file-order maps
   MeshPresentation presentation;
   // The buffers of batched solves of the mesh's frames (in memory_bytes), with room for the
   // parallel plan's batches when there is one; null when its frames are solved one by one

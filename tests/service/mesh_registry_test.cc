@@ -47,6 +47,22 @@ TEST(MeshRegistryTest, RegistersFindsListsAndUnloads) {
   EXPECT_EQ(registry.memory_bytes_used(), model->EstimatedBytes());
 }
 
+TEST(MeshRegistryTest, AMeshsMemoryCountsItsFileOrderMaps) {
+  MeshRegistry registry(ServiceLimits{});
+  const auto model = SmallModel();
+  MeshPresentation presentation;  // a glTF's: two more file vertices than the mesh, one unused
+  for (int v = 0; v < model->mesh().num_vertices(); ++v) {
+    presentation.file_vertex_to_mesh.push_back(v);
+  }
+  presentation.file_vertex_to_mesh.insert(presentation.file_vertex_to_mesh.end(), {0, 1});
+  presentation.unused_file_vertices = {model->mesh().num_vertices() + 1};
+  const std::size_t map_bytes = sizeof(int) * (model->mesh().num_vertices() + 3);
+  auto entry = registry.Register(registry.Reserve().value(), "rig", model, presentation);
+  ASSERT_TRUE(entry.ok()) << entry.status().ToString();
+  EXPECT_EQ((*entry)->memory_bytes, model->EstimatedBytes() + map_bytes);
+  EXPECT_EQ(registry.memory_bytes_used(), model->EstimatedBytes() + map_bytes);
+}
+
 TEST(MeshRegistryTest, ReservationsCountAgainstTheMeshLimitUntilReleased) {
   ServiceLimits limits;
   limits.max_meshes = 2;
