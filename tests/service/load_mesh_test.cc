@@ -406,9 +406,9 @@ TEST_F(LoadMeshTest, AnUploadInFlightHoldsItsBytesOfTheBudgetUntilItEnds) {
 
   // A phantom that would fit in the budget alone does not fit beside the upload's bytes.
   v1::MeshSummary summary;
-  const grpc::Status refused = client_->LoadPhantom(20'000, {}, &summary);
+  const grpc::Status refused = client_->LoadPhantom(12'000, {}, &summary);
   EXPECT_EQ(refused.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
-  EXPECT_THAT(refused.error_message(), HasSubstr("a phantom of 20000 vertices needs about"));
+  EXPECT_THAT(refused.error_message(), HasSubstr("a phantom of 12000 vertices needs about"));
 
   // The upload ends (its client cancels): its bytes and its slot are released.
   context->TryCancel();
@@ -418,7 +418,7 @@ TEST_F(LoadMeshTest, AnUploadInFlightHoldsItsBytesOfTheBudgetUntilItEnds) {
   }
   EXPECT_EQ(registry.loads_in_progress(), 0);
   EXPECT_EQ(registry.memory_bytes_reserved(), 0u);
-  EXPECT_TRUE(client_->LoadPhantom(20'000, {}, &summary).ok());
+  EXPECT_TRUE(client_->LoadPhantom(12'000, {}, &summary).ok());
   ExpectBackgroundStreamAlive();
 }
 

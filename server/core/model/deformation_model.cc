@@ -56,25 +56,6 @@ std::vector<int> RigidZones(const JointRegions& regions, const std::vector<Neare
   return fixed_bone;
 }
 
-// `v` rotated by vertex i's quaternion blend (QLERP: the bones' rotations weighted, signs aligned
-// to the first), without normalising the blend: the rotation of a quaternion (w, u) scaled to unit
-// length is v + 2 / |q|^2 (w (u x v) + u x (u x v)), which saves the square root and the division
-// of QuaternionBlend's normalize() (same result to round-off).
-Eigen::Vector3d RotateByBlend(const BoneWeights& bw, int vertex,
-                              const std::vector<RigidTransform>& bones, const Eigen::Vector3d& v) {
-  const int begin = bw.offsets[vertex], end = bw.offsets[vertex + 1];
-  const Eigen::Quaterniond& first = bones[bw.bones[begin]].rotation;
-  Eigen::Vector4d q = bw.weights[begin] * first.coeffs();  // (x, y, z, w)
-  for (int p = begin + 1; p < end; ++p) {
-    const Eigen::Quaterniond& qk = bones[bw.bones[p]].rotation;
-    const double sign = first.dot(qk) < 0 ? -1.0 : 1.0;
-    q += (sign * bw.weights[p]) * qk.coeffs();
-  }
-  const Eigen::Vector3d u = q.head<3>();
-  const Eigen::Vector3d t = u.cross(v);
-  return v + (2.0 / q.squaredNorm()) * (q[3] * t + u.cross(t));
-}
-
 }  // namespace
 
 StatusOr<std::shared_ptr<const DeformationModel>> DeformationModel::Build(
@@ -127,6 +108,8 @@ Status DeformationModel::Precompute(const SkinWeights* weights, const CancelToke
   if (options_.rotation_blend == RotationBlend::kLinear) {
     linear_blend_plan_ = std::make_shared<const LinearBlendPlan>(LinearBlendPlan::Build(
         bone_weights_, skeleton_.num_bones(), options_.linear_blend_segments));
+  } else {
+    general_rows_ = GeneralRowsPlan::Build(system_, rigid_rows_, bone_weights_);
   }
   BindingReport report = ReportBinding(mesh_, skeleton_, adjacency, bvh, bound_bones_, rigid_bones_,
                                        system_.anchors, IsClosed(mesh_.triangles));
@@ -207,6 +190,9 @@ StatusOr<std::shared_ptr<const MaterialFactorization>> DeformationModel::Factori
   DEFORM_ASSIGN_OR_RETURN(const Eigen::VectorXd row_weights, RowWeights(stiffness));
   result->row_weights_squared_ = row_weights.array().square();
   result->rigid_row_sums_ = RigidRowSums(system_, rigid_rows_, result->row_weights_squared_);
+  if (!linear_blend_plan_) {
+    result->slot_weights_ = general_rows_.SlotWeights(result->row_weights_squared_);
+  }
   DEFORM_ASSIGN_OR_RETURN(
       result->factor_,
       CholeskyFactor::Factorize(
@@ -258,14 +244,15 @@ std::size_t DeformationModel::EstimateBytesBeforeBuild(int num_vertices, int num
 std::size_t DeformationModel::EstimatedBytes() const {
   const MaterialFactorization& f = *default_factorization_;
   const LinearPoseResponse* response = f.linear_response();
-  return f.factor().bytes() + (response ? response->bytes() : 0) + f.rigid_row_sums_bytes() +
-         rigid_rows_.bytes() + GeometryBytes(mesh_.num_vertices(), mesh_.num_triangles());
+  return f.factor().bytes() + (response ? response->bytes() : 0) + f.right_hand_side_bytes() +
+         rigid_rows_.bytes() + general_rows_.bytes() +
+         GeometryBytes(mesh_.num_vertices(), mesh_.num_triangles());
 }
 
 std::size_t DeformationModel::FactorizationBytes() const {
   const LinearPoseResponse* response = default_factorization_->linear_response();
   return default_factorization_->factor().bytes_as_built() + (response ? response->bytes() : 0) +
-         default_factorization_->rigid_row_sums_bytes();
+         default_factorization_->right_hand_side_bytes();
 }
 
 std::size_t DeformationModel::ScratchBytes() const {
@@ -274,8 +261,12 @@ std::size_t DeformationModel::ScratchBytes() const {
   const std::size_t slots =
       linear_blend_plan_ ? static_cast<std::size_t>(linear_blend_plan_->num_slots()) : bones;
   const std::size_t unknowns = vertices + static_cast<std::size_t>(system_.num_nodes);
+  const std::size_t rotated = linear_blend_plan_
+                                  ? 3 * vertices
+                                  : 4 * static_cast<std::size_t>(general_rows_.quaternion_count()) +
+                                        3 * static_cast<std::size_t>(general_rows_.slot_count());
   return bones * sizeof(RigidTransform) + slots * sizeof(Eigen::Matrix3d) +
-         (unknowns + vertices) * 3 * sizeof(double) +
+         (3 * unknowns + rotated) * sizeof(double) +
          default_factorization_->factor().WorkSize() * sizeof(double);
 }
 
@@ -321,7 +312,13 @@ DeformScratch DeformationModel::MakeScratchWithWork(std::size_t solve_work_doubl
   scratch.slot_rotations.resize(linear_blend_plan_ ? linear_blend_plan_->num_slots()
                                                    : skeleton_.num_bones());
   scratch.solution.resize(mesh_.num_vertices() + system_.num_nodes, 3);
-  scratch.rotated_deltas.resize(mesh_.num_vertices(), 3);
+  if (linear_blend_plan_) {
+    scratch.rotated_deltas.resize(mesh_.num_vertices(), 3);
+  } else {
+    scratch.signed_quaternions.resize(4 *
+                                      static_cast<std::size_t>(general_rows_.quaternion_count()));
+    scratch.rotated_slots.resize(3 * static_cast<std::size_t>(general_rows_.slot_count()));
+  }
   scratch.solve_work.resize(solve_work_doubles);
   return scratch;
 }
@@ -438,20 +435,11 @@ bool DeformationModel::SolveInPlace(const MaterialFactorization& factorization,
 void DeformationModel::AssembleOwnedRightHandSide(const MaterialFactorization& factorization,
                                                   const Pose& pose, DeformScratch* scratch) const {
   ForwardKinematics(skeleton_, pose, &scratch->bone_transforms);
-  RotateDeltas(factorization, scratch);
-  // A^T b = L'^T r + anchor_weight^2 c + node_weight^2 o.
-  MultiplyRotatedRows(system_, rigid_rows_, factorization.rigid_row_sums_.data(),
-                      scratch->slot_rotations.data(), scratch->rotated_deltas.data(),
-                      scratch->solution.data(), 0,
-                      static_cast<int>(system_.laplacian_transpose.outerSize()));
-  AddConstraintTargets(pose, scratch);
-}
-
-// Rotated, weighted differential coordinates r_i = w_i^2 T_i delta_i, T_i the rotation blend.
-void DeformationModel::RotateDeltas(const MaterialFactorization& factorization,
-                                    DeformScratch* scratch) const {
   PrepareSlotRotations(scratch);
-  RotateDeltasOf(factorization, scratch, 0, mesh_.num_vertices());
+  // A^T b = L'^T r + anchor_weight^2 c + node_weight^2 o, r = w^2 T delta.
+  RotateDeltasPart(factorization, scratch, 0, 1);
+  MultiplyRotatedPart(factorization, scratch, 0, 1);
+  AddConstraintTargets(pose, scratch);
 }
 
 void DeformationModel::PrepareSlotRotations(DeformScratch* scratch) const {
@@ -459,31 +447,10 @@ void DeformationModel::PrepareSlotRotations(DeformScratch* scratch) const {
   auto& rotations = scratch->slot_rotations;
   if (linear_blend_plan_) {
     linear_blend_plan_->SlotRotations(bones, rotations.data());
-  } else {
-    for (size_t k = 0; k < bones.size(); ++k) rotations[k] = bones[k].rotation.toRotationMatrix();
+    return;
   }
-}
-
-void DeformationModel::RotateDeltasOf(const MaterialFactorization& factorization,
-                                      DeformScratch* scratch, int first, int end) const {
-  const auto& bones = scratch->bone_transforms;
-  const auto& bw = bone_weights_;
-  const auto& w2 = factorization.row_weights_squared_;
-  auto& r = scratch->rotated_deltas;
-  const auto& rotations = scratch->slot_rotations;
-  const unsigned char* read = rigid_rows_.delta_read.data();
-  for (int i = first; i < end; ++i) {
-    if (!read[i]) continue;  // only rigid rows, through their sums, use this vertex
-    const int begin = bw.offsets[i], stop = bw.offsets[i + 1];
-    const Eigen::Vector3d delta = system_.rest_deltas.row(i).transpose();
-    if (stop - begin == 1) {  // most vertices: wholly one bone's
-      r.row(i) = w2[i] * (rotations[bw.bones[begin]] * delta).transpose();
-    } else if (linear_blend_plan_) {
-      r.row(i) = w2[i] * (linear_blend_plan_->Blend(i, rotations.data()) * delta).transpose();
-    } else {
-      r.row(i) = w2[i] * RotateByBlend(bw, i, bones, delta).transpose();
-    }
-  }
+  for (size_t k = 0; k < bones.size(); ++k) rotations[k] = bones[k].rotation.toRotationMatrix();
+  general_rows_.SignQuaternions(bones, scratch->signed_quaternions.data());
 }
 
 namespace {
@@ -498,6 +465,45 @@ std::pair<int, int> RangeOfPart(int count, int parts, int index) {
 
 }  // namespace
 
+void DeformationModel::RotateDeltasPart(const MaterialFactorization& factorization,
+                                        DeformScratch* scratch, int part, int parts) const {
+  if (!linear_blend_plan_) {
+    general_rows_.Rotate(scratch->signed_quaternions.data(), factorization.slot_weights_.data(),
+                         scratch->rotated_slots.data(), part, parts);
+    return;
+  }
+  // The linear blend: r_i = w_i^2 T_i delta_i, T_i a linear combination of slot rotations.
+  const auto [first, end] = RangeOfPart(mesh_.num_vertices(), parts, part);
+  const auto& bw = bone_weights_;
+  const auto& w2 = factorization.row_weights_squared_;
+  auto& r = scratch->rotated_deltas;
+  const auto& rotations = scratch->slot_rotations;
+  const unsigned char* read = rigid_rows_.delta_read.data();
+  for (int i = first; i < end; ++i) {
+    if (!read[i]) continue;  // only rigid rows, through their sums, use this vertex
+    const Eigen::Vector3d delta = system_.rest_deltas.row(i).transpose();
+    if (bw.offsets[i + 1] - bw.offsets[i] == 1) {  // wholly one bone's
+      r.row(i) = w2[i] * (rotations[bw.bones[bw.offsets[i]]] * delta).transpose();
+    } else {
+      r.row(i) = w2[i] * (linear_blend_plan_->Blend(i, rotations.data()) * delta).transpose();
+    }
+  }
+}
+
+void DeformationModel::MultiplyRotatedPart(const MaterialFactorization& factorization,
+                                           DeformScratch* scratch, int part, int parts) const {
+  const double* sums = factorization.rigid_row_sums_.data();
+  if (!linear_blend_plan_) {
+    general_rows_.Multiply(scratch->slot_rotations.data(), sums, scratch->rotated_slots.data(),
+                           scratch->solution.data(), part, parts);
+    return;
+  }
+  const auto [first, end] =
+      RangeOfPart(static_cast<int>(system_.laplacian_transpose.outerSize()), parts, part);
+  MultiplyRotatedRows(system_, rigid_rows_, sums, scratch->slot_rotations.data(),
+                      scratch->rotated_deltas.data(), scratch->solution.data(), first, end);
+}
+
 struct DeformationModel::ParallelAssembly {
   const DeformationModel* model;
   const MaterialFactorization* factorization;
@@ -506,23 +512,18 @@ struct DeformationModel::ParallelAssembly {
 
   static void Rotate(void* context, int index) {
     const auto& a = *static_cast<const ParallelAssembly*>(context);
-    const auto [first, end] = RangeOfPart(a.model->mesh_.num_vertices(), a.parts, index);
-    a.model->RotateDeltasOf(*a.factorization, a.scratch, first, end);
+    a.model->RotateDeltasPart(*a.factorization, a.scratch, index, a.parts);
   }
   static void Multiply(void* context, int index) {
     const auto& a = *static_cast<const ParallelAssembly*>(context);
-    const int rows = static_cast<int>(a.model->system_.laplacian_transpose.outerSize());
-    const auto [first, end] = RangeOfPart(rows, a.parts, index);
-    MultiplyRotatedRows(a.model->system_, a.model->rigid_rows_,
-                        a.factorization->rigid_row_sums_.data(), a.scratch->slot_rotations.data(),
-                        a.scratch->rotated_deltas.data(), a.scratch->solution.data(), first, end);
-    // The anchors among these rows (anchors ascend), once their rows hold the product.
-    const std::vector<int>& anchors = a.model->system_.anchors;
-    const auto anchor_at = [&](int row) {
-      return static_cast<int>(std::lower_bound(anchors.begin(), anchors.end(), row) -
-                              anchors.begin());
-    };
-    a.model->AddAnchorTargets(a.scratch, anchor_at(first), anchor_at(end));
+    a.model->MultiplyRotatedPart(*a.factorization, a.scratch, index, a.parts);
+  }
+  // Once every row holds its product (the parts' rows interleave).
+  static void Anchors(void* context, int index) {
+    const auto& a = *static_cast<const ParallelAssembly*>(context);
+    const auto [first, end] =
+        RangeOfPart(static_cast<int>(a.model->system_.anchors.size()), a.parts, index);
+    a.model->AddAnchorTargets(a.scratch, first, end);
   }
 };
 
@@ -539,7 +540,8 @@ bool DeformationModel::DeformParallel(const MaterialFactorization& factorization
   PrepareSlotRotations(scratch);
   ParallelAssembly assembly{this, &factorization, scratch, plan.parts};
   runner->Run(plan.parts, &ParallelAssembly::Rotate, &assembly);
-  runner->Run(plan.parts, &ParallelAssembly::Multiply, &assembly);  // and the anchors
+  runner->Run(plan.parts, &ParallelAssembly::Multiply, &assembly);
+  runner->Run(plan.parts, &ParallelAssembly::Anchors, &assembly);
   AddNodeTargets(pose, scratch);
   const auto solve_start = Clock::now();
   const Status solved = factorization.factor().Solve3Parallel(

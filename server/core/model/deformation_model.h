@@ -35,6 +35,7 @@
 #include "core/geometry/skin_weights.h"
 #include "core/model/binding_report.h"
 #include "core/model/bone_weights.h"
+#include "core/model/general_rows.h"
 #include "core/model/joint_regions.h"
 #include "core/model/laplacian_system.h"
 #include "core/model/linear_blend_plan.h"
@@ -67,13 +68,18 @@ class MaterialFactorization {
   // 0-120 degrees stays within 1.5 times the rest pose's, at most 2.0e-7 of the diagonal).
   double float32_probe_error() const { return float32_probe_error_; }
   static constexpr double kFloat32ProbeTolerance = 2.5e-7;
-  // The bytes of its rigid rows' sums (rigid_rows.h: 3 doubles per row of L'^T).
-  std::size_t rigid_row_sums_bytes() const { return rigid_row_sums_.size() * sizeof(double); }
+  // The bytes of its right-hand side's precomputed parts: the rigid rows' sums (rigid_rows.h: 3
+  // doubles per row of L'^T) and, for the quaternion blend, its slots' weights (general_rows.h: 1
+  // double per slot).
+  std::size_t right_hand_side_bytes() const {
+    return (rigid_row_sums_.size() + slot_weights_.size()) * sizeof(double);
+  }
 
  private:
   friend class DeformationModel;
   Eigen::VectorXd row_weights_squared_;  // w_i^2 (n) for the stiffness it was built for
   std::vector<double> rigid_row_sums_;   // RigidRowSums for those weights ((n + m) by 3)
+  std::vector<double> slot_weights_;     // GeneralRowsPlan::SlotWeights (quaternion blend only)
   CholeskyFactor factor_;
   std::unique_ptr<const LinearPoseResponse> linear_response_;
   double factor_seconds_ = 0;
@@ -87,9 +93,13 @@ struct DeformScratch {
   std::vector<RigidTransform> bone_transforms;  // K
   // K, the same rotations as matrices, then (linear blend) the knots' (linear_blend_plan.h)
   std::vector<Eigen::Matrix3d> slot_rotations;
-  Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> solution;        // (n + m) by 3
-  // n by 3: r = w^2 T delta of the vertices the general rows of L'^T read (rigid_rows.h); the
-  // others' rows are never written.
+  Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> solution;  // (n + m) by 3
+  // The quaternion blend: the frame's signed quaternions and r = w^2 T delta of the slots
+  // (general_rows.h: 4 doubles per signed quaternion, 3 planes of the slots).
+  std::vector<double> signed_quaternions;
+  std::vector<double> rotated_slots;
+  // The linear blend: n by 3, r = w^2 T delta of the vertices the general rows of L'^T read
+  // (rigid_rows.h); the others' rows are never written. Empty for the quaternion blend.
   Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> rotated_deltas;
   std::vector<double> solve_work;  // CholeskyFactor::WorkSize()
 
@@ -252,6 +262,8 @@ class DeformationModel {
   const Skeleton& skeleton() const { return skeleton_; }
   const ModelOptions& options() const { return options_; }
   const BoneWeights& bone_weights() const { return bone_weights_; }
+  // The quaternion blend's rows of L'^T r laid out for vector units (empty for the linear blend).
+  const GeneralRowsPlan& general_rows() const { return general_rows_; }
   // With the linear rotation blend, its knots and per-vertex terms; null otherwise.
   const LinearBlendPlan* linear_blend_plan() const { return linear_blend_plan_.get(); }
   const JointRegions& joint_regions() const { return regions_; }
@@ -328,14 +340,17 @@ class DeformationModel {
   Status BindToWeights(const SkinWeights& weights, const VertexAdjacency& adjacency);
   // The vertex rows' weights w_i for `stiffness` (all 1 with uniform_material).
   StatusOr<Eigen::VectorXd> RowWeights(const Stiffness& stiffness) const;
-  // The steps of AssembleRightHandSide: r = w^2 T delta into scratch->rotated_deltas (after the
-  // forward kinematics; only the rows the general rows of L'^T read, rigid_rows.h), then L'^T r
-  // and the anchors' and joint nodes' targets into scratch->solution.
-  void RotateDeltas(const MaterialFactorization& factorization, DeformScratch* scratch) const;
-  // RotateDeltas in two steps, the second by vertex range (a parallel assembly splits it).
+  // The steps of AssembleRightHandSide after the forward kinematics and PrepareSlotRotations:
+  // part `part` of `parts` of r = w^2 T delta (the quaternion blend: into scratch->rotated_slots
+  // through general_rows_, after PrepareSlotRotations signed the quaternions; the linear blend:
+  // into scratch->rotated_deltas' rows that the general rows of L'^T read, rigid_rows.h), then
+  // part `part` of L'^T r into scratch->solution (every part's rotation done). Parts are
+  // independent within each step.
   void PrepareSlotRotations(DeformScratch* scratch) const;
-  void RotateDeltasOf(const MaterialFactorization& factorization, DeformScratch* scratch, int first,
-                      int end) const;
+  void RotateDeltasPart(const MaterialFactorization& factorization, DeformScratch* scratch,
+                        int part, int parts) const;
+  void MultiplyRotatedPart(const MaterialFactorization& factorization, DeformScratch* scratch,
+                           int part, int parts) const;
   struct ParallelAssembly;       // DeformParallel's parts
   struct ParallelBatchAssembly;  // DeformBatchParallel's parts
   // The doubles of a batch scratch's solve work (MakeBatchScratch).
@@ -365,8 +380,9 @@ class DeformationModel {
   std::vector<int> bound_bones_;
   std::optional<SkinWeights> given_weights_;
   BindingReport binding_report_;
-  LaplacianSystem system_;  // L', the rest deltas, the anchors and joint nodes
-  RigidRows rigid_rows_;    // the rows of L'^T r one bone's rotation determines
+  LaplacianSystem system_;        // L', the rest deltas, the anchors and joint nodes
+  RigidRows rigid_rows_;          // the rows of L'^T r one bone's rotation determines
+  GeneralRowsPlan general_rows_;  // the quaternion blend's rows of L'^T r, for vector units
   std::shared_ptr<const SymbolicCholesky> symbolic_;
   std::shared_ptr<const MaterialFactorization> default_factorization_;
   double precompute_seconds_ = 0;

@@ -536,12 +536,16 @@ TEST(DeformationModel, EstimatedBytesAddTheFactorToTheGeometry) {
       model->mesh().num_vertices(), model->mesh().num_triangles());
   const std::size_t geometry = DeformationModel::kBytesPerVertex * model->mesh().num_vertices() +
                                DeformationModel::kBytesPerTriangle * model->mesh().num_triangles();
-  // The rigid rows' sums (3 doubles a row of L'^T) and bones (an int a row, a byte a vertex).
+  // The rigid rows' sums (3 doubles a row of L'^T) and bones (an int a row, a byte a vertex),
+  // and the general rows' plan with its slots' weights (a double a slot).
   const std::size_t n = model->mesh().num_vertices();
   const std::size_t rows = n + model->num_joint_nodes();
   const std::size_t rigid_rows = rows * 3 * sizeof(double) + rows * sizeof(int) + n;
-  EXPECT_EQ(model->EstimatedBytes(),
-            geometry + model->default_factorization()->factor().bytes() + rigid_rows);
+  const GeneralRowsPlan& plan = model->general_rows();
+  const std::size_t general_rows = plan.bytes() + plan.slot_count() * sizeof(double);
+  EXPECT_GT(plan.slot_count(), 0);
+  EXPECT_EQ(model->EstimatedBytes(), geometry + model->default_factorization()->factor().bytes() +
+                                         rigid_rows + general_rows);
   // Before the build the factor is predicted, from above: admission errs towards refusing.
   EXPECT_GT(before, geometry + model->default_factorization()->factor().bytes());
 }
@@ -554,6 +558,7 @@ TEST(DeformationModel, ScratchAndFactorizationBytesAreWhatAStreamAllocates) {
       scratch.slot_rotations.size() * sizeof(scratch.slot_rotations[0]) +
       static_cast<std::size_t>(scratch.solution.size() + scratch.rotated_deltas.size()) *
           sizeof(double) +
+      (scratch.signed_quaternions.size() + scratch.rotated_slots.size()) * sizeof(double) +
       scratch.solve_work.size() * sizeof(double);
   EXPECT_EQ(model->ScratchBytes(), allocated);
   Stiffness stiffer;
@@ -561,9 +566,10 @@ TEST(DeformationModel, ScratchAndFactorizationBytesAreWhatAStreamAllocates) {
   auto other = model->Factorize(stiffer);
   ASSERT_TRUE(other.ok()) << other.status().ToString();
   const std::size_t rows = model->mesh().num_vertices() + model->num_joint_nodes();
-  EXPECT_EQ((*other)->rigid_row_sums_bytes(), rows * 3 * sizeof(double));
+  EXPECT_EQ((*other)->right_hand_side_bytes(),
+            (rows * 3 + scratch.rotated_slots.size() / 3) * sizeof(double));
   EXPECT_EQ(model->FactorizationBytes(),
-            (*other)->factor().bytes() + (*other)->rigid_row_sums_bytes());
+            (*other)->factor().bytes() + (*other)->right_hand_side_bytes());
 }
 
 TEST(DeformationModel, BuildPhasesAreTheCancellablePhasesInOrder) {

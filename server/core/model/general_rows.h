@@ -1,0 +1,128 @@
+// The right-hand side's rows of L'^T r laid out for vector units (the quaternion blend).
+//
+// A frame's A^T b holds L'^T r, r_j = w_j^2 T_j delta_j, T_j vertex j's quaternion blend (QLERP:
+// its bones' unit quaternions weighted, their signs aligned to its first bone's, the blend
+// normalised). The rigid rows (rigid_rows.h) are one 3x3 product each. The general rows read the
+// rotated deltas of their vertices, which this plan computes and reads kLanes at a time:
+//
+// - Slots. Every vertex some general row reads has a slot. The slots are grouped by the vertex's
+//   ordered bone list (its bone-weight entries' bones, largest weight first), so a group's signed
+//   quaternions are the same for all its vertices and a frame blends a group with one set of
+//   them. Within a group the slots ascend by vertex. A group is padded to a multiple of
+//   kSlotBlock slots with slots of zero delta and zero weight (their r is 0, never read). Deltas,
+//   weights and the rotated deltas are planar, in slot order.
+// - Packs. The general rows of at most kMaxPackedEntries entries go in packs of kPackRows rows of
+//   the same length, entry by entry (one load takes an entry of each of the pack's rows), their
+//   columns as slots. A length's last pack repeats its last row, which then writes the same
+//   values twice. Longer rows (a joint node's row reads every vertex of its region) are
+//   compressed rows over slots.
+//
+// Same values as RotateByBlend and SparseRowTimes3 (deformation_model.cc, laplacian_system.h) to
+// round-off: sums in another order, 1e-14 of their norm (tested).
+#pragma once
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <vector>
+
+#include "core/geometry/pose.h"
+#include "core/model/bone_weights.h"
+#include "core/model/laplacian_system.h"
+#include "core/model/rigid_rows.h"
+#include "core/solver/supernodal_solve.h"
+
+namespace deform {
+
+// The plan's arrays as the kernels read them (internal/general_rows_kernel_impl.h).
+struct SlotGroupsView {
+  int group_count = 0;
+  int slot_count = 0;                 // a multiple of kSlotBlock
+  const int* slot_offsets = nullptr;  // group_count + 1, multiples of kSlotBlock
+  const int* quaternion_offsets =
+      nullptr;                          // group_count + 1: the group's bones' signed quaternions
+  const int* weight_offsets = nullptr;  // group_count: weights[offset + k * slots + l], bone k
+  const double* weights = nullptr;
+  const double* deltas = nullptr;  // 3 planes (x, y, z) of slot_count
+};
+struct RowPacksView {
+  // Pack p's entries e in [entry_offsets[p], entry_offsets[p + 1]): kPackRows columns (slots)
+  // and values at [kPackRows * e, kPackRows * (e + 1)); its rows at rows[kPackRows * p].
+  const int* entry_offsets = nullptr;
+  const int* columns = nullptr;
+  const double* values = nullptr;
+  const int* rows = nullptr;
+};
+
+// The kernels of one instruction set (internal/general_rows_kernel_*.cc).
+struct GeneralRowsKernel {
+  // Blocks [first_block, end_block) of kSlotBlock slots: rotated (3 planes of slot_count) =
+  // slot_weights * (the group's blend of `quaternions`, 4 doubles x y z w each) * deltas.
+  void (*rotate)(const SlotGroupsView& groups, const double* quaternions,
+                 const double* slot_weights, double* rotated, int first_block, int end_block);
+  // Packs [first_pack, end_pack) of L'^T r into out ((n + m) by 3, row-major; written).
+  void (*multiply)(const RowPacksView& packs, const double* rotated, int slot_count, double* out,
+                   int first_pack, int end_pack);
+};
+
+class GeneralRowsPlan {
+ public:
+  static constexpr int kSlotBlock = 8;
+  static constexpr int kPackRows = 8;
+  static constexpr int kMaxPackedEntries = 16;
+
+  // The plan of `system`'s L'^T with its rigid rows under the blending `weights`, its kernels
+  // those of `kernel` (available: SolveKernelAvailable).
+  static GeneralRowsPlan Build(const LaplacianSystem& system, const RigidRows& rigid,
+                               const BoneWeights& weights, SolveKernel kernel = BestSolveKernel());
+
+  int slot_count() const { return slot_count_; }
+  // The signed quaternions a frame needs (4 doubles each): one per bone of each group.
+  int quaternion_count() const { return static_cast<int>(quaternion_bones_.size()); }
+  // w_j^2 of each slot's vertex j (0 in the padding), for a factorisation's row weights (n).
+  std::vector<double> SlotWeights(const Eigen::VectorXd& row_weights_squared) const;
+  // quaternions[4 q, 4 q + 4) = x y z w of each group's bones' rotations, each sign aligned to
+  // the group's first bone's. No allocation.
+  void SignQuaternions(const std::vector<RigidTransform>& bones, double* quaternions) const;
+
+  // Part `part` of `parts` of the frame's rotated deltas (3 planes of slot_count(), x y z) from
+  // SignQuaternions' output and SlotWeights'. Parts are independent.
+  void Rotate(const double* quaternions, const double* slot_weights, double* rotated, int part,
+              int parts) const;
+  // Part `part` of `parts` of the rows of L'^T r into `out` ((n + m) by 3, row-major; written,
+  // not added): a rigid row as rotations[bone] * its RigidRowSums entry (`rigid_sums`), a general
+  // row from `rotated` (every part's Rotate done). Parts write disjoint rows. No allocation.
+  void Multiply(const Eigen::Matrix3d* rotations, const double* rigid_sums, const double* rotated,
+                double* out, int part, int parts) const;
+
+  std::size_t bytes() const;
+
+ private:
+  SlotGroupsView Groups() const;
+  RowPacksView Packs() const;
+  int pack_count() const { return static_cast<int>(pack_entry_offsets_.size()) - 1; }
+
+  GeneralRowsKernel kernel_{};
+  int slot_count_ = 0;
+  std::vector<int> slot_vertex_;  // per slot, -1 in the padding
+  std::vector<int> group_slot_offsets_;
+  std::vector<int> group_quaternion_offsets_;
+  std::vector<int> group_weight_offsets_;
+  std::vector<int> quaternion_bones_;  // per signed quaternion, its bone
+  std::vector<int> quaternion_first_;  // per signed quaternion, its group's first bone
+  std::vector<double> weights_;
+  std::vector<double> deltas_;  // 3 planes
+  std::vector<int> pack_entry_offsets_;
+  std::vector<int> pack_columns_;
+  std::vector<double> pack_values_;
+  std::vector<int> pack_rows_;
+  // The rows too long for a pack, compressed over slots.
+  std::vector<int> long_rows_;
+  std::vector<int> long_offsets_;
+  std::vector<int> long_columns_;
+  std::vector<double> long_values_;
+  // The rigid rows and their bones.
+  std::vector<int> rigid_rows_;
+  std::vector<int> rigid_bones_;
+};
+
+}  // namespace deform

@@ -1,0 +1,151 @@
+// The kernels of general_rows.h, compiled once per instruction set: by
+// general_rows_kernel_baseline.cc (two doubles a vector), general_rows_kernel_avx2.cc (-mavx2
+// -mfma: four, hardware gathers) and general_rows_kernel_avx512.cc (-mavx512f -mavx512vl as well:
+// eight, gathers and scatters). Each defines its GeneralRowsKernel from these functions.
+#pragma once
+
+#include <algorithm>
+#include <cstddef>
+#include <cstring>
+
+#if defined(__AVX2__)
+#include <immintrin.h>
+#endif
+
+#include "core/model/general_rows.h"
+
+namespace deform {
+namespace {
+
+#if defined(__AVX512F__)
+constexpr int kLanes = 8;
+#elif defined(__AVX2__)
+constexpr int kLanes = 4;
+#else
+constexpr int kLanes = 2;
+#endif
+static_assert(GeneralRowsPlan::kSlotBlock % kLanes == 0 && GeneralRowsPlan::kPackRows % kLanes == 0,
+              "blocks and packs are whole vectors");
+
+using Lanes = double __attribute__((vector_size(8 * kLanes)));
+
+inline Lanes Load(const double* p) {
+  Lanes v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+inline void Store(double* p, Lanes v) { std::memcpy(p, &v, sizeof v); }
+inline Lanes Broadcast(double x) {
+  Lanes v;
+  for (int l = 0; l < kLanes; ++l) v[l] = x;
+  return v;
+}
+
+// base[index[l]] for each lane. (The masked gathers: GCC 12's unmasked ones read an undefined
+// source register, and -Wmaybe-uninitialized says so.)
+inline Lanes Gather(const double* base, const int* index) {
+#if defined(__AVX512F__)
+  return _mm512_mask_i32gather_pd(
+      _mm512_setzero_pd(), 0xff, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(index)),
+      base, 8);
+#elif defined(__AVX2__)
+  const __m256d all = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
+  return _mm256_mask_i32gather_pd(_mm256_setzero_pd(), base,
+                                  _mm_loadu_si128(reinterpret_cast<const __m128i*>(index)), all, 8);
+#else
+  Lanes v;
+  for (int l = 0; l < kLanes; ++l) v[l] = base[index[l]];
+  return v;
+#endif
+}
+
+// out[3 rows[l] + c] = x, y, z (c = 0, 1, 2) for each lane.
+inline void ScatterRows(double* out, const int* rows, Lanes x, Lanes y, Lanes z) {
+#if defined(__AVX512F__)
+  const __m256i at = _mm256_mullo_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(rows)),
+                                        _mm256_set1_epi32(3));
+  _mm512_i32scatter_pd(out, at, x, 8);
+  _mm512_i32scatter_pd(out + 1, at, y, 8);
+  _mm512_i32scatter_pd(out + 2, at, z, 8);
+#else
+  for (int l = 0; l < kLanes; ++l) {
+    double* row = out + 3 * static_cast<std::ptrdiff_t>(rows[l]);
+    row[0] = x[l];
+    row[1] = y[l];
+    row[2] = z[l];
+  }
+#endif
+}
+
+void RotateSlotsImpl(const SlotGroupsView& groups, const double* quaternions,
+                     const double* __restrict slot_weights, double* __restrict rotated,
+                     int first_block, int end_block) {
+  const int first = first_block * GeneralRowsPlan::kSlotBlock;
+  const int end = end_block * GeneralRowsPlan::kSlotBlock;
+  const std::ptrdiff_t plane = groups.slot_count;
+  const double* dx = groups.deltas;
+  const double* dy = dx + plane;
+  const double* dz = dy + plane;
+  double* rx = rotated;
+  double* ry = rx + plane;
+  double* rz = ry + plane;
+  // The group holding slot `first`: the last whose offset is at most `first`.
+  int g = static_cast<int>(std::upper_bound(groups.slot_offsets,
+                                            groups.slot_offsets + groups.group_count + 1, first) -
+                           groups.slot_offsets) -
+          1;
+  for (; g < groups.group_count && groups.slot_offsets[g] < end; ++g) {
+    const int group_begin = groups.slot_offsets[g];
+    const int slots = groups.slot_offsets[g + 1] - group_begin;
+    const double* q = quaternions + 4 * static_cast<std::ptrdiff_t>(groups.quaternion_offsets[g]);
+    const int bones = groups.quaternion_offsets[g + 1] - groups.quaternion_offsets[g];
+    const double* w = groups.weights + groups.weight_offsets[g];
+    const int stop = std::min(end, groups.slot_offsets[g + 1]);
+    for (int s = std::max(first, group_begin); s < stop; s += kLanes) {
+      const int l = s - group_begin;
+      // The blend q = sum_k w_k q_k of this group's signed quaternions.
+      Lanes qx = Broadcast(0), qy = qx, qz = qx, qw = qx;
+      for (int k = 0; k < bones; ++k) {
+        const Lanes wk = Load(w + static_cast<std::ptrdiff_t>(k) * slots + l);
+        qx += wk * q[4 * k];
+        qy += wk * q[4 * k + 1];
+        qz += wk * q[4 * k + 2];
+        qw += wk * q[4 * k + 3];
+      }
+      // v rotated by q / |q|: v + 2 / |q|^2 (w (u x v) + u x (u x v)), u = (qx, qy, qz).
+      const Lanes vx = Load(dx + s), vy = Load(dy + s), vz = Load(dz + s);
+      const Lanes tx = qy * vz - qz * vy, ty = qz * vx - qx * vz, tz = qx * vy - qy * vx;
+      const Lanes ux = qy * tz - qz * ty, uy = qz * tx - qx * tz, uz = qx * ty - qy * tx;
+      const Lanes scale = 2.0 / (qx * qx + qy * qy + qz * qz + qw * qw);
+      const Lanes w2 = Load(slot_weights + s);
+      Store(rx + s, w2 * (vx + scale * (qw * tx + ux)));
+      Store(ry + s, w2 * (vy + scale * (qw * ty + uy)));
+      Store(rz + s, w2 * (vz + scale * (qw * tz + uz)));
+    }
+  }
+}
+
+void MultiplyPacksImpl(const RowPacksView& packs, const double* __restrict rotated, int slot_count,
+                       double* __restrict out, int first_pack, int end_pack) {
+  constexpr int kRows = GeneralRowsPlan::kPackRows;
+  const double* rx = rotated;
+  const double* ry = rx + slot_count;
+  const double* rz = ry + slot_count;
+  for (int p = first_pack; p < end_pack; ++p) {
+    const int entry_begin = packs.entry_offsets[p], entry_end = packs.entry_offsets[p + 1];
+    for (int half = 0; half < kRows; half += kLanes) {
+      Lanes ax = Broadcast(0), ay = ax, az = ax;
+      for (int e = entry_begin; e < entry_end; ++e) {
+        const int* columns = packs.columns + static_cast<std::ptrdiff_t>(kRows) * e + half;
+        const Lanes value = Load(packs.values + static_cast<std::ptrdiff_t>(kRows) * e + half);
+        ax += value * Gather(rx, columns);
+        ay += value * Gather(ry, columns);
+        az += value * Gather(rz, columns);
+      }
+      ScatterRows(out, packs.rows + static_cast<std::ptrdiff_t>(kRows) * p + half, ax, ay, az);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace deform

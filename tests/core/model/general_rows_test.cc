@@ -1,0 +1,158 @@
+#include "core/model/general_rows.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace deform {
+namespace {
+
+// A system of n vertex columns and n + m rows: row i reads 1 + i % 21 consecutive vertices from
+// i (mod n), so rows of every packed length and longer ones; the node rows read 40 vertices each.
+// Bone weights: vertices [0, n / 4) wholly bone 0's, then runs blended between bones (1, 2),
+// (2, 1) (the same bones, the other first), (3, 1, 2) and wholly bone 3's. Bone 2's quaternion is
+// stored with a negative w, so its sign against bone 1's and bone 3's must be aligned.
+struct Fixture {
+  static constexpr int n = 203;  // groups of sizes that are not multiples of 8
+  static constexpr int m = 2;
+  LaplacianSystem system;
+  BoneWeights weights;
+  Eigen::VectorXd w2 = Eigen::VectorXd::Zero(n);
+  std::vector<RigidTransform> bones;
+  std::vector<Eigen::Matrix3d> rotations;
+
+  Fixture() {
+    std::mt19937 random(11);
+    std::uniform_real_distribution<double> value(-1, 1);
+    std::vector<Eigen::Triplet<double>> entries;
+    for (int i = 0; i < n + m; ++i) {
+      const int length = i < n ? 1 + i % 21 : 40;
+      for (int k = 0; k < length; ++k) entries.emplace_back(i, (i + 3 * k) % n, value(random));
+    }
+    system.num_vertices = n;
+    system.num_nodes = m;
+    system.laplacian_transpose.resize(n + m, n);
+    system.laplacian_transpose.setFromTriplets(entries.begin(), entries.end());
+    system.laplacian_transpose.makeCompressed();
+    system.rest_deltas = Positions::NullaryExpr(n, 3, [&] { return value(random); });
+    weights.num_bones = 4;
+    weights.offsets.push_back(0);
+    for (int j = 0; j < n; ++j) {
+      const double a = 0.5 + 0.4 * value(random);  // in (0.1, 0.9)
+      if (j < n / 4) {
+        Add({0}, {1.0});
+      } else if (j < n / 2) {
+        Add({1, 2}, {std::max(a, 1 - a), std::min(a, 1 - a)});
+      } else if (j < 5 * n / 8) {
+        Add({2, 1}, {std::max(a, 1 - a), std::min(a, 1 - a)});
+      } else if (j < 7 * n / 8) {
+        Add({3, 1, 2}, {0.5, 0.3, 0.2});
+      } else {
+        Add({3}, {1.0});
+      }
+      w2[j] = 0.5 + value(random) * value(random);
+    }
+    for (int b = 0; b < 4; ++b) {
+      RigidTransform bone;
+      bone.rotation = Eigen::AngleAxisd(0.3 + b, Eigen::Vector3d(1, b, 2).normalized());
+      if (b == 2) bone.rotation.coeffs() = -bone.rotation.coeffs();
+      bones.push_back(bone);
+      rotations.push_back(bone.rotation.toRotationMatrix());
+    }
+  }
+
+  void Add(std::vector<int> b, std::vector<double> w) {
+    weights.bones.insert(weights.bones.end(), b.begin(), b.end());
+    weights.weights.insert(weights.weights.end(), w.begin(), w.end());
+    weights.offsets.push_back(static_cast<int>(weights.bones.size()));
+  }
+
+  // L'^T r with r_j = w_j^2 T_j delta_j, T_j the normalised blend of vertex j's quaternions with
+  // signs aligned to its first bone's, every row summed in full.
+  Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> Expected() const {
+    Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> r(n, 3);
+    for (int j = 0; j < n; ++j) {
+      const Eigen::Quaterniond& first = bones[weights.bones[weights.offsets[j]]].rotation;
+      Eigen::Vector4d q = Eigen::Vector4d::Zero();
+      for (int p = weights.offsets[j]; p < weights.offsets[j + 1]; ++p) {
+        const Eigen::Quaterniond& qk = bones[weights.bones[p]].rotation;
+        q += (first.dot(qk) < 0 ? -1.0 : 1.0) * weights.weights[p] * qk.coeffs();
+      }
+      const Eigen::Quaterniond blend = Eigen::Quaterniond(q).normalized();
+      r.row(j) = w2[j] * (blend * Eigen::Vector3d(system.rest_deltas.row(j))).transpose();
+    }
+    Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> product(n + m, 3);
+    MultiplyLaplacianTranspose(system, r.data(), product.data());
+    return product;
+  }
+};
+
+class GeneralRowsTest : public testing::TestWithParam<SolveKernel> {};
+
+// The plan's product equals the full product to round-off, for every kernel this CPU runs and
+// split into parts as a parallel assembly splits it.
+TEST_P(GeneralRowsTest, TheProductEqualsTheFullProductOfTheNormalisedBlend) {
+  if (!SolveKernelAvailable(GetParam())) GTEST_SKIP() << "this CPU lacks the instruction set";
+  const Fixture f;
+  const RigidRows rigid = RigidRows::Find(f.system, f.weights);
+  const std::vector<double> sums = RigidRowSums(f.system, rigid, f.w2);
+  const GeneralRowsPlan plan = GeneralRowsPlan::Build(f.system, rigid, f.weights, GetParam());
+  ASSERT_EQ(plan.slot_count() % GeneralRowsPlan::kSlotBlock, 0);
+  const std::vector<double> slot_weights = plan.SlotWeights(f.w2);
+  std::vector<double> quaternions(4 * static_cast<std::size_t>(plan.quaternion_count()));
+  plan.SignQuaternions(f.bones, quaternions.data());
+  const auto expected = f.Expected();
+  for (const int parts : {1, 2, 3}) {
+    std::vector<double> rotated(3 * static_cast<std::size_t>(plan.slot_count()), -1e300);
+    Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> product(Fixture::n + Fixture::m, 3);
+    product.setConstant(std::numeric_limits<double>::quiet_NaN());
+    for (int part = 0; part < parts; ++part) {
+      plan.Rotate(quaternions.data(), slot_weights.data(), rotated.data(), part, parts);
+    }
+    for (int part = parts - 1; part >= 0; --part) {
+      plan.Multiply(f.rotations.data(), sums.data(), rotated.data(), product.data(), part, parts);
+    }
+    ASSERT_TRUE(product.allFinite()) << parts << " parts: a row not written";
+    EXPECT_LT((product - expected).norm(), 1e-14 * expected.norm()) << parts << " parts";
+  }
+  EXPECT_GT(expected.norm(), 1.0);
+}
+
+INSTANTIATE_TEST_SUITE_P(AllKernels, GeneralRowsTest,
+                         testing::Values(SolveKernel::kBaseline, SolveKernel::kAvx2Fma,
+                                         SolveKernel::kAvx512),
+                         [](const testing::TestParamInfo<SolveKernel>& info) {
+                           return std::string(SolveKernelName(info.param)) == "avx2+fma"
+                                      ? std::string("avx2")
+                                      : std::string(SolveKernelName(info.param));
+                         });
+
+// Slots only for the vertices general rows read, each group padded to whole blocks; the padding
+// and the unread vertices carry no weight.
+TEST(GeneralRows, SlotsAreTheReadVerticesInPaddedGroups) {
+  const Fixture f;
+  const RigidRows rigid = RigidRows::Find(f.system, f.weights);
+  const GeneralRowsPlan plan = GeneralRowsPlan::Build(f.system, rigid, f.weights);
+  int read = 0;
+  for (int j = 0; j < Fixture::n; ++j) read += rigid.delta_read[j] ? 1 : 0;
+  EXPECT_GE(plan.slot_count(), read);
+  // Five bone lists at most, each padded by fewer than a block.
+  EXPECT_LT(plan.slot_count(), read + 5 * GeneralRowsPlan::kSlotBlock);
+  // One signed quaternion per bone of each list: {0}, {1, 2}, {2, 1}, {3, 1, 2}, {3}.
+  EXPECT_EQ(plan.quaternion_count(), 1 + 2 + 2 + 3 + 1);
+  const std::vector<double> slot_weights = plan.SlotWeights(f.w2);
+  double sum = 0;
+  for (const double w : slot_weights) sum += w;
+  double expected = 0;
+  for (int j = 0; j < Fixture::n; ++j) expected += rigid.delta_read[j] ? f.w2[j] : 0.0;
+  EXPECT_NEAR(sum, expected, 1e-12);
+  EXPECT_GT(plan.bytes(), 0u);
+}
+
+}  // namespace
+}  // namespace deform
