@@ -521,9 +521,7 @@ struct DeformationModel::ParallelAssembly {
   // Once every row holds its product (the parts' rows interleave).
   static void Anchors(void* context, int index) {
     const auto& a = *static_cast<const ParallelAssembly*>(context);
-    const auto [first, end] =
-        RangeOfPart(static_cast<int>(a.model->system_.anchors.size()), a.parts, index);
-    a.model->AddAnchorTargets(a.scratch, first, end);
+    a.model->AddAnchorTargetsPart(a.scratch, index, a.parts);
   }
 };
 
@@ -594,13 +592,19 @@ bool DeformationModel::DeformBatchParallel(const MaterialFactorization& factoriz
 
 // scratch->solution's anchor and joint-node rows += weight^2 * their posed targets.
 void DeformationModel::AddConstraintTargets(const Pose& pose, DeformScratch* scratch) const {
-  AddAnchorTargets(scratch, 0, static_cast<int>(system_.anchors.size()));
+  AddAnchorTargetsPart(scratch, 0, 1);
   AddNodeTargets(pose, scratch);
 }
 
 // An anchor's target is sum_e weight_e (R_e rest + t_e) over its bones' entries, R_e as the
 // matrix PrepareSlotRotations made of the bone's rotation (slot k < K is bone k's).
-void DeformationModel::AddAnchorTargets(DeformScratch* scratch, int first, int end) const {
+void DeformationModel::AddAnchorTargetsPart(DeformScratch* scratch, int part, int parts) const {
+  if (!linear_blend_plan_) {
+    general_rows_.AddAnchorTargets(scratch->slot_rotations.data(), scratch->bone_transforms,
+                                   scratch->solution.data(), part, parts);
+    return;
+  }
+  const auto [first, end] = RangeOfPart(static_cast<int>(system_.anchors.size()), parts, part);
   const auto& bones = scratch->bone_transforms;
   const auto& rotations = scratch->slot_rotations;
   auto& rhs = scratch->solution;

@@ -358,13 +358,13 @@ class DeformationModel {
   // What DeformBatch and DeformBatchParallel refuse (false): see DeformBatch.
   bool RefusesBatch(const MaterialFactorization& factorization, DeformScratch* const* scratches,
                     int count, const DeformBatchScratch& batch) const;
-  // scratch->solution's rows of anchors [first, end) (indices into system_.anchors) +=
-  // anchor_weight^2 * their posed targets, through scratch->slot_rotations (PrepareSlotRotations
-  // first). No allocation.
-  void AddAnchorTargets(DeformScratch* scratch, int first, int end) const;
+  // Part `part` of `parts` of the anchors: their rows of scratch->solution += anchor_weight^2 *
+  // their posed targets, through scratch->slot_rotations (PrepareSlotRotations first), once
+  // every part's MultiplyRotatedPart is done. No allocation.
+  void AddAnchorTargetsPart(DeformScratch* scratch, int part, int parts) const;
   // The joint nodes' rows += node_weight^2 * their posed joint centres.
   void AddNodeTargets(const Pose& pose, DeformScratch* scratch) const;
-  // AddAnchorTargets for every anchor, then AddNodeTargets.
+  // AddAnchorTargetsPart for every anchor, then AddNodeTargets.
   void AddConstraintTargets(const Pose& pose, DeformScratch* scratch) const;
 
   std::uint64_t id_ = 0;  // unique within the process, never 0 (Owns)

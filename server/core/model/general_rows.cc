@@ -95,11 +95,11 @@ GeneralRowsPlan GeneralRowsPlan::Build(const LaplacianSystem& system, const Rigi
   const int rows = static_cast<int>(lt.outerSize());
   const int* row_begin = lt.outerIndexPtr();
   std::vector<std::vector<int>> rows_of_length(kMaxPackedEntries + 1);
+  std::map<int, std::vector<int>> rigid_rows_of_bone;
   plan.long_offsets_.push_back(0);
   for (int i = 0; i < rows; ++i) {
     if (rigid.bone_of_row[i] >= 0) {
-      plan.rigid_rows_.push_back(i);
-      plan.rigid_bones_.push_back(rigid.bone_of_row[i]);
+      rigid_rows_of_bone[rigid.bone_of_row[i]].push_back(i);
       continue;
     }
     const int length = row_begin[i + 1] - row_begin[i];
@@ -132,7 +132,46 @@ GeneralRowsPlan GeneralRowsPlan::Build(const LaplacianSystem& system, const Rigi
       plan.pack_entry_offsets_.push_back(plan.pack_entry_offsets_.back() + length);
     }
   }
+  plan.BuildAnchorGroups(system);
+  plan.rigid_offsets_.push_back(0);
+  for (auto& [bone, members] : rigid_rows_of_bone) {
+    members.resize(RoundUp(static_cast<int>(members.size()), kSlotBlock), members.back());
+    plan.rigid_bones_.push_back(bone);
+    plan.rigid_rows_.insert(plan.rigid_rows_.end(), members.begin(), members.end());
+    plan.rigid_offsets_.push_back(static_cast<int>(plan.rigid_rows_.size()));
+  }
   return plan;
+}
+
+void GeneralRowsPlan::BuildAnchorGroups(const LaplacianSystem& system) {
+  anchor_weight_squared_ = system.anchor_weight * system.anchor_weight;
+  std::map<std::vector<int>, std::vector<int>> groups;
+  const auto& bones = system.anchor_bones;
+  for (int a = 0; a < static_cast<int>(system.anchors.size()); ++a) {
+    groups[std::vector<int>(bones.begin() + system.anchor_offsets[a],
+                            bones.begin() + system.anchor_offsets[a + 1])]
+        .push_back(a);
+  }
+  const std::size_t count = system.anchors.size();
+  anchor_rest_.assign(3 * count, 0.0);
+  anchor_offsets_.push_back(0);
+  anchor_bone_offsets_.push_back(0);
+  for (const auto& [group_bones, members] : groups) {
+    anchor_weight_offsets_.push_back(static_cast<int>(anchor_weights_.size()));
+    for (std::size_t k = 0; k < group_bones.size(); ++k) {
+      for (const int a : members) {
+        anchor_weights_.push_back(system.anchor_weights[system.anchor_offsets[a] + k]);
+      }
+    }
+    for (const int a : members) {
+      const std::size_t at = anchor_rows_.size();
+      for (int c = 0; c < 3; ++c) anchor_rest_[c * count + at] = system.anchor_rest(a, c);
+      anchor_rows_.push_back(system.anchors[a]);
+    }
+    anchor_bones_.insert(anchor_bones_.end(), group_bones.begin(), group_bones.end());
+    anchor_offsets_.push_back(static_cast<int>(anchor_rows_.size()));
+    anchor_bone_offsets_.push_back(static_cast<int>(anchor_bones_.size()));
+  }
 }
 
 std::vector<double> GeneralRowsPlan::SlotWeights(const Eigen::VectorXd& row_weights_squared) const {
@@ -169,6 +208,39 @@ RowPacksView GeneralRowsPlan::Packs() const {
   return {pack_entry_offsets_.data(), pack_columns_.data(), pack_values_.data(), pack_rows_.data()};
 }
 
+RigidGroupsView GeneralRowsPlan::RigidGroups() const {
+  return {static_cast<int>(rigid_bones_.size()), rigid_offsets_.data(), rigid_bones_.data(),
+          rigid_rows_.data()};
+}
+
+LongRowsView GeneralRowsPlan::LongRows() const {
+  return {long_rows_.data(), long_offsets_.data(), long_columns_.data(), long_values_.data()};
+}
+
+AnchorGroupsView GeneralRowsPlan::AnchorGroups() const {
+  AnchorGroupsView view;
+  view.group_count = static_cast<int>(anchor_weight_offsets_.size());
+  view.anchor_count = static_cast<int>(anchor_rows_.size());
+  view.weight_squared = anchor_weight_squared_;
+  view.offsets = anchor_offsets_.data();
+  view.bone_offsets = anchor_bone_offsets_.data();
+  view.bones = anchor_bones_.data();
+  view.weight_offsets = anchor_weight_offsets_.data();
+  view.weights = anchor_weights_.data();
+  view.rest = anchor_rest_.data();
+  view.rows = anchor_rows_.data();
+  return view;
+}
+
+void GeneralRowsPlan::AddAnchorTargets(const Eigen::Matrix3d* rotations,
+                                       const std::vector<RigidTransform>& bones, double* out,
+                                       int part, int parts) const {
+  const auto [first, end] = PartOf(static_cast<int>(anchor_rows_.size()), part, parts);
+  if (first < end) {
+    kernel_.add_anchors(AnchorGroups(), rotations[0].data(), bones.data(), out, first, end);
+  }
+}
+
 void GeneralRowsPlan::Rotate(const double* quaternions, const double* slot_weights, double* rotated,
                              int part, int parts) const {
   const auto [first, end] = PartOf(slot_count_ / kSlotBlock, part, parts);
@@ -181,52 +253,32 @@ void GeneralRowsPlan::Multiply(const Eigen::Matrix3d* rotations, const double* r
   if (first_pack < end_pack) {
     kernel_.multiply(Packs(), rotated, slot_count_, out, first_pack, end_pack);
   }
-  const double* rx = rotated;
-  const double* ry = rx + slot_count_;
-  const double* rz = ry + slot_count_;
   const auto [first_long, end_long] = PartOf(static_cast<int>(long_rows_.size()), part, parts);
-  for (int k = first_long; k < end_long; ++k) {
-    // Two partial sums, so that consecutive entries do not wait on each other's adds.
-    double a0 = 0, a1 = 0, a2 = 0, b0 = 0, b1 = 0, b2 = 0;
-    int p = long_offsets_[k];
-    const int end = long_offsets_[k + 1];
-    for (; p + 2 <= end; p += 2) {
-      const int s = long_columns_[p], t = long_columns_[p + 1];
-      const double u = long_values_[p], v = long_values_[p + 1];
-      a0 += u * rx[s];
-      a1 += u * ry[s];
-      a2 += u * rz[s];
-      b0 += v * rx[t];
-      b1 += v * ry[t];
-      b2 += v * rz[t];
-    }
-    if (p < end) {
-      const int s = long_columns_[p];
-      a0 += long_values_[p] * rx[s];
-      a1 += long_values_[p] * ry[s];
-      a2 += long_values_[p] * rz[s];
-    }
-    double* target = out + 3 * static_cast<std::ptrdiff_t>(long_rows_[k]);
-    target[0] = a0 + b0;
-    target[1] = a1 + b1;
-    target[2] = a2 + b2;
+  if (first_long < end_long) {
+    kernel_.multiply_long(LongRows(), rotated, slot_count_, out, first_long, end_long);
   }
-  const auto [first_rigid, end_rigid] = PartOf(static_cast<int>(rigid_rows_.size()), part, parts);
-  for (int k = first_rigid; k < end_rigid; ++k) {
-    const std::ptrdiff_t at = 3 * static_cast<std::ptrdiff_t>(rigid_rows_[k]);
-    Eigen::Map<Eigen::Vector3d>{out + at}.noalias() =
-        rotations[rigid_bones_[k]] * Eigen::Map<const Eigen::Vector3d>(rigid_sums + at);
+  const auto [first_rigid, end_rigid] =
+      PartOf(static_cast<int>(rigid_rows_.size()) / kSlotBlock, part, parts);
+  if (first_rigid < end_rigid) {
+    static_assert(sizeof(Eigen::Matrix3d) == 9 * sizeof(double), "matrices packed in an array");
+    kernel_.multiply_rigid(RigidGroups(), rotations[0].data(), rigid_sums, out, first_rigid,
+                           end_rigid);
   }
 }
 
 std::size_t GeneralRowsPlan::bytes() const {
-  const auto ints =
-      slot_vertex_.size() + group_slot_offsets_.size() + group_quaternion_offsets_.size() +
-      group_weight_offsets_.size() + quaternion_bones_.size() + quaternion_first_.size() +
-      pack_entry_offsets_.size() + pack_columns_.size() + pack_rows_.size() + long_rows_.size() +
-      long_offsets_.size() + long_columns_.size() + rigid_rows_.size() + rigid_bones_.size();
-  const auto doubles = weights_.size() + deltas_.size() + pack_values_.size() + long_values_.size();
-  return ints * sizeof(int) + doubles * sizeof(double);
+  const auto ints = slot_vertex_.size() + group_slot_offsets_.size() +
+                    group_quaternion_offsets_.size() + group_weight_offsets_.size() +
+                    quaternion_bones_.size() + quaternion_first_.size() +
+                    pack_entry_offsets_.size() + pack_columns_.size() + pack_rows_.size() +
+                    long_rows_.size() + long_offsets_.size() + long_columns_.size() +
+                    rigid_offsets_.size() + rigid_bones_.size() + rigid_rows_.size();
+  const auto anchor_ints = anchor_offsets_.size() + anchor_bone_offsets_.size() +
+                           anchor_bones_.size() + anchor_weight_offsets_.size() +
+                           anchor_rows_.size();
+  const auto doubles = weights_.size() + deltas_.size() + pack_values_.size() +
+                       long_values_.size() + anchor_weights_.size() + anchor_rest_.size();
+  return (ints + anchor_ints) * sizeof(int) + doubles * sizeof(double);
 }
 
 }  // namespace deform

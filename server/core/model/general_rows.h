@@ -16,6 +16,9 @@
 //   columns as slots. A length's last pack repeats its last row, which then writes the same
 //   values twice. Longer rows (a joint node's row reads every vertex of its region) are
 //   compressed rows over slots.
+// - Anchors. Grouped by their bone lists, rest positions and weights planar in group order.
+// - Rigid rows. Grouped by bone and padded to whole blocks, each group's last rows repeating its
+//   last row: a frame rotates a group's rigid sums with one matrix.
 //
 // Same values as RotateByBlend and SparseRowTimes3 (deformation_model.cc, laplacian_system.h) to
 // round-off: sums in another order, 1e-14 of their norm (tested).
@@ -44,6 +47,38 @@ struct SlotGroupsView {
   const double* weights = nullptr;
   const double* deltas = nullptr;  // 3 planes (x, y, z) of slot_count
 };
+// The rigid rows grouped by bone: group g's rows rows[offsets[g], offsets[g + 1]) (a multiple of
+// kSlotBlock; a group's last rows repeat its last row) are bone bones[g]'s.
+struct RigidGroupsView {
+  int group_count = 0;
+  const int* offsets = nullptr;
+  const int* bones = nullptr;
+  const int* rows = nullptr;
+};
+// Rows too long for a pack, compressed over slots: row rows[k]'s entries [offsets[k],
+// offsets[k + 1]).
+struct LongRowsView {
+  const int* rows = nullptr;
+  const int* offsets = nullptr;
+  const int* columns = nullptr;
+  const double* values = nullptr;
+};
+// The anchors grouped by their bone lists: group g's anchors [offsets[g], offsets[g + 1]) in
+// group order, their bones bones[bone_offsets[g], bone_offsets[g + 1]), weights
+// weights[weight_offsets[g] + k * count + l] (bone k, anchor l of the group's count), rest
+// positions in 3 planes of every anchor (x, y, z) and rows rows[a].
+struct AnchorGroupsView {
+  int group_count = 0;
+  int anchor_count = 0;
+  double weight_squared = 0;  // anchor_weight^2
+  const int* offsets = nullptr;
+  const int* bone_offsets = nullptr;
+  const int* bones = nullptr;
+  const int* weight_offsets = nullptr;
+  const double* weights = nullptr;
+  const double* rest = nullptr;
+  const int* rows = nullptr;
+};
 struct RowPacksView {
   // Pack p's entries e in [entry_offsets[p], entry_offsets[p + 1]): kPackRows columns (slots)
   // and values at [kPackRows * e, kPackRows * (e + 1)); its rows at rows[kPackRows * p].
@@ -62,6 +97,19 @@ struct GeneralRowsKernel {
   // Packs [first_pack, end_pack) of L'^T r into out ((n + m) by 3, row-major; written).
   void (*multiply)(const RowPacksView& packs, const double* rotated, int slot_count, double* out,
                    int first_pack, int end_pack);
+  // Long rows [first, end) the same way.
+  void (*multiply_long)(const LongRowsView& rows, const double* rotated, int slot_count,
+                        double* out, int first, int end);
+  // Blocks [first_block, end_block) of kSlotBlock rigid rows: out's row i = R_bone c_i, R_bone
+  // the bone's rotation (`rotations`: 9 doubles each, column-major) and c_i the row's rigid sum
+  // (`sums`, (n + m) by 3 row-major).
+  void (*multiply_rigid)(const RigidGroupsView& groups, const double* rotations, const double* sums,
+                         double* out, int first_block, int end_block);
+  // Anchors [first, end) (in group order): out's anchor rows += anchor_weight^2 * the anchor's
+  // target, sum_k w_k (R_k rest + t_k) over its bones (`rotations` as above, translations from
+  // `bones`).
+  void (*add_anchors)(const AnchorGroupsView& anchors, const double* rotations,
+                      const RigidTransform* bones, double* out, int first, int end);
 };
 
 class GeneralRowsPlan {
@@ -94,11 +142,21 @@ class GeneralRowsPlan {
   void Multiply(const Eigen::Matrix3d* rotations, const double* rigid_sums, const double* rotated,
                 double* out, int part, int parts) const;
 
+  // Part `part` of `parts` of the anchors' targets: their rows of `out` += anchor_weight^2 *
+  // sum_e w_e (R_e rest + t_e) (`rotations` and `bones` indexed by bone), once every part's
+  // Multiply is done. Parts add to disjoint rows. No allocation.
+  void AddAnchorTargets(const Eigen::Matrix3d* rotations, const std::vector<RigidTransform>& bones,
+                        double* out, int part, int parts) const;
+
   std::size_t bytes() const;
 
  private:
+  void BuildAnchorGroups(const LaplacianSystem& system);
   SlotGroupsView Groups() const;
   RowPacksView Packs() const;
+  RigidGroupsView RigidGroups() const;
+  LongRowsView LongRows() const;
+  AnchorGroupsView AnchorGroups() const;
   int pack_count() const { return static_cast<int>(pack_entry_offsets_.size()) - 1; }
 
   GeneralRowsKernel kernel_{};
@@ -120,9 +178,19 @@ class GeneralRowsPlan {
   std::vector<int> long_offsets_;
   std::vector<int> long_columns_;
   std::vector<double> long_values_;
-  // The rigid rows and their bones.
-  std::vector<int> rigid_rows_;
+  // The anchors grouped by bone list (AnchorGroupsView).
+  double anchor_weight_squared_ = 0;
+  std::vector<int> anchor_offsets_;
+  std::vector<int> anchor_bone_offsets_;
+  std::vector<int> anchor_bones_;
+  std::vector<int> anchor_weight_offsets_;
+  std::vector<double> anchor_weights_;
+  std::vector<double> anchor_rest_;  // 3 planes
+  std::vector<int> anchor_rows_;
+  // The rigid rows grouped by bone (RigidGroupsView).
+  std::vector<int> rigid_offsets_;
   std::vector<int> rigid_bones_;
+  std::vector<int> rigid_rows_;
 };
 
 }  // namespace deform

@@ -57,8 +57,22 @@ struct Fixture {
       }
       w2[j] = 0.5 + value(random) * value(random);
     }
+    // Every third vertex an anchor that follows the vertex's own bones.
+    system.anchor_weight = 3.0;
+    system.anchor_offsets.push_back(0);
+    for (int j = 0; j < n; j += 3) {
+      system.anchors.push_back(j);
+      for (int p = weights.offsets[j]; p < weights.offsets[j + 1]; ++p) {
+        system.anchor_bones.push_back(weights.bones[p]);
+        system.anchor_weights.push_back(weights.weights[p]);
+      }
+      system.anchor_offsets.push_back(static_cast<int>(system.anchor_bones.size()));
+    }
+    system.anchor_rest = Positions::NullaryExpr(static_cast<int>(system.anchors.size()), 3,
+                                                [&] { return value(random); });
     for (int b = 0; b < 4; ++b) {
       RigidTransform bone;
+      bone.translation = Eigen::Vector3d(b, -1.0, 0.5 * b);
       bone.rotation = Eigen::AngleAxisd(0.3 + b, Eigen::Vector3d(1, b, 2).normalized());
       if (b == 2) bone.rotation.coeffs() = -bone.rotation.coeffs();
       bones.push_back(bone);
@@ -93,6 +107,35 @@ struct Fixture {
 };
 
 class GeneralRowsTest : public testing::TestWithParam<SolveKernel> {};
+
+// The anchors' targets added to their rows equal anchor_weight^2 sum_e w_e (R_e rest + t_e), for
+// every kernel and split into parts.
+TEST_P(GeneralRowsTest, AnchorTargetsAreAddedToTheirRows) {
+  if (!SolveKernelAvailable(GetParam())) GTEST_SKIP() << "this CPU lacks the instruction set";
+  const Fixture f;
+  const GeneralRowsPlan plan =
+      GeneralRowsPlan::Build(f.system, RigidRows::Find(f.system, f.weights), f.weights, GetParam());
+  Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> base(Fixture::n + Fixture::m, 3);
+  base.setRandom();
+  auto expected = base;
+  for (int a = 0; a < static_cast<int>(f.system.anchors.size()); ++a) {
+    Eigen::Vector3d target = Eigen::Vector3d::Zero();
+    for (int e = f.system.anchor_offsets[a]; e < f.system.anchor_offsets[a + 1]; ++e) {
+      const RigidTransform& bone = f.bones[f.system.anchor_bones[e]];
+      target += f.system.anchor_weights[e] *
+                bone.Apply(Eigen::Vector3d(f.system.anchor_rest.row(a).transpose()));
+    }
+    expected.row(f.system.anchors[a]) += 9.0 * target.transpose();
+  }
+  for (const int parts : {1, 2, 3}) {
+    auto added = base;
+    for (int part = 0; part < parts; ++part) {
+      plan.AddAnchorTargets(f.rotations.data(), f.bones, added.data(), part, parts);
+    }
+    EXPECT_LT((added - expected).norm(), 1e-14 * expected.norm()) << parts << " parts";
+  }
+  EXPECT_GT((expected - base).norm(), 1.0);
+}
 
 // The plan's product equals the full product to round-off, for every kernel this CPU runs and
 // split into parts as a parallel assembly splits it.

@@ -6,6 +6,8 @@ namespace deform {
 
 // Declared (and picked) in general_rows.cc.
 extern const GeneralRowsKernel kAvx2FmaGeneralRowsKernel;
-const GeneralRowsKernel kAvx2FmaGeneralRowsKernel = {&RotateSlotsImpl, &MultiplyPacksImpl};
+const GeneralRowsKernel kAvx2FmaGeneralRowsKernel = {&RotateSlotsImpl, &MultiplyPacksImpl,
+                                                     &MultiplyLongRowsImpl, &MultiplyRigidRowsImpl,
+                                                     &AddAnchorsImpl};
 
 }  // namespace deform

@@ -6,6 +6,8 @@ namespace deform {
 
 // Declared (and picked) in general_rows.cc.
 extern const GeneralRowsKernel kAvx512GeneralRowsKernel;
-const GeneralRowsKernel kAvx512GeneralRowsKernel = {&RotateSlotsImpl, &MultiplyPacksImpl};
+const GeneralRowsKernel kAvx512GeneralRowsKernel = {&RotateSlotsImpl, &MultiplyPacksImpl,
+                                                    &MultiplyLongRowsImpl, &MultiplyRigidRowsImpl,
+                                                    &AddAnchorsImpl};
 
 }  // namespace deform

@@ -6,6 +6,8 @@ namespace deform {
 
 // Declared (and picked) in general_rows.cc.
 extern const GeneralRowsKernel kBaselineGeneralRowsKernel;
-const GeneralRowsKernel kBaselineGeneralRowsKernel = {&RotateSlotsImpl, &MultiplyPacksImpl};
+const GeneralRowsKernel kBaselineGeneralRowsKernel = {&RotateSlotsImpl, &MultiplyPacksImpl,
+                                                      &MultiplyLongRowsImpl, &MultiplyRigidRowsImpl,
+                                                      &AddAnchorsImpl};
 
 }  // namespace deform

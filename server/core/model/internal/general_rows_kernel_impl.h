@@ -45,9 +45,9 @@ inline Lanes Broadcast(double x) {
 // source register, and -Wmaybe-uninitialized says so.)
 inline Lanes Gather(const double* base, const int* index) {
 #if defined(__AVX512F__)
-  return _mm512_mask_i32gather_pd(
-      _mm512_setzero_pd(), 0xff, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(index)),
-      base, 8);
+  return _mm512_mask_i32gather_pd(_mm512_setzero_pd(), 0xff,
+                                  _mm256_loadu_si256(reinterpret_cast<const __m256i*>(index)), base,
+                                  8);
 #elif defined(__AVX2__)
   const __m256d all = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
   return _mm256_mask_i32gather_pd(_mm256_setzero_pd(), base,
@@ -73,6 +73,25 @@ inline void ScatterRows(double* out, const int* rows, Lanes x, Lanes y, Lanes z)
     row[0] = x[l];
     row[1] = y[l];
     row[2] = z[l];
+  }
+#endif
+}
+
+// out[3 rows[l] + c] += x, y, z (c = 0, 1, 2) for each lane; the rows distinct.
+inline void AddToRows(double* out, const int* rows, Lanes x, Lanes y, Lanes z) {
+#if defined(__AVX512F__)
+  const __m256i at = _mm256_mullo_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(rows)),
+                                        _mm256_set1_epi32(3));
+  const __m512d zero = _mm512_setzero_pd();
+  _mm512_i32scatter_pd(out, at, x + _mm512_mask_i32gather_pd(zero, 0xff, at, out, 8), 8);
+  _mm512_i32scatter_pd(out + 1, at, y + _mm512_mask_i32gather_pd(zero, 0xff, at, out + 1, 8), 8);
+  _mm512_i32scatter_pd(out + 2, at, z + _mm512_mask_i32gather_pd(zero, 0xff, at, out + 2, 8), 8);
+#else
+  for (int l = 0; l < kLanes; ++l) {
+    double* row = out + 3 * static_cast<std::ptrdiff_t>(rows[l]);
+    row[0] += x[l];
+    row[1] += y[l];
+    row[2] += z[l];
   }
 #endif
 }
@@ -143,6 +162,120 @@ void MultiplyPacksImpl(const RowPacksView& packs, const double* __restrict rotat
         az += value * Gather(rz, columns);
       }
       ScatterRows(out, packs.rows + static_cast<std::ptrdiff_t>(kRows) * p + half, ax, ay, az);
+    }
+  }
+}
+
+void MultiplyLongRowsImpl(const LongRowsView& rows, const double* __restrict rotated,
+                          int slot_count, double* __restrict out, int first, int end) {
+  const double* rx = rotated;
+  const double* ry = rx + slot_count;
+  const double* rz = ry + slot_count;
+  for (int k = first; k < end; ++k) {
+    // kLanes partial sums a coordinate, twice over, so that consecutive entries do not wait on
+    // each other's adds.
+    Lanes ax = Broadcast(0), ay = ax, az = ax, bx = ax, by = ax, bz = ax;
+    int p = rows.offsets[k];
+    const int stop = rows.offsets[k + 1];
+    for (; p + 2 * kLanes <= stop; p += 2 * kLanes) {
+      const Lanes u = Load(rows.values + p), v = Load(rows.values + p + kLanes);
+      ax += u * Gather(rx, rows.columns + p);
+      ay += u * Gather(ry, rows.columns + p);
+      az += u * Gather(rz, rows.columns + p);
+      bx += v * Gather(rx, rows.columns + p + kLanes);
+      by += v * Gather(ry, rows.columns + p + kLanes);
+      bz += v * Gather(rz, rows.columns + p + kLanes);
+    }
+    ax += bx;
+    ay += by;
+    az += bz;
+    double sum[3] = {0, 0, 0};
+    for (int l = 0; l < kLanes; ++l) {
+      sum[0] += ax[l];
+      sum[1] += ay[l];
+      sum[2] += az[l];
+    }
+    for (; p < stop; ++p) {
+      const int s = rows.columns[p];
+      sum[0] += rows.values[p] * rx[s];
+      sum[1] += rows.values[p] * ry[s];
+      sum[2] += rows.values[p] * rz[s];
+    }
+    double* target = out + 3 * static_cast<std::ptrdiff_t>(rows.rows[k]);
+    target[0] = sum[0];
+    target[1] = sum[1];
+    target[2] = sum[2];
+  }
+}
+
+void MultiplyRigidRowsImpl(const RigidGroupsView& groups, const double* rotations,
+                           const double* __restrict sums, double* __restrict out, int first_block,
+                           int end_block) {
+  const int first = first_block * GeneralRowsPlan::kSlotBlock;
+  const int end = end_block * GeneralRowsPlan::kSlotBlock;
+  int g = static_cast<int>(
+              std::upper_bound(groups.offsets, groups.offsets + groups.group_count + 1, first) -
+              groups.offsets) -
+          1;
+  for (; g < groups.group_count && groups.offsets[g] < end; ++g) {
+    const double* r = rotations + 9 * static_cast<std::ptrdiff_t>(groups.bones[g]);  // by column
+    const int stop = std::min(end, groups.offsets[g + 1]);
+    for (int k = std::max(first, groups.offsets[g]); k < stop; k += kLanes) {
+      const int* rows = groups.rows + k;
+      int at[kLanes];
+      for (int l = 0; l < kLanes; ++l) at[l] = 3 * rows[l];
+      const Lanes cx = Gather(sums, at), cy = Gather(sums + 1, at), cz = Gather(sums + 2, at);
+      ScatterRows(out, rows, r[0] * cx + r[3] * cy + r[6] * cz, r[1] * cx + r[4] * cy + r[7] * cz,
+                  r[2] * cx + r[5] * cy + r[8] * cz);
+    }
+  }
+}
+
+void AddAnchorsImpl(const AnchorGroupsView& anchors, const double* rotations,
+                    const RigidTransform* bones, double* __restrict out, int first, int end) {
+  const std::ptrdiff_t plane = anchors.anchor_count;
+  const double* px = anchors.rest;
+  const double* py = px + plane;
+  const double* pz = py + plane;
+  const double scale = anchors.weight_squared;
+  int g = static_cast<int>(
+              std::upper_bound(anchors.offsets, anchors.offsets + anchors.group_count + 1, first) -
+              anchors.offsets) -
+          1;
+  for (; g < anchors.group_count && anchors.offsets[g] < end; ++g) {
+    const int begin = anchors.offsets[g];
+    const int count = anchors.offsets[g + 1] - begin;
+    const int* group_bones = anchors.bones + anchors.bone_offsets[g];
+    const int bone_count = anchors.bone_offsets[g + 1] - anchors.bone_offsets[g];
+    const double* w = anchors.weights + anchors.weight_offsets[g];
+    const int stop = std::min(end, anchors.offsets[g + 1]);
+    int a = std::max(first, begin);
+    // Whole vectors, then the group's last anchors one at a time (no padding: rows are added to).
+    for (; a + kLanes <= stop; a += kLanes) {
+      const Lanes x = Load(px + a), y = Load(py + a), z = Load(pz + a);
+      Lanes tx = Broadcast(0), ty = tx, tz = tx;
+      for (int k = 0; k < bone_count; ++k) {
+        const double* r = rotations + 9 * static_cast<std::ptrdiff_t>(group_bones[k]);
+        const Eigen::Vector3d& t = bones[group_bones[k]].translation;
+        const Lanes wk = Load(w + static_cast<std::ptrdiff_t>(k) * count + (a - begin));
+        tx += wk * (r[0] * x + r[3] * y + r[6] * z + t.x());
+        ty += wk * (r[1] * x + r[4] * y + r[7] * z + t.y());
+        tz += wk * (r[2] * x + r[5] * y + r[8] * z + t.z());
+      }
+      AddToRows(out, anchors.rows + a, scale * tx, scale * ty, scale * tz);
+    }
+    for (; a < stop; ++a) {
+      double target[3] = {0, 0, 0};
+      for (int k = 0; k < bone_count; ++k) {
+        const double* r = rotations + 9 * static_cast<std::ptrdiff_t>(group_bones[k]);
+        const Eigen::Vector3d& t = bones[group_bones[k]].translation;
+        const double wk = w[static_cast<std::ptrdiff_t>(k) * count + (a - begin)];
+        for (int c = 0; c < 3; ++c) {
+          target[c] += wk * (r[c] * px[a] + r[3 + c] * py[a] + r[6 + c] * pz[a] + t[c]);
+        }
+      }
+      double* row = out + 3 * static_cast<std::ptrdiff_t>(anchors.rows[a]);
+      for (int c = 0; c < 3; ++c) row[c] += scale * target[c];
     }
   }
 }
