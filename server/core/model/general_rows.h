@@ -9,8 +9,8 @@
 //   ordered bone list (its bone-weight entries' bones, largest weight first), so a group's signed
 //   quaternions are the same for all its vertices and a frame blends a group with one set of
 //   them. Within a group the slots ascend by vertex. A group is padded to a multiple of
-//   kSlotBlock slots with slots of zero delta and zero weight (their r is 0, never read). Deltas,
-//   weights and the rotated deltas are planar, in slot order.
+//   kSlotBlock slots with slots of zero delta and zero w^2 that blend the group's first bone alone
+//   (their r is 0, never read). Deltas, weights and the rotated deltas are planar, in slot order.
 // - Packs. The general rows of at most kMaxPackedEntries entries go in packs of kPackRows rows of
 //   the same length, entry by entry (one load takes an entry of each of the pack's rows), their
 //   columns as slots. A length's last pack repeats its last row, which then writes the same
@@ -20,8 +20,9 @@
 // - Rigid rows. Grouped by bone and padded to whole blocks, each group's last rows repeating its
 //   last row: a frame rotates a group's rigid sums with one matrix.
 //
-// Same values as RotateByBlend and SparseRowTimes3 (deformation_model.cc, laplacian_system.h) to
-// round-off: sums in another order, 1e-14 of their norm (tested).
+// The same values as blending and rotating vertex by vertex and summing row by row
+// (SparseRowTimes3, laplacian_system.h) to round-off: sums in another order, 1e-14 of their norm
+// (tested against the normalised blend's full product).
 #pragma once
 
 #include <Eigen/Core>
@@ -41,8 +42,8 @@ struct SlotGroupsView {
   int group_count = 0;
   int slot_count = 0;                 // a multiple of kSlotBlock
   const int* slot_offsets = nullptr;  // group_count + 1, multiples of kSlotBlock
-  const int* quaternion_offsets =
-      nullptr;                          // group_count + 1: the group's bones' signed quaternions
+  // group_count + 1: each group's bones' signed quaternions (SignQuaternions' order).
+  const int* quaternion_offsets = nullptr;
   const int* weight_offsets = nullptr;  // group_count: weights[offset + k * slots + l], bone k
   const double* weights = nullptr;
   const double* deltas = nullptr;  // 3 planes (x, y, z) of slot_count
@@ -119,7 +120,7 @@ class GeneralRowsPlan {
   static constexpr int kMaxPackedEntries = 16;
 
   // The plan of `system`'s L'^T with its rigid rows under the blending `weights`, its kernels
-  // those of `kernel` (available: SolveKernelAvailable).
+  // those of `kernel` (the baseline's where SolveKernelAvailable says this CPU lacks it).
   static GeneralRowsPlan Build(const LaplacianSystem& system, const RigidRows& rigid,
                                const BoneWeights& weights, SolveKernel kernel = BestSolveKernel());
 
