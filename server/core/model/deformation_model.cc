@@ -10,6 +10,7 @@
 #include <string>
 #include <utility>
 
+#include "core/base/equal_parts.h"
 #include "core/geometry/mesh_topology.h"
 #include "core/geometry/skeleton_geometry.h"
 #include "core/geometry/triangle_bvh.h"
@@ -453,18 +454,6 @@ void DeformationModel::PrepareSlotRotations(DeformScratch* scratch) const {
   general_rows_.SignQuaternions(bones, scratch->signed_quaternions.data());
 }
 
-namespace {
-
-// Part `index` of `parts` equal ranges of [0, count).
-std::pair<int, int> RangeOfPart(int count, int parts, int index) {
-  const auto at = [&](int i) {
-    return static_cast<int>(static_cast<std::int64_t>(count) * i / parts);
-  };
-  return {at(index), at(index + 1)};
-}
-
-}  // namespace
-
 void DeformationModel::RotateDeltasPart(const MaterialFactorization& factorization,
                                         DeformScratch* scratch, int part, int parts) const {
   if (!linear_blend_plan_) {
@@ -473,7 +462,7 @@ void DeformationModel::RotateDeltasPart(const MaterialFactorization& factorizati
     return;
   }
   // The linear blend: r_i = w_i^2 T_i delta_i, T_i a linear combination of slot rotations.
-  const auto [first, end] = RangeOfPart(mesh_.num_vertices(), parts, part);
+  const auto [first, end] = EqualPart(mesh_.num_vertices(), part, parts);
   const auto& bw = bone_weights_;
   const auto& w2 = factorization.row_weights_squared_;
   auto& r = scratch->rotated_deltas;
@@ -499,7 +488,7 @@ void DeformationModel::MultiplyRotatedPart(const MaterialFactorization& factoriz
     return;
   }
   const auto [first, end] =
-      RangeOfPart(static_cast<int>(system_.laplacian_transpose.outerSize()), parts, part);
+      EqualPart(static_cast<int>(system_.laplacian_transpose.outerSize()), part, parts);
   MultiplyRotatedRows(system_, rigid_rows_, sums, scratch->slot_rotations.data(),
                       scratch->rotated_deltas.data(), scratch->solution.data(), first, end);
 }
@@ -604,7 +593,7 @@ void DeformationModel::AddAnchorTargetsPart(DeformScratch* scratch, int part, in
                                    scratch->solution.data(), part, parts);
     return;
   }
-  const auto [first, end] = RangeOfPart(static_cast<int>(system_.anchors.size()), parts, part);
+  const auto [first, end] = EqualPart(static_cast<int>(system_.anchors.size()), part, parts);
   const auto& bones = scratch->bone_transforms;
   const auto& rotations = scratch->slot_rotations;
   auto& rhs = scratch->solution;

@@ -1,9 +1,10 @@
 #include "core/model/general_rows.h"
 
 #include <algorithm>
-#include <cstdint>
 #include <map>
 #include <utility>
+
+#include "core/base/equal_parts.h"
 
 namespace deform {
 
@@ -29,12 +30,20 @@ const GeneralRowsKernel& KernelFor(SolveKernel kernel) {
   return kBaselineGeneralRowsKernel;
 }
 
-// [count * part / parts, count * (part + 1) / parts).
-std::pair<int, int> PartOf(int count, int part, int parts) {
-  const auto at = [&](int i) {
-    return static_cast<int>(static_cast<std::int64_t>(count) * i / parts);
-  };
-  return {at(part), at(part + 1)};
+// The indices i in [0, count) that keep(i), grouped by their lists lists[offsets[i],
+// offsets[i + 1]) (a vertex's or an anchor's bones, in order), ascending within a group; the
+// groups in the lists' lexicographic order.
+template <typename Keep>
+std::map<std::vector<int>, std::vector<int>> GroupByList(const std::vector<int>& offsets,
+                                                         const std::vector<int>& lists, int count,
+                                                         Keep&& keep) {
+  std::map<std::vector<int>, std::vector<int>> groups;
+  for (int i = 0; i < count; ++i) {
+    if (!keep(i)) continue;
+    groups[std::vector<int>(lists.begin() + offsets[i], lists.begin() + offsets[i + 1])].push_back(
+        i);
+  }
+  return groups;
 }
 
 int RoundUp(int value, int multiple) { return (value + multiple - 1) / multiple * multiple; }
@@ -48,13 +57,8 @@ GeneralRowsPlan GeneralRowsPlan::Build(const LaplacianSystem& system, const Rigi
   const int n = system.num_vertices;
 
   // The slots: the read vertices grouped by their ordered bone lists, ascending within a group.
-  std::map<std::vector<int>, std::vector<int>> groups;
-  for (int j = 0; j < n; ++j) {
-    if (!rigid.delta_read[j]) continue;
-    const auto bones_begin = weights.bones.begin();
-    groups[std::vector<int>(bones_begin + weights.offsets[j], bones_begin + weights.offsets[j + 1])]
-        .push_back(j);
-  }
+  const auto groups = GroupByList(weights.offsets, weights.bones, n,
+                                  [&](int j) { return rigid.delta_read[j] != 0; });
   std::vector<int> slot_of(n, -1);
   plan.group_slot_offsets_.push_back(0);
   plan.group_quaternion_offsets_.push_back(0);
@@ -145,14 +149,9 @@ GeneralRowsPlan GeneralRowsPlan::Build(const LaplacianSystem& system, const Rigi
 
 void GeneralRowsPlan::BuildAnchorGroups(const LaplacianSystem& system) {
   anchor_weight_squared_ = system.anchor_weight * system.anchor_weight;
-  std::map<std::vector<int>, std::vector<int>> groups;
-  const auto& bones = system.anchor_bones;
-  for (int a = 0; a < static_cast<int>(system.anchors.size()); ++a) {
-    groups[std::vector<int>(bones.begin() + system.anchor_offsets[a],
-                            bones.begin() + system.anchor_offsets[a + 1])]
-        .push_back(a);
-  }
   const std::size_t count = system.anchors.size();
+  const auto groups = GroupByList(system.anchor_offsets, system.anchor_bones,
+                                  static_cast<int>(count), [](int) { return true; });
   anchor_rest_.assign(3 * count, 0.0);
   anchor_offsets_.push_back(0);
   anchor_bone_offsets_.push_back(0);
@@ -235,7 +234,7 @@ AnchorGroupsView GeneralRowsPlan::AnchorGroups() const {
 void GeneralRowsPlan::AddAnchorTargets(const Eigen::Matrix3d* rotations,
                                        const std::vector<RigidTransform>& bones, double* out,
                                        int part, int parts) const {
-  const auto [first, end] = PartOf(static_cast<int>(anchor_rows_.size()), part, parts);
+  const auto [first, end] = EqualPart(static_cast<int>(anchor_rows_.size()), part, parts);
   if (first < end) {
     kernel_.add_anchors(AnchorGroups(), rotations[0].data(), bones.data(), out, first, end);
   }
@@ -243,22 +242,22 @@ void GeneralRowsPlan::AddAnchorTargets(const Eigen::Matrix3d* rotations,
 
 void GeneralRowsPlan::Rotate(const double* quaternions, const double* slot_weights, double* rotated,
                              int part, int parts) const {
-  const auto [first, end] = PartOf(slot_count_ / kSlotBlock, part, parts);
+  const auto [first, end] = EqualPart(slot_count_ / kSlotBlock, part, parts);
   if (first < end) kernel_.rotate(Groups(), quaternions, slot_weights, rotated, first, end);
 }
 
 void GeneralRowsPlan::Multiply(const Eigen::Matrix3d* rotations, const double* rigid_sums,
                                const double* rotated, double* out, int part, int parts) const {
-  const auto [first_pack, end_pack] = PartOf(pack_count(), part, parts);
+  const auto [first_pack, end_pack] = EqualPart(pack_count(), part, parts);
   if (first_pack < end_pack) {
     kernel_.multiply(Packs(), rotated, slot_count_, out, first_pack, end_pack);
   }
-  const auto [first_long, end_long] = PartOf(static_cast<int>(long_rows_.size()), part, parts);
+  const auto [first_long, end_long] = EqualPart(static_cast<int>(long_rows_.size()), part, parts);
   if (first_long < end_long) {
     kernel_.multiply_long(LongRows(), rotated, slot_count_, out, first_long, end_long);
   }
   const auto [first_rigid, end_rigid] =
-      PartOf(static_cast<int>(rigid_rows_.size()) / kSlotBlock, part, parts);
+      EqualPart(static_cast<int>(rigid_rows_.size()) / kSlotBlock, part, parts);
   if (first_rigid < end_rigid) {
     static_assert(sizeof(Eigen::Matrix3d) == 9 * sizeof(double), "matrices packed in an array");
     kernel_.multiply_rigid(RigidGroups(), rotations[0].data(), rigid_sums, out, first_rigid,

@@ -96,6 +96,13 @@ inline void AddToRows(double* out, const int* rows, Lanes x, Lanes y, Lanes z) {
 #endif
 }
 
+// The group holding item `index` of groups whose items begin at offsets[0, group_count] (ascending,
+// offsets[0] = 0): the last group whose offset is at most `index`.
+inline int GroupHolding(const int* offsets, int group_count, int index) {
+  return static_cast<int>(std::upper_bound(offsets, offsets + group_count + 1, index) - offsets) -
+         1;
+}
+
 void RotateSlotsImpl(const SlotGroupsView& groups, const double* quaternions,
                      const double* __restrict slot_weights, double* __restrict rotated,
                      int first_block, int end_block) {
@@ -108,11 +115,7 @@ void RotateSlotsImpl(const SlotGroupsView& groups, const double* quaternions,
   double* rx = rotated;
   double* ry = rx + plane;
   double* rz = ry + plane;
-  // The group holding slot `first`: the last whose offset is at most `first`.
-  int g = static_cast<int>(std::upper_bound(groups.slot_offsets,
-                                            groups.slot_offsets + groups.group_count + 1, first) -
-                           groups.slot_offsets) -
-          1;
+  int g = GroupHolding(groups.slot_offsets, groups.group_count, first);
   for (; g < groups.group_count && groups.slot_offsets[g] < end; ++g) {
     const int group_begin = groups.slot_offsets[g];
     const int slots = groups.slot_offsets[g + 1] - group_begin;
@@ -213,10 +216,7 @@ void MultiplyRigidRowsImpl(const RigidGroupsView& groups, const double* rotation
                            int end_block) {
   const int first = first_block * GeneralRowsPlan::kSlotBlock;
   const int end = end_block * GeneralRowsPlan::kSlotBlock;
-  int g = static_cast<int>(
-              std::upper_bound(groups.offsets, groups.offsets + groups.group_count + 1, first) -
-              groups.offsets) -
-          1;
+  int g = GroupHolding(groups.offsets, groups.group_count, first);
   for (; g < groups.group_count && groups.offsets[g] < end; ++g) {
     const double* r = rotations + 9 * static_cast<std::ptrdiff_t>(groups.bones[g]);  // by column
     const int stop = std::min(end, groups.offsets[g + 1]);
@@ -238,10 +238,7 @@ void AddAnchorsImpl(const AnchorGroupsView& anchors, const double* rotations,
   const double* py = px + plane;
   const double* pz = py + plane;
   const double scale = anchors.weight_squared;
-  int g = static_cast<int>(
-              std::upper_bound(anchors.offsets, anchors.offsets + anchors.group_count + 1, first) -
-              anchors.offsets) -
-          1;
+  int g = GroupHolding(anchors.offsets, anchors.group_count, first);
   for (; g < anchors.group_count && anchors.offsets[g] < end; ++g) {
     const int begin = anchors.offsets[g];
     const int count = anchors.offsets[g + 1] - begin;
