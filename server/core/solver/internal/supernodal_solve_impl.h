@@ -725,41 +725,95 @@ static_assert(kBatchLanes <= kSolveBatchLanes, "SolveManyWorkSize must cover thi
 // Batch vectors in a row of `columns` columns (zero-padded).
 constexpr int BatchVecsFor(int columns) { return (columns + kBatchLanes - 1) / kBatchLanes; }
 
-// Register blocking of the batched passes: an update works on BlockFor(kVecs) solution rows
-// (forward) or columns of the block (backward) at once, so that each load of a solution row
-// serves all of them and their BlockFor(kVecs) * kVecs independent multiply-add chains hide the
-// multiply-add's latency; the diagonal blocks are solved in tiles of as many rows. BlockFor is the
-// largest power of two up to eight whose accumulators (at most sixteen vectors), one loaded vector
-// and two broadcasts fit the registers: thirty-two with AVX-512, sixteen elsewhere.
+// Register blocking of the batched passes. A row of kVecs batch vectors is taken in strips
+// (StripsFor(kVecs) of them, StripVecs(kVecs) vectors at most each): the columns of a batch never
+// mix, so each strip is solved on its own while the factor's rows it reads are still in the
+// nearest cache. An update works on RowBlockFor(kVecs) solution rows (forward) or columns of the
+// block (backward) at once, so that each load of a strip of a solution row serves all of them and
+// their independent multiply-add chains hide the multiply-add's latency; the diagonal blocks are
+// solved in tiles of as many rows. The block is the largest power of two up to eight whose
+// accumulators (at most sixteen vectors), one strip of loaded vectors and a broadcast fit the
+// registers.
+//
+// With AVX-512's thirty-two registers a whole row is one strip (a batch of eight frames: 3
+// vectors, in blocks of 4 rows). With sixteen (AVX2, and SSE2's pairs) strips of at most three
+// vectors, in blocks of 4 rows: 12 accumulators, 3 loaded vectors and a broadcast. A whole row of
+// eight frames (6 vectors) allowed blocks of 2 rows only, and even their 12 accumulators and 6
+// loaded vectors did not fit: GCC read the solved vectors from memory at each multiply-add and
+// kept sums on the stack. With strips (and SubtractSolvedColumns inlined), against whole rows
+// (and it called), medians of four to six rounds alternating in one process (AVX2, Zen 3), a
+// batch of eight frames: 0.32 against 0.38 ms on the 1.6k leg, 104 against 115 on the arm, and
+// 16.0 against 16.0 on the 26k leg, whose batch's 5 MB of solution rows (24 columns each) are
+// ten times the core's 512 KB L2 (the likely bound there). Strips of two were no faster.
 #if defined(__AVX512F__)
 constexpr int kBatchRegisters = 32;
+constexpr int StripsFor(int) { return 1; }
 #else
 constexpr int kBatchRegisters = 16;
+constexpr int StripsFor(int vecs) { return (vecs + 2) / 3; }
 #endif
-constexpr int BlockFor(int vecs) {
+constexpr int StripVecs(int vecs) { return (vecs + StripsFor(vecs) - 1) / StripsFor(vecs); }
+constexpr int RowBlockFor(int vecs) {
+  const int strip = StripVecs(vecs);
   int block = 8;
-  while (block > 1 && (block * vecs > 16 || block * vecs + 3 > kBatchRegisters)) block /= 2;
+  while (block > 1 && (block * strip > 16 || block * strip + strip + 1 > kBatchRegisters)) {
+    block /= 2;
+  }
   return block;
 }
 
-// sum[i] -= (row i of `rows`, its first `count` values) * (the solved rows own[0, count)), for
-// kRows rows of a supernode's block (`width` values each) whose sums are held in registers.
-template <typename Value, int kVecs, int kRows>
-inline void SubtractSolvedColumns(const Value* __restrict rows, int width, int count,
-                                  const double* __restrict own, BatchVec (&sum)[kRows][kVecs],
-                                  const SpreadPrefetch& prefetch = {}) {
+// Batch vectors [kFirst, kFirst + kCount) of a row: one strip.
+template <int kFirst, int kCount>
+struct Strip {
+  static constexpr int first = kFirst;
+  static constexpr int count = kCount;
+};
+
+template <int kVecs, typename Body, int... kIndices>
+inline void ForEachStripOf(Body&& body, std::integer_sequence<int, kIndices...>) {
+  constexpr int kStrips = StripsFor(kVecs);
+  (body(Strip<kIndices * kVecs / kStrips,
+              (kIndices + 1) * kVecs / kStrips - kIndices * kVecs / kStrips>()),
+   ...);
+}
+
+// Calls body(Strip<first, count>()) for each strip of a row of kVecs batch vectors, in order.
+template <int kVecs, typename Body>
+inline void ForEachStrip(Body&& body) {
+  ForEachStripOf<kVecs>(body, std::make_integer_sequence<int, StripsFor(kVecs)>());
+}
+
+// sum[i] -= (row i of `rows`, its first `count` values) * (the solved rows own[0, count), a strip
+// of kCount vectors of rows kVecs vectors apart), for kRows rows of a supernode's block (`width`
+// values each) whose sums are held in registers.
+//
+// Always inlined: GCC kept some instances out of line, and the caller's sums then went through
+// the stack at every block of rows, a narrow supernode's few values each. Inlined, against out of
+// line (the same run as above), a batch of four frames (one strip, blocked as before): 0.12
+// against 0.24 ms on the 1.6k leg, 9.7 against 13.4 on the 26k leg, 57 against 95 on the arm.
+template <typename Value, int kVecs, int kCount, int kRows>
+__attribute__((always_inline)) inline void SubtractSolvedColumns(
+    const Value* __restrict rows, int width, int count, const double* __restrict own,
+    BatchVec (&sum)[kRows][kCount], const SpreadPrefetch& prefetch = {}) {
   constexpr int kStride = kBatchLanes * kVecs;
   for (int k = 0; k < count; ++k) {
     prefetch.Step(k);
     const double* known = own + kStride * k;
-    BatchVec v[kVecs];
-    for (int j = 0; j < kVecs; ++j) v[j] = LoadBatch(known + kBatchLanes * j);
+    BatchVec v[kCount];
+    for (int j = 0; j < kCount; ++j) v[j] = LoadBatch(known + kBatchLanes * j);
     for (int i = 0; i < kRows; ++i) {
       const BatchVec l = SplatBatch(rows[i * width + k]);
-      for (int j = 0; j < kVecs; ++j) sum[i][j] -= l * v[j];
+      for (int j = 0; j < kCount; ++j) sum[i][j] -= l * v[j];
     }
   }
   prefetch.Rest(count);
+}
+
+// The block's prefetches are spread over the first strip's loop only (the others read the same
+// rows again, from the nearest cache).
+template <typename StripType>
+inline SpreadPrefetch PrefetchFor(StripType, const SpreadPrefetch& prefetch) {
+  return StripType::first == 0 ? prefetch : SpreadPrefetch{};
 }
 
 // Rows [r, num_rows) of the block below the diagonal, kRows at a time while they last, then in
@@ -773,15 +827,23 @@ inline void ForwardRowsMany(const SupernodeBlock<Value>& s, const double* __rest
     const Value* block_rows = s.values + r * width;
     const auto prefetch = SpreadPrefetch::Of<Pass::kForward>(s, block_rows, kRows * width);
     double* target[kRows];
-    BatchVec sum[kRows][kVecs];
     for (int i = 0; i < kRows; ++i) {
       target[i] = y + kStride * static_cast<std::ptrdiff_t>(s.rows[r + i]);
-      for (int j = 0; j < kVecs; ++j) sum[i][j] = LoadBatch(target[i] + kBatchLanes * j);
     }
-    SubtractSolvedColumns<Value, kVecs, kRows>(block_rows, width, width, own, sum, prefetch);
-    for (int i = 0; i < kRows; ++i) {
-      for (int j = 0; j < kVecs; ++j) StoreBatch(target[i] + kBatchLanes * j, sum[i][j]);
-    }
+    ForEachStrip<kVecs>([&](auto strip) {
+      constexpr int kFirst = decltype(strip)::first, kCount = decltype(strip)::count;
+      BatchVec sum[kRows][kCount];
+      for (int i = 0; i < kRows; ++i) {
+        for (int j = 0; j < kCount; ++j)
+          sum[i][j] = LoadBatch(target[i] + kBatchLanes * (kFirst + j));
+      }
+      SubtractSolvedColumns<Value, kVecs, kCount, kRows>(
+          block_rows, width, width, own + kBatchLanes * kFirst, sum, PrefetchFor(strip, prefetch));
+      for (int i = 0; i < kRows; ++i) {
+        for (int j = 0; j < kCount; ++j)
+          StoreBatch(target[i] + kBatchLanes * (kFirst + j), sum[i][j]);
+      }
+    });
   }
   if constexpr (kRows > 1) ForwardRowsMany<Value, kVecs, kRows / 2>(s, own, y, r);
 }
@@ -798,29 +860,34 @@ inline void ForwardDiagonalMany(const SupernodeBlock<Value>& s, double* __restri
   for (; c + kTile <= width; c += kTile) {
     const Value* tile_rows = s.values + static_cast<std::ptrdiff_t>(c) * width;
     const auto prefetch = SpreadPrefetch::Of<Pass::kForward>(s, tile_rows, kTile * width);
-    double* const tile = own + kStride * c;
-    BatchVec sum[kTile][kVecs];
-    for (int i = 0; i < kTile; ++i) {
-      for (int j = 0; j < kVecs; ++j) sum[i][j] = LoadBatch(tile + kStride * i + kBatchLanes * j);
-    }
-    SubtractSolvedColumns<Value, kVecs, kTile>(tile_rows, width, c, own, sum, prefetch);
-    // The triangle's loops unrolled whole, so the tile's sums stay in registers: left to itself
-    // GCC keeps these loops (their bound varies with `i`) and with them the sums on the stack,
-    // each multiply-add a load and a store (about a tenth of the batched passes' time).
-#pragma GCC unroll 8
-    for (int i = 0; i < kTile; ++i) {
-      const Value* row = tile_rows + i * width;
-#pragma GCC unroll 8
-      for (int m = 0; m < i; ++m) {
-        const BatchVec l = SplatBatch(row[c + m]);
-        for (int j = 0; j < kVecs; ++j) sum[i][j] -= l * sum[m][j];
+    ForEachStrip<kVecs>([&](auto strip) {
+      constexpr int kFirst = decltype(strip)::first, kCount = decltype(strip)::count;
+      double* const tile = own + kStride * c + kBatchLanes * kFirst;
+      BatchVec sum[kTile][kCount];
+      for (int i = 0; i < kTile; ++i) {
+        for (int j = 0; j < kCount; ++j)
+          sum[i][j] = LoadBatch(tile + kStride * i + kBatchLanes * j);
       }
-      const BatchVec inverse_pivot = SplatBatch(1.0 / static_cast<double>(row[c + i]));
-      for (int j = 0; j < kVecs; ++j) {
-        sum[i][j] = sum[i][j] * inverse_pivot;
-        StoreBatch(tile + kStride * i + kBatchLanes * j, sum[i][j]);
+      SubtractSolvedColumns<Value, kVecs, kCount, kTile>(
+          tile_rows, width, c, own + kBatchLanes * kFirst, sum, PrefetchFor(strip, prefetch));
+      // The triangle's loops unrolled whole, so the tile's sums stay in registers: left to
+      // itself GCC keeps these loops (their bound varies with `i`) and with them the sums on the
+      // stack, each multiply-add a load and a store (about a tenth of the batched passes' time).
+#pragma GCC unroll 8
+      for (int i = 0; i < kTile; ++i) {
+        const Value* row = tile_rows + i * width;
+#pragma GCC unroll 8
+        for (int m = 0; m < i; ++m) {
+          const BatchVec l = SplatBatch(row[c + m]);
+          for (int j = 0; j < kCount; ++j) sum[i][j] -= l * sum[m][j];
+        }
+        const BatchVec inverse_pivot = SplatBatch(1.0 / static_cast<double>(row[c + i]));
+        for (int j = 0; j < kCount; ++j) {
+          sum[i][j] = sum[i][j] * inverse_pivot;
+          StoreBatch(tile + kStride * i + kBatchLanes * j, sum[i][j]);
+        }
       }
-    }
+    });
   }
   if constexpr (kTile > 1) ForwardDiagonalMany<Value, kVecs, kTile / 2>(s, own, c);
 }
@@ -831,8 +898,8 @@ template <typename Value, int kVecs>
 inline void ForwardSupernodeMany(const SupernodeBlock<Value>& s, double* __restrict y) {
   constexpr int kStride = kBatchLanes * kVecs;
   double* __restrict own = y + kStride * static_cast<std::ptrdiff_t>(s.first);
-  ForwardDiagonalMany<Value, kVecs, BlockFor(kVecs)>(s, own, 0);
-  ForwardRowsMany<Value, kVecs, BlockFor(kVecs)>(s, own, y, s.width);
+  ForwardDiagonalMany<Value, kVecs, RowBlockFor(kVecs)>(s, own, 0);
+  ForwardRowsMany<Value, kVecs, RowBlockFor(kVecs)>(s, own, y, s.width);
 }
 
 // Columns [k, width) of the block: own[c] -= sum over the rows below the diagonal of
@@ -844,44 +911,48 @@ template <typename Value, int kVecs, int kColumns>
 inline void BackwardColumnsMany(const SupernodeBlock<Value>& s, double* __restrict own,
                                 const double* __restrict y, int k) {
   constexpr int kStride = kBatchLanes * kVecs;
-  constexpr int kSplits = kColumns * kVecs >= 8 ? 1 : kColumns * kVecs >= 4 ? 2 : 4;
   const int width = s.width;
   for (; k + kColumns <= width; k += kColumns) {
-    BatchVec sum[kSplits][kColumns][kVecs];
-    for (int u = 0; u < kSplits; ++u) {
+    ForEachStrip<kVecs>([&](auto strip) {
+      constexpr int kFirst = decltype(strip)::first, kCount = decltype(strip)::count;
+      constexpr int kSplits = kColumns * kCount >= 8 ? 1 : kColumns * kCount >= 4 ? 2 : 4;
+      BatchVec sum[kSplits][kColumns][kCount];
+      for (int u = 0; u < kSplits; ++u) {
+        for (int c = 0; c < kColumns; ++c) {
+          for (int j = 0; j < kCount; ++j) sum[u][c][j] = SplatBatch(0);
+        }
+      }
+      const auto add_row = [&](std::int64_t row_index, BatchVec(&into)[kColumns][kCount]) {
+        const Value* row = s.values + row_index * width + k;
+        // The block's stream below, a line a row as each strip of columns reads its own.
+        if (kFirst == 0) SpreadPrefetch::Of<Pass::kBackward>(s, row, 1).Step(0);
+        const double* solved =
+            y + kStride * static_cast<std::ptrdiff_t>(s.rows[row_index]) + kBatchLanes * kFirst;
+        BatchVec v[kCount];
+        for (int j = 0; j < kCount; ++j) v[j] = LoadBatch(solved + kBatchLanes * j);
+        for (int c = 0; c < kColumns; ++c) {
+          const BatchVec l = SplatBatch(row[c]);
+          for (int j = 0; j < kCount; ++j) into[c][j] += l * v[j];
+        }
+      };
+      // The last rows first: the backward pass reads the factor descending (PrefetchFactor).
+      std::int64_t r = s.num_rows;
+      for (; r - kSplits >= width; r -= kSplits) {
+        for (int u = 0; u < kSplits; ++u) add_row(r - kSplits + u, sum[u]);
+      }
+      for (; r > width; --r) add_row(r - 1, sum[0]);
+      for (int u = 1; u < kSplits; ++u) {
+        for (int c = 0; c < kColumns; ++c) {
+          for (int j = 0; j < kCount; ++j) sum[0][c][j] += sum[u][c][j];
+        }
+      }
       for (int c = 0; c < kColumns; ++c) {
-        for (int j = 0; j < kVecs; ++j) sum[u][c][j] = SplatBatch(0);
+        double* target = own + kStride * (k + c) + kBatchLanes * kFirst;
+        for (int j = 0; j < kCount; ++j) {
+          StoreBatch(target + kBatchLanes * j, LoadBatch(target + kBatchLanes * j) - sum[0][c][j]);
+        }
       }
-    }
-    const auto add_row = [&](std::int64_t row_index, BatchVec(&into)[kColumns][kVecs]) {
-      const Value* row = s.values + row_index * width + k;
-      // The block's stream below, a line a row as each strip of columns reads its own.
-      SpreadPrefetch::Of<Pass::kBackward>(s, row, 1).Step(0);
-      const double* solved = y + kStride * static_cast<std::ptrdiff_t>(s.rows[row_index]);
-      BatchVec v[kVecs];
-      for (int j = 0; j < kVecs; ++j) v[j] = LoadBatch(solved + kBatchLanes * j);
-      for (int c = 0; c < kColumns; ++c) {
-        const BatchVec l = SplatBatch(row[c]);
-        for (int j = 0; j < kVecs; ++j) into[c][j] += l * v[j];
-      }
-    };
-    // The last rows first: the backward pass reads the factor descending (PrefetchFactor).
-    std::int64_t r = s.num_rows;
-    for (; r - kSplits >= width; r -= kSplits) {
-      for (int u = 0; u < kSplits; ++u) add_row(r - kSplits + u, sum[u]);
-    }
-    for (; r > width; --r) add_row(r - 1, sum[0]);
-    for (int u = 1; u < kSplits; ++u) {
-      for (int c = 0; c < kColumns; ++c) {
-        for (int j = 0; j < kVecs; ++j) sum[0][c][j] += sum[u][c][j];
-      }
-    }
-    for (int c = 0; c < kColumns; ++c) {
-      double* target = own + kStride * (k + c);
-      for (int j = 0; j < kVecs; ++j) {
-        StoreBatch(target + kBatchLanes * j, LoadBatch(target + kBatchLanes * j) - sum[0][c][j]);
-      }
-    }
+    });
   }
   if constexpr (kColumns > 1) BackwardColumnsMany<Value, kVecs, kColumns / 2>(s, own, y, k);
 }
@@ -898,36 +969,40 @@ inline void BackwardDiagonalMany(const SupernodeBlock<Value>& s, double* __restr
     const int f = c - kTile;
     const Value* tile_rows = s.values + static_cast<std::ptrdiff_t>(f) * width;
     const auto prefetch = SpreadPrefetch::Of<Pass::kBackward>(s, tile_rows, kTile * width);
-    double* const tile = own + kStride * f;
-    BatchVec solved[kTile][kVecs];
-    // Unrolled whole, as in ForwardDiagonalMany, so `solved` stays in registers.
+    ForEachStrip<kVecs>([&](auto strip) {
+      constexpr int kFirst = decltype(strip)::first, kCount = decltype(strip)::count;
+      double* const tile = own + kStride * f + kBatchLanes * kFirst;
+      BatchVec solved[kTile][kCount];
+      // Unrolled whole, as in ForwardDiagonalMany, so `solved` stays in registers.
 #pragma GCC unroll 8
-    for (int i = kTile - 1; i >= 0; --i) {
-      const Value* row = tile_rows + i * width;
-      double* const target = tile + kStride * i;
-      for (int j = 0; j < kVecs; ++j) solved[i][j] = LoadBatch(target + kBatchLanes * j);
+      for (int i = kTile - 1; i >= 0; --i) {
+        const Value* row = tile_rows + i * width;
+        double* const target = tile + kStride * i;
+        for (int j = 0; j < kCount; ++j) solved[i][j] = LoadBatch(target + kBatchLanes * j);
 #pragma GCC unroll 8
-      for (int m = kTile - 1; m > i; --m) {
-        const BatchVec l = SplatBatch(tile_rows[m * width + f + i]);
-        for (int j = 0; j < kVecs; ++j) solved[i][j] -= l * solved[m][j];
+        for (int m = kTile - 1; m > i; --m) {
+          const BatchVec l = SplatBatch(tile_rows[m * width + f + i]);
+          for (int j = 0; j < kCount; ++j) solved[i][j] -= l * solved[m][j];
+        }
+        const BatchVec inverse_pivot = SplatBatch(1.0 / static_cast<double>(row[f + i]));
+        for (int j = 0; j < kCount; ++j) {
+          solved[i][j] = solved[i][j] * inverse_pivot;
+          StoreBatch(target + kBatchLanes * j, solved[i][j]);
+        }
       }
-      const BatchVec inverse_pivot = SplatBatch(1.0 / static_cast<double>(row[f + i]));
-      for (int j = 0; j < kVecs; ++j) {
-        solved[i][j] = solved[i][j] * inverse_pivot;
-        StoreBatch(target + kBatchLanes * j, solved[i][j]);
+      const SpreadPrefetch strip_prefetch = PrefetchFor(strip, prefetch);
+      for (int k = 0; k < f; ++k) {
+        strip_prefetch.Step(k);
+        double* above = own + kStride * k + kBatchLanes * kFirst;
+        BatchVec sum[kCount];
+        for (int j = 0; j < kCount; ++j) sum[j] = LoadBatch(above + kBatchLanes * j);
+        for (int i = 0; i < kTile; ++i) {
+          const BatchVec l = SplatBatch(tile_rows[i * width + k]);
+          for (int j = 0; j < kCount; ++j) sum[j] -= l * solved[i][j];
+        }
+        for (int j = 0; j < kCount; ++j) StoreBatch(above + kBatchLanes * j, sum[j]);
       }
-    }
-    for (int k = 0; k < f; ++k) {
-      prefetch.Step(k);
-      double* above = own + kStride * k;
-      BatchVec sum[kVecs];
-      for (int j = 0; j < kVecs; ++j) sum[j] = LoadBatch(above + kBatchLanes * j);
-      for (int i = 0; i < kTile; ++i) {
-        const BatchVec l = SplatBatch(tile_rows[i * width + k]);
-        for (int j = 0; j < kVecs; ++j) sum[j] -= l * solved[i][j];
-      }
-      for (int j = 0; j < kVecs; ++j) StoreBatch(above + kBatchLanes * j, sum[j]);
-    }
+    });
     prefetch.Rest(f);
   }
   if constexpr (kTile > 1) BackwardDiagonalMany<Value, kVecs, kTile / 2>(s, own, c);
@@ -940,8 +1015,8 @@ template <typename Value, int kVecs>
 inline void BackwardSupernodeMany(const SupernodeBlock<Value>& s, double* __restrict y) {
   constexpr int kStride = kBatchLanes * kVecs;
   double* __restrict own = y + kStride * static_cast<std::ptrdiff_t>(s.first);
-  BackwardColumnsMany<Value, kVecs, BlockFor(kVecs)>(s, own, y, 0);
-  BackwardDiagonalMany<Value, kVecs, BlockFor(kVecs)>(s, own, s.width);
+  BackwardColumnsMany<Value, kVecs, RowBlockFor(kVecs)>(s, own, y, 0);
+  BackwardDiagonalMany<Value, kVecs, RowBlockFor(kVecs)>(s, own, s.width);
 }
 
 // The batched passes on solution rows of kVecs batch vectors: gather(row, unknown) fills the row
