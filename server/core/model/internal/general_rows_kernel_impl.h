@@ -1,6 +1,6 @@
 // The kernels of general_rows.h, compiled once per instruction set: by
 // general_rows_kernel_baseline.cc (two doubles a vector), general_rows_kernel_avx2.cc (-mavx2
-// -mfma: four, hardware gathers) and general_rows_kernel_avx512.cc (-mavx512f -mavx512vl as well:
+// -mfma: four) and general_rows_kernel_avx512.cc (-mavx512f -mavx512vl as well:
 // eight, gathers and scatters). Each defines its GeneralRowsKernel from these functions.
 #pragma once
 
@@ -8,7 +8,7 @@
 #include <cstddef>
 #include <cstring>
 
-#if defined(__AVX2__)
+#if defined(__AVX512F__)
 #include <immintrin.h>
 #endif
 
@@ -41,17 +41,18 @@ inline Lanes Broadcast(double x) {
   return v;
 }
 
-// base[index[l]] for each lane. (The masked gathers: GCC 12's unmasked ones read an undefined
-// source register, and -Wmaybe-uninitialized says so.)
+// base[index[l]] for each lane. With AVX-512 a hardware gather (the masked one: GCC 12's unmasked
+// ones read an undefined source register, and -Wmaybe-uninitialized says so); elsewhere one load
+// a lane. AVX2's four-lane gather was slower than four loads and inserts on an AMD Zen 3: the
+// right-hand side (deform_bench's RightHandSide, three rounds alternating) 0.026-0.031 against
+// 0.015-0.018 ms on the 1.6k leg, 0.38-0.52 against 0.23-0.30 on the 26k leg, 1.6-1.9 against
+// 0.93-1.07 on the arm. (Intel's microcode against Gather Data Sampling, 2023, slowed the
+// gathers of its AVX2 processors too; not measured here.)
 inline Lanes Gather(const double* base, const int* index) {
 #if defined(__AVX512F__)
   return _mm512_mask_i32gather_pd(_mm512_setzero_pd(), 0xff,
                                   _mm256_loadu_si256(reinterpret_cast<const __m256i*>(index)), base,
                                   8);
-#elif defined(__AVX2__)
-  const __m256d all = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
-  return _mm256_mask_i32gather_pd(_mm256_setzero_pd(), base,
-                                  _mm_loadu_si128(reinterpret_cast<const __m128i*>(index)), all, 8);
 #else
   Lanes v;
   for (int l = 0; l < kLanes; ++l) v[l] = base[index[l]];
