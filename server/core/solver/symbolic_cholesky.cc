@@ -95,6 +95,46 @@ std::vector<std::int64_t> ColumnCounts(const std::vector<int>& cp, const std::ve
   return counts;
 }
 
+// A postorder of the elimination tree (`parent`, -1 for a root): every subtree's columns
+// consecutive, each column right after its subtree, a node's children in ascending order of
+// `weight` (ties by index), so that the heaviest child comes last, next to its parent. Renumbering
+// the columns in this order leaves the factor's fill and its tree's shape unchanged, and puts each
+// chain of the tree (a parent following its child) in consecutive columns, where SupernodeColumns
+// can merge them. order[k] = the column that comes k-th.
+std::vector<int> Postorder(const std::vector<int>& parent,
+                           const std::vector<std::int64_t>& weight) {
+  const int n = static_cast<int>(parent.size());
+  std::vector<int> by_weight(n);
+  std::iota(by_weight.begin(), by_weight.end(), 0);
+  std::stable_sort(by_weight.begin(), by_weight.end(),
+                   [&](int a, int b) { return weight[a] > weight[b]; });
+  // Children lists, each in ascending weight (a child pushed later goes in front).
+  std::vector<int> first_child(n, -1), next_sibling(n, -1);
+  for (const int j : by_weight) {
+    if (parent[j] < 0) continue;
+    next_sibling[j] = first_child[parent[j]];
+    first_child[parent[j]] = j;
+  }
+  std::vector<int> order, stack;
+  order.reserve(n);
+  for (auto root = by_weight.rbegin(); root != by_weight.rend(); ++root) {
+    if (parent[*root] >= 0) continue;
+    stack.push_back(*root);
+    while (!stack.empty()) {
+      const int top = stack.back();
+      const int child = first_child[top];
+      if (child < 0) {
+        order.push_back(top);
+        stack.pop_back();
+      } else {
+        first_child[top] = next_sibling[child];
+        stack.push_back(child);
+      }
+    }
+  }
+  return order;
+}
+
 // Supernode boundaries, relaxed (CHOLMOD's amalgamation rule and defaults): column j joins j - 1's
 // supernode when j is j - 1's parent in the elimination tree and the merged block's explicit zeros
 // stay within a share that shrinks as the supernode widens: any share up to 4 columns, 80% up to
@@ -154,11 +194,27 @@ StatusOr<std::shared_ptr<const SymbolicCholesky>> SymbolicCholesky::Analyze(cons
   auto s = std::make_shared<SymbolicCholesky>();
   s->n_ = n;
   s->ordering_ = ordering;
-  DEFORM_ASSIGN_OR_RETURN(s->permutation_, FillReducingOrdering(a, ordering));
+  DEFORM_ASSIGN_OR_RETURN(const std::vector<int> fill_reducing, FillReducingOrdering(a, ordering));
+  s->permutation_ = fill_reducing;
   DEFORM_RETURN_IF_ERROR(s->AnalyzePermutedPattern(a));
   s->elimination_tree_ = EliminationTree(s->c_column_pointers_, s->c_row_indices_);
-  const std::vector<std::int64_t> column_counts =
+  std::vector<std::int64_t> column_counts =
       ColumnCounts(s->c_column_pointers_, s->c_row_indices_, s->elimination_tree_);
+  if (ordering != Ordering::kNatural) {
+    // The ordering followed by a postorder of its elimination tree (as CHOLMOD does): the same
+    // fill, with the tree's chains in consecutive columns. On the 26k leg (METIS) 2,339
+    // supernodes instead of 8,507 (6,609 of them single columns), 8% more stored values, and in
+    // the solves 2.4 times fewer rows below the supernodes' diagonal blocks to update (AVX2, Zen 3,
+    // deform_bench medians of five rounds alternating: TriangularSolve 5.1 against 5.6 ms on the
+    // 26k leg and 35.8 against 38.6 on the arm; BatchedSolve of eight frames 13.3 against 13.9 and
+    // 81.8 against 91.5). The numeric refactorisation measured alike within this host's noise
+    // (Factorize on the 26k leg 284-438 against 280-340 ms).
+    const std::vector<int> order = Postorder(s->elimination_tree_, column_counts);
+    for (int k = 0; k < n; ++k) s->permutation_[k] = fill_reducing[order[k]];
+    DEFORM_RETURN_IF_ERROR(s->AnalyzePermutedPattern(a));
+    s->elimination_tree_ = EliminationTree(s->c_column_pointers_, s->c_row_indices_);
+    column_counts = ColumnCounts(s->c_column_pointers_, s->c_row_indices_, s->elimination_tree_);
+  }
   s->column_pointers_.assign(n + 1, 0);
   std::partial_sum(column_counts.begin(), column_counts.end(), s->column_pointers_.begin() + 1);
   s->supernode_columns_ = SupernodeColumns(s->elimination_tree_, column_counts);

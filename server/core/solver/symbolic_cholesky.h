@@ -28,6 +28,9 @@ class SymbolicCholesky {
   Ordering ordering() const { return ordering_; }
   // Non-zeros of the factor L, diagonal included.
   std::int64_t factor_nonzeros() const { return column_pointers_.back(); }
+  // The parent of each column of L in its elimination tree, -1 for a root. Postordered (every
+  // subtree's columns consecutive, ending at its root) unless the ordering is kNatural.
+  const std::vector<int>& elimination_tree() const { return elimination_tree_; }
 
  private:
   friend class CholeskyFactor;

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <cmath>
 #include <random>
@@ -575,21 +576,60 @@ TEST(SolveKernel, TheBestIsAvailable) {
   EXPECT_TRUE(SolveKernelAvailable(SolveKernel::kBaseline));
 }
 
-TEST(SparseCholesky, MetisOrderingFillsLessThanNatural) {
-  // A 2D grid Laplacian: nested dissection beats the natural (banded) order.
-  const int side = 40, n = side * side;
+// Non-zeros of the Cholesky factor of P A P^T (diagonal included), by Eigen's own analysis, for
+// permutation[new] = old.
+std::int64_t EigenFactorNonzeros(const ColMajorMatrix& a, const std::vector<int>& permutation) {
+  const int n = static_cast<int>(a.cols());
+  std::vector<int> inverse(n);
+  for (int k = 0; k < n; ++k) inverse[permutation[k]] = k;
   std::vector<Eigen::Triplet<double>> t;
-  for (int r = 0; r < side; ++r) {
-    for (int c = 0; c < side; ++c) {
-      const int i = r * side + c;
-      t.emplace_back(i, i, 4.5);
-      if (c + 1 < side) t.emplace_back(i, i + 1, -1), t.emplace_back(i + 1, i, -1);
-      if (r + 1 < side) t.emplace_back(i, i + side, -1), t.emplace_back(i + side, i, -1);
+  for (int j = 0; j < n; ++j) {
+    for (ColMajorMatrix::InnerIterator it(a, j); it; ++it) {
+      t.emplace_back(inverse[it.row()], inverse[j], it.value());
     }
   }
-  ColMajorMatrix a(n, n);
-  a.setFromTriplets(t.begin(), t.end());
-  a.makeCompressed();
+  ColMajorMatrix c(n, n);
+  c.setFromTriplets(t.begin(), t.end());
+  Eigen::SimplicialLLT<ColMajorMatrix, Eigen::Lower, Eigen::NaturalOrdering<int>> llt(c);
+  return llt.matrixL().nestedExpression().nonZeros();
+}
+
+// The analysis renumbers the fill-reducing ordering's columns in a postorder of its elimination
+// tree: every subtree's columns are consecutive and end at its root, and the fill is the
+// ordering's own.
+TEST(SymbolicCholesky, TheEliminationTreeIsPostorderedWithTheOrderingsFill) {
+  const std::pair<std::string, ColMajorMatrix> matrices[] = {
+      {"grid", GridMatrix(30)}, {"random", RandomSpdMatrix(600, 3, 5)}};
+  for (const auto& [name, a] : matrices) {
+    for (const Ordering ordering : {Ordering::kAmd, Ordering::kMetis}) {
+      auto symbolic = SymbolicCholesky::Analyze(a, ordering);
+      ASSERT_TRUE(symbolic.ok());
+      const std::vector<int>& parent = (*symbolic)->elimination_tree();
+      const int n = static_cast<int>(parent.size());
+      // first[j]: the first column of j's subtree (its columns [first[j], j] when postordered).
+      std::vector<int> first(n), size(n, 1);
+      for (int j = 0; j < n; ++j) first[j] = j;
+      for (int j = 0; j < n; ++j) {
+        ASSERT_TRUE(parent[j] == -1 || parent[j] > j) << name;
+        if (parent[j] < 0) continue;
+        first[parent[j]] = std::min(first[parent[j]], first[j]);
+        size[parent[j]] += size[j];
+      }
+      for (int j = 0; j < n; ++j) {
+        EXPECT_EQ(j - first[j] + 1, size[j])
+            << name << ", " << OrderingName(ordering) << ", column " << j;
+      }
+      auto fill_reducing = FillReducingOrdering(a, ordering);
+      ASSERT_TRUE(fill_reducing.ok());
+      EXPECT_EQ((*symbolic)->factor_nonzeros(), EigenFactorNonzeros(a, *fill_reducing))
+          << name << ", " << OrderingName(ordering);
+    }
+  }
+}
+
+TEST(SparseCholesky, MetisOrderingFillsLessThanNatural) {
+  // A 2D grid Laplacian: nested dissection beats the natural (banded) order.
+  const ColMajorMatrix a = GridMatrix(40);
   auto metis = SymbolicCholesky::Analyze(a, Ordering::kMetis);
   auto natural = SymbolicCholesky::Analyze(a, Ordering::kNatural);
   ASSERT_TRUE(metis.ok() && natural.ok());
