@@ -925,7 +925,7 @@ inline void BackwardColumnsMany(const SupernodeBlock<Value>& s, double* __restri
       const auto add_row = [&](std::int64_t row_index, BatchVec(&into)[kColumns][kCount]) {
         const Value* row = s.values + row_index * width + k;
         // The block's stream below, a line a row as each strip of columns reads its own.
-        if (kFirst == 0) SpreadPrefetch::Of<Pass::kBackward>(s, row, 1).Step(0);
+        if constexpr (kFirst == 0) SpreadPrefetch::Of<Pass::kBackward>(s, row, 1).Step(0);
         const double* solved =
             y + kStride * static_cast<std::ptrdiff_t>(s.rows[row_index]) + kBatchLanes * kFirst;
         BatchVec v[kCount];
