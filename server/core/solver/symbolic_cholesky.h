@@ -28,9 +28,15 @@ class SymbolicCholesky {
   Ordering ordering() const { return ordering_; }
   // Non-zeros of the factor L, diagonal included.
   std::int64_t factor_nonzeros() const { return column_pointers_.back(); }
+  // Non-zeros of column j of L, diagonal included.
+  std::int64_t column_nonzeros(int j) const {
+    return column_pointers_[j + 1] - column_pointers_[j];
+  }
   // The parent of each column of L in its elimination tree, -1 for a root. Postordered (every
   // subtree's columns consecutive, ending at its root) unless the ordering is kNatural.
   const std::vector<int>& elimination_tree() const { return elimination_tree_; }
+  // The columns' order: permutation()[new] = old (the fill-reducing ordering, postordered).
+  const std::vector<int>& permutation() const { return permutation_; }
 
  private:
   friend class CholeskyFactor;

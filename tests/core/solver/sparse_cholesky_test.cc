@@ -576,9 +576,8 @@ TEST(SolveKernel, TheBestIsAvailable) {
   EXPECT_TRUE(SolveKernelAvailable(SolveKernel::kBaseline));
 }
 
-// Non-zeros of the Cholesky factor of P A P^T (diagonal included), by Eigen's own analysis, for
-// permutation[new] = old.
-std::int64_t EigenFactorNonzeros(const ColMajorMatrix& a, const std::vector<int>& permutation) {
+// P A P^T for permutation[new] = old.
+ColMajorMatrix Permuted(const ColMajorMatrix& a, const std::vector<int>& permutation) {
   const int n = static_cast<int>(a.cols());
   std::vector<int> inverse(n);
   for (int k = 0; k < n; ++k) inverse[permutation[k]] = k;
@@ -590,13 +589,34 @@ std::int64_t EigenFactorNonzeros(const ColMajorMatrix& a, const std::vector<int>
   }
   ColMajorMatrix c(n, n);
   c.setFromTriplets(t.begin(), t.end());
-  Eigen::SimplicialLLT<ColMajorMatrix, Eigen::Lower, Eigen::NaturalOrdering<int>> llt(c);
-  return llt.matrixL().nestedExpression().nonZeros();
+  return c;
+}
+
+// Eigen's own analysis of P A P^T in the given order: its factor's non-zeros (diagonal included)
+// and its elimination tree.
+struct EigenAnalysis
+    : Eigen::SimplicialLLT<ColMajorMatrix, Eigen::Lower, Eigen::NaturalOrdering<int>> {
+  EigenAnalysis(const ColMajorMatrix& a, const std::vector<int>& permutation) {
+    compute(Permuted(a, permutation));
+  }
+  std::int64_t factor_nonzeros() const { return matrixL().nestedExpression().nonZeros(); }
+  std::vector<int> elimination_tree() const {
+    return std::vector<int>(m_parent.data(), m_parent.data() + m_parent.size());
+  }
+  std::vector<std::int64_t> column_nonzeros() const {  // diagonal included (an LLT's are)
+    return std::vector<std::int64_t>(m_nonZerosPerCol.data(),
+                                     m_nonZerosPerCol.data() + m_nonZerosPerCol.size());
+  }
+};
+
+std::int64_t EigenFactorNonzeros(const ColMajorMatrix& a, const std::vector<int>& permutation) {
+  return EigenAnalysis(a, permutation).factor_nonzeros();
 }
 
 // The analysis renumbers the fill-reducing ordering's columns in a postorder of its elimination
-// tree: every subtree's columns are consecutive and end at its root, and the fill is the
-// ordering's own.
+// tree: every subtree's columns are consecutive and end at its root, the fill is the ordering's
+// own, and the tree it keeps (relabelled from the ordering's, not recomputed) is the renumbered
+// matrix's own, as are its column counts, as Eigen finds them.
 TEST(SymbolicCholesky, TheEliminationTreeIsPostorderedWithTheOrderingsFill) {
   const std::pair<std::string, ColMajorMatrix> matrices[] = {
       {"grid", GridMatrix(30)}, {"random", RandomSpdMatrix(600, 3, 5)}};
@@ -622,6 +642,12 @@ TEST(SymbolicCholesky, TheEliminationTreeIsPostorderedWithTheOrderingsFill) {
       auto fill_reducing = FillReducingOrdering(a, ordering);
       ASSERT_TRUE(fill_reducing.ok());
       EXPECT_EQ((*symbolic)->factor_nonzeros(), EigenFactorNonzeros(a, *fill_reducing))
+          << name << ", " << OrderingName(ordering);
+      const EigenAnalysis renumbered(a, (*symbolic)->permutation());
+      EXPECT_EQ(parent, renumbered.elimination_tree()) << name << ", " << OrderingName(ordering);
+      std::vector<std::int64_t> column_nonzeros(n);
+      for (int j = 0; j < n; ++j) column_nonzeros[j] = (*symbolic)->column_nonzeros(j);
+      EXPECT_EQ(column_nonzeros, renumbered.column_nonzeros())
           << name << ", " << OrderingName(ordering);
     }
   }
