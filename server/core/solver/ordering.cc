@@ -3,6 +3,7 @@
 #include <metis.h>
 
 #include <Eigen/OrderingMethods>
+#include <mutex>
 #include <numeric>
 #include <string>
 #include <utility>
@@ -43,8 +44,18 @@ StatusOr<std::vector<int>> MetisOrdering(const ColMajorMatrix& a, std::vector<in
   METIS_SetDefaultOptions(options);
   options[METIS_OPTION_SEED] = 1;  // deterministic ordering from run to run
   std::vector<idx_t> perm(nvtxs), iperm(nvtxs);
-  const int rc =
-      METIS_NodeND(&nvtxs, xadj.data(), adjncy.data(), nullptr, options, perm.data(), iperm.data());
+  // METIS keeps its random generator's state (GKlib's Mersenne twister) in globals that every
+  // thread shares: two calls at once race on it, which is undefined behaviour, and each may get an
+  // ordering other than its own from the seed. Two threads building the 3k phantom's model at once
+  // got nine different factor sizes in twenty builds, one thread always the same. So one call at a
+  // time: an ordering takes milliseconds to a few seconds, once per mesh loaded.
+  static std::mutex metis_calls;
+  int rc;
+  {
+    const std::lock_guard<std::mutex> one_at_a_time(metis_calls);
+    rc = METIS_NodeND(&nvtxs, xadj.data(), adjncy.data(), nullptr, options, perm.data(),
+                      iperm.data());
+  }
   if (rc != METIS_OK) {
     return Status::Internal("METIS_NodeND failed with code " + std::to_string(rc));
   }

@@ -653,6 +653,34 @@ TEST(SymbolicCholesky, TheEliminationTreeIsPostorderedWithTheOrderingsFill) {
   }
 }
 
+// METIS keeps its random generator in globals: orderings computed on several threads at once
+// must each be the one computed alone (FillReducingOrdering lets one METIS call run at a time).
+TEST(FillReducingOrdering, MetisOrdersAlikeOnSeveralThreadsAtOnce) {
+  const std::pair<std::string, ColMajorMatrix> matrices[] = {
+      {"grid", GridMatrix(60)}, {"random", RandomSpdMatrix(4000, 3, 17)}};
+  for (const auto& [name, a] : matrices) {
+    const auto alone = FillReducingOrdering(a, Ordering::kMetis);
+    ASSERT_TRUE(alone.ok());
+    constexpr int kThreads = 4;
+    constexpr int kRounds = 6;
+    std::vector<int> differing(kThreads, 0);
+    std::vector<std::thread> threads;
+    for (int t = 0; t < kThreads; ++t) {
+      threads.emplace_back([&, t] {
+        for (int round = 0; round < kRounds; ++round) {
+          const auto ordering = FillReducingOrdering(a, Ordering::kMetis);
+          if (!ordering.ok() || *ordering != *alone) ++differing[t];
+        }
+      });
+    }
+    for (std::thread& thread : threads) thread.join();
+    for (int t = 0; t < kThreads; ++t) {
+      EXPECT_EQ(differing[t], 0) << name << ": thread " << t
+                                 << "'s orderings differ from one alone";
+    }
+  }
+}
+
 TEST(SparseCholesky, MetisOrderingFillsLessThanNatural) {
   // A 2D grid Laplacian: nested dissection beats the natural (banded) order.
   const ColMajorMatrix a = GridMatrix(40);
