@@ -1,12 +1,46 @@
 #include "core/solver/ordering.h"
 
 #include <metis.h>
+#include <stdlib.h>  // random_r
 
 #include <Eigen/OrderingMethods>
+#include <cstdint>
 #include <mutex>
 #include <numeric>
 #include <string>
 #include <utility>
+
+// METIS (Debian's build) draws its random matchings from the C library's rand(), seeded by
+// srand() at each call from its seed option. That generator is one per process, and other
+// libraries of a server draw from it too (gRPC, c-ares and OpenMesh import rand), so a draw on
+// another thread during an ordering changed the ordering: the same mesh loaded twice could get
+// two factors of different sizes (a 3k phantom's factor, 2,120 bytes apart, in a test run under
+// load). These two definitions take the place of the C library's for the whole program (the
+// dynamic linker binds libmetis's and the others' calls to the executable's definitions first)
+// and give each thread its own generator: the C library's own algorithm (random_r with its
+// default 128-byte state), so that one thread's sequence from a seed, and with it every
+// ordering, is what the C library's rand() gives a program that has only that thread.
+namespace {
+// One thread's generator: zeroed as initstate_r requires, with glibc's default state size (its
+// TYPE_3 generator) and, until srand(), the seed rand() has unseeded (1).
+struct ThreadRandom {
+  random_data data{};
+  char state[128] = {};
+  ThreadRandom() { initstate_r(1, state, sizeof state, &data); }
+};
+random_data* ThisThreadsRandom() {
+  thread_local ThreadRandom random;
+  return &random.data;
+}
+}  // namespace
+
+extern "C" void srand(unsigned int seed) noexcept { srandom_r(seed, ThisThreadsRandom()); }
+
+extern "C" int rand() noexcept {
+  std::int32_t value = 0;
+  random_r(ThisThreadsRandom(), &value);
+  return value;
+}
 
 namespace deform {
 namespace {
@@ -44,11 +78,9 @@ StatusOr<std::vector<int>> MetisOrdering(const ColMajorMatrix& a, std::vector<in
   METIS_SetDefaultOptions(options);
   options[METIS_OPTION_SEED] = 1;  // deterministic ordering from run to run
   std::vector<idx_t> perm(nvtxs), iperm(nvtxs);
-  // METIS keeps its random generator's state (GKlib's Mersenne twister) in globals that every
-  // thread shares: two calls at once race on it, which is undefined behaviour, and each may get an
-  // ordering other than its own from the seed. Two threads building the 3k phantom's model at once
-  // got nine different factor sizes in twenty builds, one thread always the same. So one call at a
-  // time: an ordering takes milliseconds to a few seconds, once per mesh loaded.
+  // One METIS call at a time all the same (its random generator is the thread's own, above, but
+  // METIS is not documented as safe to call from several threads): an ordering takes
+  // milliseconds to a few seconds, once per mesh loaded.
   static std::mutex metis_calls;
   int rc;
   {

@@ -24,8 +24,8 @@ const char* OrderingName(Ordering ordering);
 StatusOr<Ordering> OrderingFromName(std::string_view name);
 
 // The permutation `ordering` chooses for the pattern of `a` (square, both triangles stored,
-// column-major), as permutation[new] = old. Deterministic from run to run and from thread to
-// thread: calls may come from several threads at once (METIS's own calls take turns).
+// column-major), as permutation[new] = old. Deterministic from run to run, whatever other threads
+// do meanwhile (METIS's calls take turns, and its rand() is each thread's own: ordering.cc).
 // INVALID_ARGUMENT for kAuto (which compares whole analyses, see above); INTERNAL if METIS fails.
 StatusOr<std::vector<int>> FillReducingOrdering(
     const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& a, Ordering ordering);

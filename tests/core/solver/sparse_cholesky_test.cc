@@ -5,7 +5,9 @@
 #include <Eigen/Dense>
 #include <Eigen/SparseCholesky>
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <cstdlib>
 #include <random>
 #include <string>
 #include <thread>
@@ -679,6 +681,32 @@ TEST(FillReducingOrdering, MetisOrdersAlikeOnSeveralThreadsAtOnce) {
                                  << "'s orderings differ from one alone";
     }
   }
+}
+
+// METIS draws from rand(), which other libraries in a server call too (gRPC among them): another
+// thread's draws must not change an ordering (each thread has its own generator, ordering.cc).
+TEST(FillReducingOrdering, MetisOrdersAlikeWhileAnotherThreadDrawsFromRand) {
+  const ColMajorMatrix a = GridMatrix(60);
+  const auto alone = FillReducingOrdering(a, Ordering::kMetis);
+  ASSERT_TRUE(alone.ok());
+  std::atomic<bool> stop{false};
+  std::atomic<unsigned> draws{0};
+  std::thread drawer([&] {
+    std::srand(12345);
+    while (!stop.load(std::memory_order_relaxed)) {
+      static_cast<void>(std::rand());
+      draws.fetch_add(1, std::memory_order_relaxed);
+    }
+  });
+  while (draws.load() == 0) std::this_thread::yield();
+  int differing = 0;
+  for (int round = 0; round < 8; ++round) {
+    const auto ordering = FillReducingOrdering(a, Ordering::kMetis);
+    if (!ordering.ok() || *ordering != *alone) ++differing;
+  }
+  stop = true;
+  drawer.join();
+  EXPECT_EQ(differing, 0) << "orderings changed by another thread's rand()";
 }
 
 TEST(SparseCholesky, MetisOrderingFillsLessThanNatural) {
