@@ -660,7 +660,8 @@ TEST(SymbolicCholesky, TheEliminationTreeIsPostorderedWithTheOrderingsFill) {
 TEST(FillReducingOrdering, MetisOrdersAlikeOnSeveralThreadsAtOnce) {
   const std::pair<std::string, ColMajorMatrix> matrices[] = {
       {"grid", GridMatrix(60)}, {"random", RandomSpdMatrix(4000, 3, 17)}};
-  for (const auto& [name, a] : matrices) {
+  for (const auto& [name, matrix] : matrices) {
+    const ColMajorMatrix& a = matrix;  // a structured binding cannot be captured in C++17
     const auto alone = FillReducingOrdering(a, Ordering::kMetis);
     ASSERT_TRUE(alone.ok());
     constexpr int kThreads = 4;
