@@ -611,10 +611,6 @@ struct EigenAnalysis
   }
 };
 
-std::int64_t EigenFactorNonzeros(const ColMajorMatrix& a, const std::vector<int>& permutation) {
-  return EigenAnalysis(a, permutation).factor_nonzeros();
-}
-
 // The analysis renumbers the fill-reducing ordering's columns in a postorder of its elimination
 // tree: every subtree's columns are consecutive and end at its root, the fill is the ordering's
 // own, and the tree it keeps (relabelled from the ordering's, not recomputed) is the renumbered
@@ -643,7 +639,7 @@ TEST(SymbolicCholesky, TheEliminationTreeIsPostorderedWithTheOrderingsFill) {
       }
       auto fill_reducing = FillReducingOrdering(a, ordering);
       ASSERT_TRUE(fill_reducing.ok());
-      EXPECT_EQ((*symbolic)->factor_nonzeros(), EigenFactorNonzeros(a, *fill_reducing))
+      EXPECT_EQ((*symbolic)->factor_nonzeros(), EigenAnalysis(a, *fill_reducing).factor_nonzeros())
           << name << ", " << OrderingName(ordering);
       const EigenAnalysis renumbered(a, (*symbolic)->permutation());
       EXPECT_EQ(parent, renumbered.elimination_tree()) << name << ", " << OrderingName(ordering);
@@ -655,8 +651,9 @@ TEST(SymbolicCholesky, TheEliminationTreeIsPostorderedWithTheOrderingsFill) {
   }
 }
 
-// METIS keeps its random generator in globals: orderings computed on several threads at once
-// must each be the one computed alone (FillReducingOrdering lets one METIS call run at a time).
+// METIS draws its random matchings from rand(): orderings computed on several threads at once must
+// each be the one computed alone (ordering.cc gives each thread its own rand() generator, and
+// FillReducingOrdering lets one METIS call run at a time).
 TEST(FillReducingOrdering, MetisOrdersAlikeOnSeveralThreadsAtOnce) {
   const std::pair<std::string, ColMajorMatrix> matrices[] = {
       {"grid", GridMatrix(60)}, {"random", RandomSpdMatrix(4000, 3, 17)}};
