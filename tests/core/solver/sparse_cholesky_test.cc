@@ -594,8 +594,8 @@ ColMajorMatrix Permuted(const ColMajorMatrix& a, const std::vector<int>& permuta
   return c;
 }
 
-// Eigen's own analysis of P A P^T in the given order: its factor's non-zeros (diagonal included)
-// and its elimination tree.
+// Eigen's own analysis of P A P^T in the given order: its factor's non-zeros, its elimination
+// tree and its columns' non-zeros (diagonals included).
 struct EigenAnalysis
     : Eigen::SimplicialLLT<ColMajorMatrix, Eigen::Lower, Eigen::NaturalOrdering<int>> {
   EigenAnalysis(const ColMajorMatrix& a, const std::vector<int>& permutation) {
