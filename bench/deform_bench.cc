@@ -25,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/arithmetic_peak.h"
 #include "bench/bench_meshes.h"
 #include "bench/memory_bandwidth.h"
 #include "core/io/model_input.h"
@@ -244,7 +245,13 @@ void BM_ColdSolve(benchmark::State& state, BenchMesh mesh, int frames_per_batch,
 // right-hand sides those of the benchmark pose. Besides the counters of the other solves
 // (median_ms and the bounds are per batch): frame_ms, the median per frame; unbatched_frame_ms,
 // Solve3's median (the best kernel) on the same right-hand side timed in the same benchmark;
-// x_unbatched, their ratio; frame_bound_ms and frame_cache_bound_ms, the bounds per frame.
+// x_unbatched, their ratio; frame_bound_ms and frame_cache_bound_ms, the bounds per frame; and
+// the arithmetic bound, which a batch of several frames meets before the bytes' (each value read
+// serves every column): arith_bound_ms, both passes' multiply-adds of L's non-zeros (the
+// kernel's explicit zeros not counted) into the batch's columns padded to the kernel's vectors
+// (three frames' nine columns are twelve with four-double vectors) at this core's rate in the
+// kernel's instructions, measured right after (madd_G_per_s: MeasureMultiplyAddRate), and
+// x_arith_bound = median_ms / arith_bound_ms.
 void BM_BatchedSolve(benchmark::State& state, BenchMesh mesh, int frames_per_batch,
                      SolveKernel kernel) {
   if (!SolveKernelAvailable(kernel)) return state.SkipWithError("kernel not available here");
@@ -268,6 +275,14 @@ void BM_BatchedSolve(benchmark::State& state, BenchMesh mesh, int frames_per_bat
   state.counters["x_unbatched"] = frame_ms / (Median(unbatched) * 1e3);
   state.counters["frame_bound_ms"] = state.counters["bound_ms"] / frames_per_batch;
   state.counters["frame_cache_bound_ms"] = state.counters["cache_bound_ms"] / frames_per_batch;
+  const int lanes = SolveKernelFunctionsFor(kernel).batch_lanes;
+  const int padded_columns = BatchRowStride(lanes, 3 * frames_per_batch);
+  const double multiply_add_rate = MeasureMultiplyAddRate(kernel);
+  const double arith_bound_ms =
+      2.0 * static_cast<double>(factor.nonzeros()) * padded_columns / multiply_add_rate * 1e3;
+  state.counters["madd_G_per_s"] = multiply_add_rate / 1e9;
+  state.counters["arith_bound_ms"] = arith_bound_ms;
+  state.counters["x_arith_bound"] = Median(seconds) * 1e3 / arith_bound_ms;
 }
 
 // One frame's two triangular passes split over `parts` threads (CholeskyFactor::Solve3Parallel on a
