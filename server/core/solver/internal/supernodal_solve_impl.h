@@ -9,8 +9,9 @@
 //
 // A supernode's own unknowns are kept planar (all x, then y, then z) in a small buffer while its
 // block is applied, so every inner loop is a dot product or an axpy along a contiguous row of the
-// block. Rows go four at a time, so each load of the unknowns serves four rows and the sums run as
-// twelve independent chains; the loops over a row are written with four-wide vectors (one AVX
+// block. In the forward pass rows go four at a time, so each load of the unknowns serves four rows
+// and the sums run as twelve independent chains (the backward pass: strips of columns, see
+// BackwardUpdate); the loops over a row are written with four-wide vectors (one AVX
 // register, or two SSE2 registers on the baseline).
 #include <algorithm>
 #include <cstddef>
@@ -252,12 +253,13 @@ inline void SubtractRow1x3(const Value* __restrict row, const double* __restrict
 // The factor's values are read as one stream: ascending in the forward pass, supernode after
 // supernode, and descending supernode by supernode in the backward pass. Each pass asks for the
 // bytes it will read kPrefetchBytes later (ahead in the forward pass, below in the backward pass)
-// as it reads the ones in hand, so that a factor larger than the cache arrives while the kernel
-// computes instead of after it: without it the 133k arm's solve took about the sum of its
-// arithmetic (factor made cache-resident) and of reading its factor from memory, not the larger
-// of the two. Into the outer caches (prefetcht2): a non-temporal hint was twice as slow. The
-// distance and the hint were chosen by measurement (deform_bench's TriangularSolve and
-// BatchedSolve on the arm; 8 to 64 KB measured alike).
+// as it reads the ones in hand (all but the three-column backward pass: see BackwardUpdate), so
+// that a factor larger than the cache arrives while the kernel computes instead of after it:
+// without it the 133k arm's solve took about the sum of its arithmetic (factor made cache-resident)
+// and of reading its factor from memory, not the larger of the two. Into the outer caches
+// (prefetcht2): a non-temporal hint was twice as slow. The distance and the hint were chosen by
+// measurement (deform_bench's TriangularSolve and BatchedSolve on the arm; 8 to 64 KB measured
+// alike).
 constexpr std::ptrdiff_t kPrefetchBytes = 16384;
 // A factor that fits a core's own cache (2 MiB of L2 on the machines measured) is not
 // prefetched: it stays there between solves, and the prefetches only cost issue slots (the 1.6k
@@ -448,7 +450,6 @@ inline void BackwardDiagonal(const SupernodeBlock<Value>& supernode, double* __r
     const Value* r1 = r0 + width;
     const Value* r2 = r1 + width;
     const Value* r3 = r2 + width;
-    PrefetchFactor<Pass::kBackward>(supernode, r0, 4 * width);
     double* in[3] = {p.x + f, p.y + f, p.z + f};
     double solved[12];  // solved[3 j + d]: unknown f + j, column d
     const double i0 = 1.0 / r0[f], i1 = 1.0 / r1[f + 1], i2 = 1.0 / r2[f + 2], i3 = 1.0 / r3[f + 3];
@@ -474,7 +475,6 @@ inline void BackwardDiagonal(const SupernodeBlock<Value>& supernode, double* __r
   for (; c > 0; --c) {
     const int f = c - 1;
     const Value* row = block + static_cast<std::ptrdiff_t>(f) * width;
-    PrefetchFactor<Pass::kBackward>(supernode, row, width);
     const double inverse = 1.0 / row[f];
     const double solved[3] = {p.x[f] * inverse, p.y[f] * inverse, p.z[f] * inverse};
     double* t = Row(ys, f);
@@ -517,33 +517,91 @@ inline void ForwardUpdate(const SupernodeBlock<Value>& supernode, const Planar& 
   }
 }
 
-// p -= sum over `supernode`'s rows below its diagonal block of (block row r) * y[rows[r]].
-template <typename Value>
-inline void BackwardUpdate(const SupernodeBlock<Value>& supernode, const Planar& p,
-                           double* __restrict y) {
-  const Value* __restrict block = supernode.values;
+// The batched backward pass takes a supernode's rows below its diagonal block in chunks, the last
+// first, of about kBackwardChunkBytes of solution rows and factor rows each (at least
+// kBackwardChunkMinRows rows): every block of columns and every strip of a row reads the chunk's
+// rows again, and a chunk stays in the core's nearest cache (32 KiB or more) between them. Taken
+// whole, a supernode's rows below were read from the outer caches by each of its width / 4 blocks
+// of columns and each strip (eight times for a 16-wide supernode in a batch of eight frames).
+// Measured alternately in one process (AVX2, Zen 3), chunks against whole, medians of 40-60 rounds
+// (the arm's 12-16): the 26k leg's batch of two frames 6.13 against 7.07 ms, four 5.01 against
+// 5.61, eight 10.7 against 11.7, sixteen 20.8 against 21.4; the arm's eight 68-69 against 75-80;
+// the 1.6k leg's eight alike (0.366 / 0.365). Chunks of 6, 12, 24 and 48 KiB measured alike.
+constexpr std::int64_t kBackwardChunkBytes = 12 * 1024;
+constexpr std::int64_t kBackwardChunkMinRows = 8;
+
+// The three-column backward pass takes a supernode's rows below its diagonal block a strip of
+// at most kStripVecs four-wide vectors of columns at a time, its sums in registers, and a block
+// wider than one strip in chunks of rows (kBackwardChunkBytes, above), so that every strip
+// reads a chunk from the nearest cache. Each row is read once by a strip, front to back, and
+// the rows go last first: the factor is read as one descending stream, as the forward pass reads
+// it ascending. Until then each four rows updated the supernode's planar unknowns in memory
+// across the whole width (SubtractRows4x3: three loads and three stores for every four of the
+// factor's values), and perf of the 133k arm's TriangularSolve had the backward pass at 1.57
+// times the forward pass's samples over the same bytes; with strips 1.24.
+//
+// The three-column backward pass does not prefetch the factor: read as this descending stream,
+// the core's own prefetchers keep up, and software prefetches got in their way. Alternately in one
+// process (AVX2, Zen 3, DRAM 16.6 GB/s on one core), medians of 40 solves: the arm's Solve3 26.7
+// ms with strips and no prefetch, 27.6 with the diagonal blocks' prefetches only, 30.3 with all,
+// 29.7 for the rows four at a time as before (with all); the 26k leg's (100 solves) 2.81, 2.92,
+// 2.90 and 2.87 ms. In an earlier round the rows four at a time took 37.2 without prefetches
+// against 36.0 with them: they needed them. The batched backward pass keeps its prefetches:
+// without them the 26k leg's batch of eight took 10.0 against 9.2 ms, the arm's 64.2 against
+// 60.3.
+constexpr int kStripVecs = 4;
+
+// p's columns [first, first + 4 kVecs) -= sum over rows [begin, end) below `supernode`'s
+// diagonal block (block row r there) * y[rows[r]], the rows taken last first.
+template <typename Value, int kVecs>
+inline void BackwardStrip(const SupernodeBlock<Value>& supernode, const Planar& p, int first,
+                          const double* __restrict y, std::int64_t begin, std::int64_t end) {
+  const Value* __restrict block = supernode.values + first;
   const int* __restrict rows = supernode.rows;
   const int width = supernode.width;
-  const std::int64_t num_rows = supernode.num_rows;
-  ZeroPadding(p, width);  // not read back, but kept finite
-  const int padded = RoundUp4(width);
-  // The last rows first: the backward pass reads the factor descending (PrefetchFactor).
-  std::int64_t r = num_rows;
-  for (; r - 4 >= width; r -= 4) {
-    const Value* r0 = block + (r - 4) * width;
-    PrefetchFactor<Pass::kBackward>(supernode, r0, 4 * width);
-    double q[12];
-    for (int j = 0; j < 4; ++j) {
-      const double* source = Row(y, rows[r - 4 + j]);
-      q[3 * j] = source[0];
-      q[3 * j + 1] = source[1];
-      q[3 * j + 2] = source[2];
+  Vec4 sx[kVecs], sy[kVecs], sz[kVecs];
+  for (int v = 0; v < kVecs; ++v) sx[v] = sy[v] = sz[v] = Splat4(0);
+  for (std::int64_t r = end - 1; r >= begin; --r) {
+    const Value* row = block + r * width;
+    const double* solved = Row(y, rows[r]);
+    const Vec4 bx = Splat4(solved[0]), by = Splat4(solved[1]), bz = Splat4(solved[2]);
+    for (int v = 0; v < kVecs; ++v) {
+      const Vec4 w = Load4(row + 4 * v);
+      sx[v] += w * bx;
+      sy[v] += w * by;
+      sz[v] += w * bz;
     }
-    SubtractRows4x3(r0, r0 + width, r0 + 2 * width, r0 + 3 * width, q, p, padded);
   }
-  for (; r > width; --r) {
-    PrefetchFactor<Pass::kBackward>(supernode, block + (r - 1) * width, width);
-    SubtractRow1x3(block + (r - 1) * width, Row(y, rows[r - 1]), p, padded);
+  for (int v = 0; v < kVecs; ++v) {
+    const int k = first + 4 * v;
+    Store4(p.x + k, Load4(p.x + k) - sx[v]);
+    Store4(p.y + k, Load4(p.y + k) - sy[v]);
+    Store4(p.z + k, Load4(p.z + k) - sz[v]);
+  }
+}
+
+// p -= sum over `supernode`'s rows below its diagonal block of (block row r) * y[rows[r]]. A
+// strip's last vector runs into the padding of p, reading the next row's values or the zeros
+// that follow the factor's (see PlanarOf).
+template <typename Value>
+inline void BackwardUpdate(const SupernodeBlock<Value>& supernode, const Planar& p,
+                           const double* __restrict y) {
+  ZeroPadding(p, supernode.width);  // not read back, but kept finite
+  const int padded = RoundUp4(supernode.width);
+  const std::int64_t row_bytes = kRowStride * sizeof(double) + supernode.width * sizeof(Value);
+  const std::int64_t chunk =
+      padded <= 4 * kStripVecs
+          ? supernode.num_rows
+          : std::max<std::int64_t>(kBackwardChunkMinRows, kBackwardChunkBytes / row_bytes);
+  for (std::int64_t end = supernode.num_rows; end > supernode.width; end -= chunk) {
+    const std::int64_t begin = std::max<std::int64_t>(supernode.width, end - chunk);
+    int first = 0;
+    for (; first + 4 * kStripVecs <= padded; first += 4 * kStripVecs) {
+      BackwardStrip<Value, kStripVecs>(supernode, p, first, y, begin, end);
+    }
+    WithCount<kStripVecs - 1>((padded - first) / 4, [&](auto vecs) {
+      BackwardStrip<Value, decltype(vecs)::value>(supernode, p, first, y, begin, end);
+    });
   }
 }
 
@@ -640,8 +698,6 @@ inline void BackwardSupernode(const SupernodalFactorView& f, int sn, double* __r
   if (s.width > 4) {
     BackwardUpdate(s, p, y);
   } else {
-    PrefetchFactor<Pass::kBackward>(s, s.values + s.width * s.width,
-                                    (s.num_rows - s.width) * s.width);
     WithCount<4>(s.width, [&](auto w) {
       BackwardUpdateNarrow<Value, decltype(w)::value>(s.values, s.rows, s.num_rows, p, y);
     });
@@ -1014,19 +1070,6 @@ inline void BackwardDiagonalMany(const SupernodeBlock<Value>& s, double* __restr
   }
   if constexpr (kTile > 1) BackwardDiagonalMany<Value, kVecs, kTile / 2>(s, own, c);
 }
-
-// The backward pass takes a supernode's rows below its diagonal block in chunks, the last first,
-// of about kBackwardChunkBytes of solution rows and factor rows each (at least
-// kBackwardChunkMinRows rows): every block of columns and every strip of a row reads the chunk's
-// rows again, and a chunk stays in the core's nearest cache (32 KiB or more) between them. Taken
-// whole, a supernode's rows below were read from the outer caches by each of its width / 4 blocks
-// of columns and each strip (eight times for a 16-wide supernode in a batch of eight frames).
-// Measured alternately in one process (AVX2, Zen 3), chunks against whole, medians of 40-60 rounds
-// (the arm's 12-16): the 26k leg's batch of two frames 6.13 against 7.07 ms, four 5.01 against
-// 5.61, eight 10.7 against 11.7, sixteen 20.8 against 21.4; the arm's eight 68-69 against 75-80;
-// the 1.6k leg's eight alike (0.366 / 0.365). Chunks of 6, 12, 24 and 48 KiB measured alike.
-constexpr std::int64_t kBackwardChunkBytes = 12 * 1024;
-constexpr std::int64_t kBackwardChunkMinRows = 8;
 
 // Backward pass of one supernode: its own rows subtract the block's rows below times the solved
 // rows there (a chunk of rows at a time, columns of the block taken together, the sums kept in
