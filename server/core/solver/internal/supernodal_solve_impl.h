@@ -530,6 +530,21 @@ inline void ForwardUpdate(const SupernodeBlock<Value>& supernode, const Planar& 
 constexpr std::int64_t kBackwardChunkBytes = 12 * 1024;
 constexpr std::int64_t kBackwardChunkMinRows = 8;
 
+// Calls chunk(begin, end) for the rows [begin, end) below `s`'s diagonal block, the last chunk
+// first: chunks of about kBackwardChunkBytes of solution rows (`row_stride` doubles each) and
+// factor rows, or all the rows in one when `whole`.
+template <typename Value, typename Chunk>
+inline void ForEachBackwardChunk(const SupernodeBlock<Value>& s, int row_stride, bool whole,
+                                 Chunk&& chunk) {
+  const std::int64_t row_bytes = row_stride * sizeof(double) + s.width * sizeof(Value);
+  const std::int64_t rows =
+      whole ? s.num_rows
+            : std::max<std::int64_t>(kBackwardChunkMinRows, kBackwardChunkBytes / row_bytes);
+  for (std::int64_t end = s.num_rows; end > s.width; end -= rows) {
+    chunk(std::max<std::int64_t>(s.width, end - rows), end);
+  }
+}
+
 // The three-column backward pass takes a supernode's rows below its diagonal block a strip of
 // at most kStripVecs four-wide vectors of columns at a time, its sums in registers, and a block
 // wider than one strip in chunks of rows (kBackwardChunkBytes, above), so that every strip
@@ -588,13 +603,8 @@ inline void BackwardUpdate(const SupernodeBlock<Value>& supernode, const Planar&
                            const double* __restrict y) {
   ZeroPadding(p, supernode.width);  // not read back, but kept finite
   const int padded = RoundUp4(supernode.width);
-  const std::int64_t row_bytes = kRowStride * sizeof(double) + supernode.width * sizeof(Value);
-  const std::int64_t chunk =
-      padded <= 4 * kStripVecs
-          ? supernode.num_rows
-          : std::max<std::int64_t>(kBackwardChunkMinRows, kBackwardChunkBytes / row_bytes);
-  for (std::int64_t end = supernode.num_rows; end > supernode.width; end -= chunk) {
-    const std::int64_t begin = std::max<std::int64_t>(supernode.width, end - chunk);
+  const bool one_strip = padded <= 4 * kStripVecs;
+  ForEachBackwardChunk(supernode, kRowStride, one_strip, [&](std::int64_t begin, std::int64_t end) {
     int first = 0;
     for (; first + 4 * kStripVecs <= padded; first += 4 * kStripVecs) {
       BackwardStrip<Value, kStripVecs>(supernode, p, first, y, begin, end);
@@ -602,7 +612,7 @@ inline void BackwardUpdate(const SupernodeBlock<Value>& supernode, const Planar&
     WithCount<kStripVecs - 1>((padded - first) / 4, [&](auto vecs) {
       BackwardStrip<Value, decltype(vecs)::value>(supernode, p, first, y, begin, end);
     });
-  }
+  });
 }
 
 // The narrow supernodes (most of them, holding few of the values) with the width fixed at
@@ -1078,13 +1088,9 @@ template <typename Value, int kVecs>
 inline void BackwardSupernodeMany(const SupernodeBlock<Value>& s, double* __restrict y) {
   constexpr int kStride = kBatchLanes * kVecs;
   double* __restrict own = y + kStride * static_cast<std::ptrdiff_t>(s.first);
-  const std::int64_t row_bytes = kStride * sizeof(double) + s.width * sizeof(Value);
-  const std::int64_t chunk =
-      std::max<std::int64_t>(kBackwardChunkMinRows, kBackwardChunkBytes / row_bytes);
-  for (std::int64_t end = s.num_rows; end > s.width; end -= chunk) {
-    const std::int64_t begin = std::max<std::int64_t>(s.width, end - chunk);
+  ForEachBackwardChunk(s, kStride, false, [&](std::int64_t begin, std::int64_t end) {
     BackwardColumnsMany<Value, kVecs, RowBlockFor(kVecs)>(s, own, y, 0, begin, end);
-  }
+  });
   BackwardDiagonalMany<Value, kVecs, RowBlockFor(kVecs)>(s, own, s.width);
 }
 
