@@ -553,7 +553,8 @@ inline void ForEachBackwardChunk(const SupernodeBlock<Value>& s, int row_stride,
 // it ascending. Until then each four rows updated the supernode's planar unknowns in memory
 // across the whole width (SubtractRows4x3: three loads and three stores for every four of the
 // factor's values), and perf of the 133k arm's TriangularSolve had the backward pass at 1.57
-// times the forward pass's samples over the same bytes; with strips 1.24.
+// times the forward pass's samples over the same bytes; with strips 1.24 (perf of the harness
+// below) and 1.34 (of deform_bench).
 //
 // The three-column backward pass does not prefetch the factor: read as this descending stream,
 // the core's own prefetchers keep up, and software prefetches got in their way. Alternately in one
