@@ -4,6 +4,8 @@
 #include <cstddef>
 #include <cstdint>
 #include <numeric>
+#include <type_traits>
+#include <utility>
 
 namespace deform {
 namespace {
@@ -123,33 +125,79 @@ struct FramesContext {
   Value* Row(Value* rows, int row) const {
     return rows + static_cast<std::ptrdiff_t>(stride) * row;
   }
-  // The frames' right-hand sides of unknown permutation[row] into `rows`' row, its padding zeroed.
-  void Gather(int row, double* rows) const {
-    const std::ptrdiff_t from = 3 * static_cast<std::ptrdiff_t>(factor->permutation[row]);
-    double* t = Row(rows, row);
-    for (int f = 0; f < frames; ++f) {
-      t[3 * f] = b[f][from];
-      t[3 * f + 1] = b[f][from + 1];
-      t[3 * f + 2] = b[f][from + 2];
-    }
-    std::fill(t + 3 * frames, t + stride, 0.0);
-  }
-  void Scatter(int row, const double* rows) const {
-    const std::ptrdiff_t to = 3 * static_cast<std::ptrdiff_t>(factor->permutation[row]);
-    const double* t = Row(rows, row);
-    for (int f = 0; f < frames; ++f) {
-      x[f][to] = t[3 * f];
-      x[f][to + 1] = t[3 * f + 1];
-      x[f][to + 2] = t[3 * f + 2];
-    }
-  }
 };
+
+// The frames' right-hand sides of unknown permutation[row] into `rows`' row, its padding zeroed;
+// kFrames = c.frames, fixed at compile time so the row's copy unrolls.
+template <int kFrames>
+void GatherRow(const FramesContext& c, int row, double* rows) {
+  const std::ptrdiff_t from = 3 * static_cast<std::ptrdiff_t>(c.factor->permutation[row]);
+  double* t = c.Row(rows, row);
+  for (int f = 0; f < kFrames; ++f) {
+    const double* source = c.b[f] + from;
+    t[3 * f] = source[0];
+    t[3 * f + 1] = source[1];
+    t[3 * f + 2] = source[2];
+  }
+  std::fill(t + 3 * kFrames, t + c.stride, 0.0);
+}
+
+// `rows`' row into the frames' solutions of unknown permutation[row].
+template <int kFrames>
+void ScatterRow(const FramesContext& c, int row, const double* rows) {
+  const std::ptrdiff_t to = 3 * static_cast<std::ptrdiff_t>(c.factor->permutation[row]);
+  const double* t = c.Row(rows, row);
+  for (int f = 0; f < kFrames; ++f) {
+    double* target = c.x[f] + to;
+    target[0] = t[3 * f];
+    target[1] = t[3 * f + 1];
+    target[2] = t[3 * f + 2];
+  }
+}
+
+template <typename Body, int... kCounts>
+void WithFrameCountOf(int frames, Body&& body, std::integer_sequence<int, kCounts...>) {
+  ((frames == kCounts + 1 ? body(std::integral_constant<int, kCounts + 1>()) : void()), ...);
+}
+
+// body(std::integral_constant<int, frames>()), for 1 <= frames <= kMaxSolveColumns / 3.
+template <typename Body>
+void WithFrameCount(int frames, Body&& body) {
+  WithFrameCountOf(frames, body, std::make_integer_sequence<int, kMaxSolveColumns / 3>());
+}
+
+// Gathers (kGather) or scatters `count` rows `listed` (in the order of their unknowns) of `rows`,
+// each asking for the row kBatchRowsAhead on (PrefetchBatchRow).
+template <bool kGather>
+void CopyRows(const FramesContext& c, const int* listed, int count, double* rows) {
+  WithFrameCount(c.frames, [&](auto frames) {
+    constexpr int kFrames = decltype(frames)::value;
+    for (int i = 0; i < count; ++i) {
+      if (i + kBatchRowsAhead < count) {
+        PrefetchBatchRow(c.Row(rows, listed[i + kBatchRowsAhead]), c.stride);
+      }
+      if constexpr (kGather) {
+        GatherRow<kFrames>(c, listed[i], rows);
+      } else {
+        ScatterRow<kFrames>(c, listed[i], rows);
+      }
+    }
+  });
+}
+
+// Part `part`'s rows (part_rows) gathered into or scattered from `rows`.
+template <bool kGather>
+void CopyPartRows(const FramesContext& c, int part, double* rows) {
+  const int first = c.plan->part_row_offsets[part];
+  CopyRows<kGather>(c, c.plan->part_rows.data() + first, c.plan->part_row_offsets[part + 1] - first,
+                    rows);
+}
 
 // ForwardPart's batched counterpart.
 void ForwardFramesPart(void* context, int part) {
   const FramesContext& c = *static_cast<const FramesContext*>(context);
   double* own = c.Rows(part);
-  ForEachRowOf(*c.plan, part, [&](int row) { c.Gather(row, own); });
+  CopyPartRows<true>(c, part, own);
   if (part > 0) {
     for (const int col : c.plan->top_columns) std::fill_n(c.Row(own, col), c.stride, 0.0);
   }
@@ -169,7 +217,7 @@ void BackwardFramesPart(void* context, int part) {
   }
   c.passes->backward_list_many(*c.factor, PartSupernodes(*c.plan, part), PartCount(*c.plan, part),
                                own, 3 * c.frames);
-  ForEachRowOf(*c.plan, part, [&](int row) { c.Scatter(row, own); });
+  CopyPartRows<false>(c, part, own);
 }
 
 }  // namespace
@@ -398,7 +446,8 @@ void ParallelSolveFrames(const SupernodalFactorView& f, const ParallelSolvePlan&
                   BatchRowStride(passes.batch_lanes, 3 * frames),
                   work + (misalignment ? (kAlignment - misalignment) / sizeof(double) : 0)};
   double* solution = c.Rows(0);
-  for (const int col : plan.top_columns) c.Gather(col, solution);
+  const int top_rows = static_cast<int>(plan.top_columns.size());
+  CopyRows<true>(c, plan.top_columns.data(), top_rows, solution);
   runner->Run(plan.parts, &ForwardFramesPart, &c);
   for (int part = 1; part < plan.parts; ++part) {
     const double* other = c.Rows(part);
@@ -411,7 +460,7 @@ void ParallelSolveFrames(const SupernodalFactorView& f, const ParallelSolvePlan&
   const int top = static_cast<int>(plan.top.size());
   passes.forward_list_many(f, plan.top.data(), top, solution, 3 * frames);
   passes.backward_list_many(f, plan.top.data(), top, solution, 3 * frames);
-  for (const int col : plan.top_columns) c.Scatter(col, solution);
+  CopyRows<false>(c, plan.top_columns.data(), top_rows, solution);
   runner->Run(plan.parts, &BackwardFramesPart, &c);
 }
 

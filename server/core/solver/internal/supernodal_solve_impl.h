@@ -1104,8 +1104,12 @@ void SolveRowsWithWidth(const SupernodalFactorView& f, int columns, double* work
   constexpr int kStride = kBatchLanes * kVecs;
   const int n = f.size;
   double* __restrict y = AlignedTo(work, kBatchLanes);  // at a whole batch vector's boundary
+  const auto row_of = [&](int unknown) {
+    return y + kStride * static_cast<std::ptrdiff_t>(f.inverse_permutation[unknown]);
+  };
   for (int unknown = 0; unknown < n; ++unknown) {
-    double* t = y + kStride * static_cast<std::ptrdiff_t>(f.inverse_permutation[unknown]);
+    if (unknown + kBatchRowsAhead < n) PrefetchBatchRow(row_of(unknown + kBatchRowsAhead), kStride);
+    double* t = row_of(unknown);
     gather(t, unknown);
     for (int c = columns; c < kStride; ++c) t[c] = 0;
   }
@@ -1119,7 +1123,8 @@ void SolveRowsWithWidth(const SupernodalFactorView& f, int columns, double* work
     }
   });
   for (int unknown = 0; unknown < n; ++unknown) {
-    scatter(y + kStride * static_cast<std::ptrdiff_t>(f.inverse_permutation[unknown]), unknown);
+    if (unknown + kBatchRowsAhead < n) PrefetchBatchRow(row_of(unknown + kBatchRowsAhead), kStride);
+    scatter(row_of(unknown), unknown);
   }
 }
 
