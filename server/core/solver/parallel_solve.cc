@@ -4,8 +4,9 @@
 #include <cstddef>
 #include <cstdint>
 #include <numeric>
-#include <type_traits>
 #include <utility>
+
+#include "internal/compile_time_count.h"
 
 namespace deform {
 namespace {
@@ -155,22 +156,11 @@ void ScatterRow(const FramesContext& c, int row, const double* rows) {
   }
 }
 
-template <typename Body, int... kCounts>
-void WithFrameCountOf(int frames, Body&& body, std::integer_sequence<int, kCounts...>) {
-  ((frames == kCounts + 1 ? body(std::integral_constant<int, kCounts + 1>()) : void()), ...);
-}
-
-// body(std::integral_constant<int, frames>()), for 1 <= frames <= kMaxSolveColumns / 3.
-template <typename Body>
-void WithFrameCount(int frames, Body&& body) {
-  WithFrameCountOf(frames, body, std::make_integer_sequence<int, kMaxSolveColumns / 3>());
-}
-
 // Gathers (kGather) or scatters `count` rows `listed` (in the order of their unknowns) of `rows`,
 // each asking for the row kBatchRowsAhead on (PrefetchBatchRow).
 template <bool kGather>
 void CopyRows(const FramesContext& c, const int* listed, int count, double* rows) {
-  WithFrameCount(c.frames, [&](auto frames) {
+  WithCount<kMaxSolveColumns / 3>(c.frames, [&](auto frames) {
     constexpr int kFrames = decltype(frames)::value;
     for (int i = 0; i < count; ++i) {
       if (i + kBatchRowsAhead < count) {

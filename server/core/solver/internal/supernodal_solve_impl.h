@@ -18,6 +18,7 @@
 #include <cstdint>
 #include <utility>
 
+#include "compile_time_count.h"
 #include "core/solver/supernodal_solve.h"
 
 #if defined(__AVX__)
@@ -29,24 +30,6 @@
 
 namespace deform {
 namespace {
-
-// A count fixed at compile time: a narrow supernode's width, a batch's vectors per row or frames.
-template <int kCount>
-struct Count {
-  static constexpr int value = kCount;
-};
-
-template <typename Run, int... kCounts>
-inline void WithCountOf(int count, Run&& run, std::integer_sequence<int, kCounts...>) {
-  ((count == kCounts + 1 ? run(Count<kCounts + 1>()) : void()), ...);
-}
-
-// Calls run(Count<count>()) for `count` in [1, kMax], so that what `run` calls is compiled for
-// every count and its loops over the count unroll; does nothing for another count.
-template <int kMax, typename Run>
-inline void WithCount(int count, Run&& run) {
-  WithCountOf(count, run, std::make_integer_sequence<int, kMax>());
-}
 
 #if defined(__AVX__)
 // Four doubles: one AVX register.
