@@ -265,7 +265,7 @@ std::size_t DeformationModel::ScratchBytes() const {
   const std::size_t rotated = linear_blend_plan_
                                   ? 3 * vertices
                                   : 4 * static_cast<std::size_t>(general_rows_.quaternion_count()) +
-                                        3 * static_cast<std::size_t>(general_rows_.slot_count());
+                                        general_rows_.rotated_size();
   return bones * sizeof(RigidTransform) + slots * sizeof(Eigen::Matrix3d) +
          (3 * unknowns + rotated) * sizeof(double) +
          default_factorization_->factor().WorkSize() * sizeof(double);
@@ -318,7 +318,7 @@ DeformScratch DeformationModel::MakeScratchWithWork(std::size_t solve_work_doubl
   } else {
     scratch.signed_quaternions.resize(4 *
                                       static_cast<std::size_t>(general_rows_.quaternion_count()));
-    scratch.rotated_slots.resize(3 * static_cast<std::size_t>(general_rows_.slot_count()));
+    scratch.rotated_slots.resize(general_rows_.rotated_size());
   }
   scratch.solve_work.resize(solve_work_doubles);
   return scratch;

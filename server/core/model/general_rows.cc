@@ -250,11 +250,11 @@ void GeneralRowsPlan::Multiply(const Eigen::Matrix3d* rotations, const double* r
                                const double* rotated, double* out, int part, int parts) const {
   const auto [first_pack, end_pack] = EqualPart(pack_count(), part, parts);
   if (first_pack < end_pack) {
-    kernel_.multiply(Packs(), rotated, slot_count_, out, first_pack, end_pack);
+    kernel_.multiply(Packs(), rotated, out, first_pack, end_pack);
   }
   const auto [first_long, end_long] = EqualPart(static_cast<int>(long_rows_.size()), part, parts);
   if (first_long < end_long) {
-    kernel_.multiply_long(LongRows(), rotated, slot_count_, out, first_long, end_long);
+    kernel_.multiply_long(LongRows(), rotated, out, first_long, end_long);
   }
   const auto [first_rigid, end_rigid] =
       EqualPart(static_cast<int>(rigid_rows_.size()) / kSlotBlock, part, parts);

@@ -3,14 +3,16 @@
 // A frame's A^T b holds L'^T r, r_j = w_j^2 T_j delta_j, T_j vertex j's quaternion blend (QLERP:
 // its bones' unit quaternions weighted, their signs aligned to its first bone's, the blend
 // normalised). The rigid rows (rigid_rows.h) are one 3x3 product each. The general rows read the
-// rotated deltas of their vertices, which this plan computes and reads kLanes at a time:
+// rotated deltas of their vertices, which this plan computes kLanes slots at a time and a row's
+// entry reads in one load:
 //
 // - Slots. Every vertex some general row reads has a slot. The slots are grouped by the vertex's
 //   ordered bone list (its bone-weight entries' bones, largest weight first), so a group's signed
 //   quaternions are the same for all its vertices and a frame blends a group with one set of
 //   them. Within a group the slots ascend by vertex. A group is padded to a multiple of
 //   kSlotBlock slots with slots of zero delta and zero w^2 that blend the group's first bone alone
-//   (their r is 0, never read). Deltas, weights and the rotated deltas are planar, in slot order.
+//   (their r is 0, never read). Deltas and weights are planar, in slot order; a slot's rotated
+//   delta is kRotatedStride doubles (x, y, z, 0), so that a row's entry reads it in one load.
 // - Packs. The general rows of at most kMaxPackedEntries entries go in packs of kPackRows rows of
 //   the same length, entry by entry (one load takes an entry of each of the pack's rows), their
 //   columns as slots. A length's last pack repeats its last row, which then writes the same
@@ -91,16 +93,16 @@ struct RowPacksView {
 
 // The kernels of one instruction set (internal/general_rows_kernel_*.cc).
 struct GeneralRowsKernel {
-  // Blocks [first_block, end_block) of kSlotBlock slots: rotated (3 planes of slot_count) =
+  // Blocks [first_block, end_block) of kSlotBlock slots: rotated (kRotatedStride doubles a slot) =
   // slot_weights * (the group's blend of `quaternions`, 4 doubles x y z w each) * deltas.
   void (*rotate)(const SlotGroupsView& groups, const double* quaternions,
                  const double* slot_weights, double* rotated, int first_block, int end_block);
   // Packs [first_pack, end_pack) of L'^T r into out ((n + m) by 3, row-major; written).
-  void (*multiply)(const RowPacksView& packs, const double* rotated, int slot_count, double* out,
-                   int first_pack, int end_pack);
+  void (*multiply)(const RowPacksView& packs, const double* rotated, double* out, int first_pack,
+                   int end_pack);
   // Long rows [first, end) the same way.
-  void (*multiply_long)(const LongRowsView& rows, const double* rotated, int slot_count,
-                        double* out, int first, int end);
+  void (*multiply_long)(const LongRowsView& rows, const double* rotated, double* out, int first,
+                        int end);
   // Blocks [first_block, end_block) of kSlotBlock rigid rows: out's row i = R_bone c_i, R_bone
   // the bone's rotation (`rotations`: 9 doubles each, column-major) and c_i the row's rigid sum
   // (`sums`, (n + m) by 3 row-major).
@@ -118,6 +120,8 @@ class GeneralRowsPlan {
   static constexpr int kSlotBlock = 8;
   static constexpr int kPackRows = 8;
   static constexpr int kMaxPackedEntries = 16;
+  // The doubles of a slot's rotated delta: x, y, z and a zero.
+  static constexpr int kRotatedStride = 4;
 
   // The plan of `system`'s L'^T with its rigid rows under the blending `weights`, its kernels
   // those of `kernel` (the baseline's where SolveKernelAvailable says this CPU lacks it).
@@ -125,6 +129,10 @@ class GeneralRowsPlan {
                                const BoneWeights& weights, SolveKernel kernel = BestSolveKernel());
 
   int slot_count() const { return slot_count_; }
+  // The doubles of a frame's rotated deltas (Rotate's output): kRotatedStride a slot.
+  std::size_t rotated_size() const {
+    return kRotatedStride * static_cast<std::size_t>(slot_count_);
+  }
   // The signed quaternions a frame needs (4 doubles each): one per bone of each group.
   int quaternion_count() const { return static_cast<int>(quaternion_bones_.size()); }
   // w_j^2 of each slot's vertex j (0 in the padding), for a factorisation's row weights (n).
@@ -133,7 +141,7 @@ class GeneralRowsPlan {
   // the group's first bone's. No allocation.
   void SignQuaternions(const std::vector<RigidTransform>& bones, double* quaternions) const;
 
-  // Part `part` of `parts` of the frame's rotated deltas (3 planes of slot_count(), x y z) from
+  // Part `part` of `parts` of the frame's rotated deltas (rotated_size() doubles) from
   // SignQuaternions' output and SlotWeights'. Parts are independent.
   void Rotate(const double* quaternions, const double* slot_weights, double* rotated, int part,
               int parts) const;

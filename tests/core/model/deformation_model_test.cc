@@ -567,7 +567,7 @@ TEST(DeformationModel, ScratchAndFactorizationBytesAreWhatAStreamAllocates) {
   ASSERT_TRUE(other.ok()) << other.status().ToString();
   const std::size_t rows = model->mesh().num_vertices() + model->num_joint_nodes();
   EXPECT_EQ((*other)->right_hand_side_bytes(),
-            (rows * 3 + scratch.rotated_slots.size() / 3) * sizeof(double));
+            (rows * 3 + model->general_rows().slot_count()) * sizeof(double));
   EXPECT_EQ(model->FactorizationBytes(),
             (*other)->factor().bytes() + (*other)->right_hand_side_bytes());
 }

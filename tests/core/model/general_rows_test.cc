@@ -151,7 +151,7 @@ TEST_P(GeneralRowsTest, TheProductEqualsTheFullProductOfTheNormalisedBlend) {
   plan.SignQuaternions(f.bones, quaternions.data());
   const auto expected = f.Expected();
   for (const int parts : {1, 2, 3}) {
-    std::vector<double> rotated(3 * static_cast<std::size_t>(plan.slot_count()), -1e300);
+    std::vector<double> rotated(plan.rotated_size(), -1e300);
     Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> product(Fixture::n + Fixture::m, 3);
     product.setConstant(std::numeric_limits<double>::quiet_NaN());
     for (int part = 0; part < parts; ++part) {

@@ -14,6 +14,9 @@
 
 #include "core/model/general_rows.h"
 
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"  // the slot helpers are internal and always inlined
+
 namespace deform {
 namespace {
 
@@ -41,13 +44,33 @@ inline Lanes Broadcast(double x) {
   return v;
 }
 
+// A slot's rotated delta (x, y, z, 0): kRotatedStride doubles, one AVX register (two SSE2
+// registers on the baseline).
+static_assert(GeneralRowsPlan::kRotatedStride == 4, "a slot is four doubles");
+using Slot = double __attribute__((vector_size(32)));
+
+inline Slot LoadSlot(const double* rotated, int slot) {
+  Slot v;
+  std::memcpy(&v, rotated + GeneralRowsPlan::kRotatedStride * static_cast<std::ptrdiff_t>(slot),
+              sizeof v);
+  return v;
+}
+// out's row `row` = (x, y, z) of `sum`.
+inline void StoreRow(double* out, int row, Slot sum) {
+  double* target = out + 3 * static_cast<std::ptrdiff_t>(row);
+  target[0] = sum[0];
+  target[1] = sum[1];
+  target[2] = sum[2];
+}
+
 // base[index[l]] for each lane. With AVX-512 a hardware gather (the masked one: GCC 12's unmasked
 // ones read an undefined source register, and -Wmaybe-uninitialized says so); elsewhere one load
 // a lane. AVX2's four-lane gather was slower than four loads and inserts on an AMD Zen 3: the
-// right-hand side (deform_bench's RightHandSide, three rounds alternating) 0.026-0.031 against
-// 0.015-0.018 ms on the 1.6k leg, 0.38-0.52 against 0.23-0.30 on the 26k leg, 1.6-1.9 against
-// 0.93-1.07 on the arm. (Intel's microcode against Gather Data Sampling, 2023, slowed the
-// gathers of its AVX2 processors too; not measured here.)
+// right-hand side (deform_bench's RightHandSide, three rounds alternating, when the packs still
+// gathered their slots from three planes) 0.026-0.031 against 0.015-0.018 ms on the 1.6k leg,
+// 0.38-0.52 against 0.23-0.30 on the 26k leg, 1.6-1.9 against 0.93-1.07 on the arm. (Intel's
+// microcode against Gather Data Sampling, 2023, slowed the gathers of its AVX2 processors too;
+// not measured here.)
 inline Lanes Gather(const double* base, const int* index) {
 #if defined(__AVX512F__)
   return _mm512_mask_i32gather_pd(_mm512_setzero_pd(), 0xff,
@@ -113,9 +136,6 @@ void RotateSlotsImpl(const SlotGroupsView& groups, const double* quaternions,
   const double* dx = groups.deltas;
   const double* dy = dx + plane;
   const double* dz = dy + plane;
-  double* rx = rotated;
-  double* ry = rx + plane;
-  double* rz = ry + plane;
   int g = GroupHolding(groups.slot_offsets, groups.group_count, first);
   for (; g < groups.group_count && groups.slot_offsets[g] < end; ++g) {
     const int group_begin = groups.slot_offsets[g];
@@ -141,74 +161,48 @@ void RotateSlotsImpl(const SlotGroupsView& groups, const double* quaternions,
       const Lanes ux = qy * tz - qz * ty, uy = qz * tx - qx * tz, uz = qx * ty - qy * tx;
       const Lanes scale = 2.0 / (qx * qx + qy * qy + qz * qz + qw * qw);
       const Lanes w2 = Load(slot_weights + s);
-      Store(rx + s, w2 * (vx + scale * (qw * tx + ux)));
-      Store(ry + s, w2 * (vy + scale * (qw * ty + uy)));
-      Store(rz + s, w2 * (vz + scale * (qw * tz + uz)));
+      const Lanes rx = w2 * (vx + scale * (qw * tx + ux));
+      const Lanes ry = w2 * (vy + scale * (qw * ty + uy));
+      const Lanes rz = w2 * (vz + scale * (qw * tz + uz));
+      double* target = rotated + GeneralRowsPlan::kRotatedStride * static_cast<std::ptrdiff_t>(s);
+      for (int lane = 0; lane < kLanes; ++lane) {
+        const Slot r = {rx[lane], ry[lane], rz[lane], 0.0};
+        std::memcpy(target + GeneralRowsPlan::kRotatedStride * lane, &r, sizeof r);
+      }
     }
   }
 }
 
-void MultiplyPacksImpl(const RowPacksView& packs, const double* __restrict rotated, int slot_count,
+void MultiplyPacksImpl(const RowPacksView& packs, const double* __restrict rotated,
                        double* __restrict out, int first_pack, int end_pack) {
   constexpr int kRows = GeneralRowsPlan::kPackRows;
-  const double* rx = rotated;
-  const double* ry = rx + slot_count;
-  const double* rz = ry + slot_count;
   for (int p = first_pack; p < end_pack; ++p) {
-    const int entry_begin = packs.entry_offsets[p], entry_end = packs.entry_offsets[p + 1];
-    for (int half = 0; half < kRows; half += kLanes) {
-      Lanes ax = Broadcast(0), ay = ax, az = ax;
-      for (int e = entry_begin; e < entry_end; ++e) {
-        const int* columns = packs.columns + static_cast<std::ptrdiff_t>(kRows) * e + half;
-        const Lanes value = Load(packs.values + static_cast<std::ptrdiff_t>(kRows) * e + half);
-        ax += value * Gather(rx, columns);
-        ay += value * Gather(ry, columns);
-        az += value * Gather(rz, columns);
-      }
-      ScatterRows(out, packs.rows + static_cast<std::ptrdiff_t>(kRows) * p + half, ax, ay, az);
+    Slot sums[kRows] = {};
+    for (int e = packs.entry_offsets[p]; e < packs.entry_offsets[p + 1]; ++e) {
+      const int* columns = packs.columns + static_cast<std::ptrdiff_t>(kRows) * e;
+      const double* values = packs.values + static_cast<std::ptrdiff_t>(kRows) * e;
+      for (int r = 0; r < kRows; ++r) sums[r] += values[r] * LoadSlot(rotated, columns[r]);
     }
+    const int* rows = packs.rows + static_cast<std::ptrdiff_t>(kRows) * p;
+    for (int r = 0; r < kRows; ++r) StoreRow(out, rows[r], sums[r]);
   }
 }
 
 void MultiplyLongRowsImpl(const LongRowsView& rows, const double* __restrict rotated,
-                          int slot_count, double* __restrict out, int first, int end) {
-  const double* rx = rotated;
-  const double* ry = rx + slot_count;
-  const double* rz = ry + slot_count;
+                          double* __restrict out, int first, int end) {
   for (int k = first; k < end; ++k) {
-    // kLanes partial sums a coordinate, twice over, so that consecutive entries do not wait on
-    // each other's adds.
-    Lanes ax = Broadcast(0), ay = ax, az = ax, bx = ax, by = ax, bz = ax;
+    // Four partial sums, so that consecutive entries do not wait on each other's adds.
+    constexpr int kChains = 4;
+    Slot sums[kChains] = {};
     int p = rows.offsets[k];
     const int stop = rows.offsets[k + 1];
-    for (; p + 2 * kLanes <= stop; p += 2 * kLanes) {
-      const Lanes u = Load(rows.values + p), v = Load(rows.values + p + kLanes);
-      ax += u * Gather(rx, rows.columns + p);
-      ay += u * Gather(ry, rows.columns + p);
-      az += u * Gather(rz, rows.columns + p);
-      bx += v * Gather(rx, rows.columns + p + kLanes);
-      by += v * Gather(ry, rows.columns + p + kLanes);
-      bz += v * Gather(rz, rows.columns + p + kLanes);
+    for (; p + kChains <= stop; p += kChains) {
+      for (int c = 0; c < kChains; ++c) {
+        sums[c] += rows.values[p + c] * LoadSlot(rotated, rows.columns[p + c]);
+      }
     }
-    ax += bx;
-    ay += by;
-    az += bz;
-    double sum[3] = {0, 0, 0};
-    for (int l = 0; l < kLanes; ++l) {
-      sum[0] += ax[l];
-      sum[1] += ay[l];
-      sum[2] += az[l];
-    }
-    for (; p < stop; ++p) {
-      const int s = rows.columns[p];
-      sum[0] += rows.values[p] * rx[s];
-      sum[1] += rows.values[p] * ry[s];
-      sum[2] += rows.values[p] * rz[s];
-    }
-    double* target = out + 3 * static_cast<std::ptrdiff_t>(rows.rows[k]);
-    target[0] = sum[0];
-    target[1] = sum[1];
-    target[2] = sum[2];
+    for (; p < stop; ++p) sums[0] += rows.values[p] * LoadSlot(rotated, rows.columns[p]);
+    StoreRow(out, rows.rows[k], (sums[0] + sums[2]) + (sums[1] + sums[3]));
   }
 }
 
@@ -280,3 +274,5 @@ void AddAnchorsImpl(const AnchorGroupsView& anchors, const double* rotations,
 
 }  // namespace
 }  // namespace deform
+
+#pragma GCC diagnostic pop
