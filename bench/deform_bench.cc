@@ -404,6 +404,38 @@ void BM_RightHandSide(benchmark::State& state, BenchMesh mesh) {
   state.counters["median_ms"] = Median(seconds) * 1e3;
 }
 
+// A batch's right-hand sides as DeformBatch assembles them (kinematics and rotation blend of each
+// frame, the general rows of all frames in one pass, each frame's rigid rows and targets): the
+// median of DeformBatch's right_hand_side timing, per frame (rhs_frame_ms), against the same
+// frames deformed one at a time by Deform in the same benchmark, its right_hand_side timing
+// (unbatched_rhs_frame_ms), and their ratio (x_unbatched). Both follow a solve, as in the service.
+void BM_BatchedRightHandSide(benchmark::State& state, BenchMesh mesh, int frames_per_batch) {
+  auto frames = SetUpFrames(state, mesh);
+  if (!frames) return;
+  const DeformationModel& model = *frames->model;
+  std::vector<DeformScratch> scratches;
+  for (int f = 0; f < frames_per_batch; ++f) scratches.push_back(model.MakeScratch());
+  std::vector<DeformScratch*> scratch_pointers;
+  std::vector<const Pose*> poses(frames_per_batch, &frames->pose);
+  for (DeformScratch& scratch : scratches) scratch_pointers.push_back(&scratch);
+  DeformBatchScratch batch = model.MakeBatchScratch(frames_per_batch);
+  std::vector<double> right_hand_sides, unbatched;
+  for (auto _ : state) {
+    DeformTimings timings;
+    model.DeformBatch(*frames->factorization, poses.data(), scratch_pointers.data(),
+                      frames_per_batch, &batch, &timings);
+    right_hand_sides.push_back(timings.right_hand_side / frames_per_batch);
+    for (DeformScratch* scratch : scratch_pointers) {
+      model.Deform(*frames->factorization, frames->pose, scratch, &timings);
+      unbatched.push_back(timings.right_hand_side);
+    }
+  }
+  state.counters["frames"] = frames_per_batch;
+  state.counters["rhs_frame_ms"] = Median(right_hand_sides) * 1e3;
+  state.counters["unbatched_rhs_frame_ms"] = Median(unbatched) * 1e3;
+  state.counters["x_unbatched"] = Median(right_hand_sides) / Median(unbatched);
+}
+
 // Baseline: Eigen's SimplicialLLT (AMD ordering) on the same system, three columns at once.
 void BM_EigenBaselineSolve(benchmark::State& state, BenchMesh mesh) {
   auto frames = SetUpFrames(state, mesh);
@@ -490,6 +522,11 @@ void RegisterBenchmarks(const BenchMesh& mesh) {
   }
   if (BestSolveKernel() == SolveKernel::kAvx512) {  // the four-wide batch in the same run
     RegisterFor(mesh, "BatchedSolveAvx2Kernel/frames:8", BM_BatchedSolve, 8, SolveKernel::kAvx2Fma)
+        ->MinTime(1.0);
+  }
+  for (const int frames : {8, 16}) {
+    RegisterFor(mesh, "BatchedRightHandSide/frames:" + std::to_string(frames),
+                BM_BatchedRightHandSide, frames)
         ->MinTime(1.0);
   }
   RegisterFor(mesh, "ParallelSolve/parts:2", BM_ParallelSolve, 2)->MinTime(1.0);

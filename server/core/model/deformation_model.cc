@@ -366,12 +366,16 @@ DeformBatchScratch DeformationModel::MakeBatchScratch(int max_frames,
   batch.model_id_ = id_;
   batch.max_frames = std::clamp(max_frames, 1, kMaxBatchFrames);
   batch.solve_work.resize(BatchSolveWorkSize(batch.max_frames, parallel));
+  if (!linear_blend_plan_) batch.rotated.resize(batch.max_frames * general_rows_.rotated_size());
   return batch;
 }
 
 std::size_t DeformationModel::BatchScratchBytes(int max_frames,
                                                 const ParallelSolvePlan* parallel) const {
-  return sizeof(double) * BatchSolveWorkSize(max_frames, parallel);
+  const std::size_t rotated = linear_blend_plan_ ? 0
+                                                 : std::clamp(max_frames, 1, kMaxBatchFrames) *
+                                                       general_rows_.rotated_size();
+  return sizeof(double) * (BatchSolveWorkSize(max_frames, parallel) + rotated);
 }
 
 bool DeformationModel::RefusesBatch(const MaterialFactorization& factorization,
@@ -403,13 +407,20 @@ bool DeformationModel::DeformBatch(const MaterialFactorization& factorization,
     return true;
   }
   const auto start = Clock::now();
+  if (linear_blend_plan_) {
+    for (int f = 0; f < count; ++f) {
+      AssembleOwnedRightHandSide(factorization, *poses[f], scratches[f]);
+    }
+  } else {
+    PrepareBatchFrames(poses, scratches, count);
+    RotateBatchPart(factorization, scratches, count, batch, 0, 1);
+    MultiplyBatchPart(factorization, scratches, count, *batch, 0, 1);
+    AddBatchTargetsPart(poses, scratches, count, 0, 1);
+  }
   // Each frame's right-hand side is solved where it is: the batched solve gathers the frames'
   // rows into its own and scatters the solutions back.
   double* solutions[kMaxBatchFrames];
-  for (int f = 0; f < count; ++f) {
-    AssembleOwnedRightHandSide(factorization, *poses[f], scratches[f]);
-    solutions[f] = scratches[f]->solution.data();
-  }
+  for (int f = 0; f < count; ++f) solutions[f] = scratches[f]->solution.data();
   const auto solve_start = Clock::now();
   const Status solved =
       factorization.factor().SolveFrames(solutions, solutions, count, batch->solve_work.data());
@@ -539,16 +550,79 @@ bool DeformationModel::DeformParallel(const MaterialFactorization& factorization
   return true;
 }
 
+void DeformationModel::PrepareBatchFrames(const Pose* const* poses, DeformScratch* const* scratches,
+                                          int count) const {
+  for (int f = 0; f < count; ++f) {
+    ForwardKinematics(skeleton_, *poses[f], &scratches[f]->bone_transforms);
+    PrepareSlotRotations(scratches[f]);
+  }
+}
+
+void DeformationModel::RotateBatchPart(const MaterialFactorization& factorization,
+                                       DeformScratch* const* scratches, int count,
+                                       DeformBatchScratch* batch, int part, int parts) const {
+  const double* quaternions[kMaxBatchFrames] = {};
+  for (int f = 0; f < count; ++f) quaternions[f] = scratches[f]->signed_quaternions.data();
+  general_rows_.RotateFrames(quaternions, count, factorization.slot_weights_.data(),
+                             batch->rotated.data(), part, parts);
+}
+
+void DeformationModel::MultiplyBatchPart(const MaterialFactorization& factorization,
+                                         DeformScratch* const* scratches, int count,
+                                         const DeformBatchScratch& batch, int part,
+                                         int parts) const {
+  double* outs[kMaxBatchFrames] = {};
+  for (int f = 0; f < count; ++f) outs[f] = scratches[f]->solution.data();
+  const double* sums = factorization.rigid_row_sums_.data();
+  // A group of frames side by side at a time, its rigid rows right after its general rows, so
+  // that the output lines both write are written again while the group's outputs are cached.
+  constexpr int kGroup = GeneralRowsPlan::kMaxFramesSideBySide;
+  for (int group = 0; group < count; group += kGroup) {
+    const int frames = std::min(kGroup, count - group);
+    general_rows_.MultiplyGeneral(batch.rotated.data() + group * general_rows_.rotated_size(),
+                                  frames, outs + group, part, parts);
+    for (int f = group; f < group + frames; ++f) {
+      general_rows_.MultiplyRigid(scratches[f]->slot_rotations.data(), sums, outs[f], part, parts);
+    }
+  }
+}
+
+void DeformationModel::AddBatchTargetsPart(const Pose* const* poses,
+                                           DeformScratch* const* scratches, int count, int part,
+                                           int parts) const {
+  for (int f = 0; f < count; ++f) {
+    AddAnchorTargetsPart(scratches[f], part, parts);
+    if (part == 0) AddNodeTargets(*poses[f], scratches[f]);
+  }
+}
+
 struct DeformationModel::ParallelBatchAssembly {
   const DeformationModel* model;
   const MaterialFactorization* factorization;
   const Pose* const* poses;
   DeformScratch* const* scratches;
+  int count;
+  DeformBatchScratch* batch;
+  int parts;
 
-  // Frame `index`'s right-hand side, whole, on the thread that takes it.
+  // The linear blend: frame `index`'s right-hand side, whole, on the thread that takes it.
   static void Assemble(void* context, int index) {
     const auto& a = *static_cast<const ParallelBatchAssembly*>(context);
     a.model->AssembleOwnedRightHandSide(*a.factorization, *a.poses[index], a.scratches[index]);
+  }
+  // The quaternion blend's steps (RotateBatchPart and on), each once every part of the one
+  // before is done.
+  static void Rotate(void* context, int index) {
+    const auto& a = *static_cast<const ParallelBatchAssembly*>(context);
+    a.model->RotateBatchPart(*a.factorization, a.scratches, a.count, a.batch, index, a.parts);
+  }
+  static void Multiply(void* context, int index) {
+    const auto& a = *static_cast<const ParallelBatchAssembly*>(context);
+    a.model->MultiplyBatchPart(*a.factorization, a.scratches, a.count, *a.batch, index, a.parts);
+  }
+  static void Targets(void* context, int index) {
+    const auto& a = *static_cast<const ParallelBatchAssembly*>(context);
+    a.model->AddBatchTargetsPart(a.poses, a.scratches, a.count, index, a.parts);
   }
 };
 
@@ -566,8 +640,15 @@ bool DeformationModel::DeformBatchParallel(const MaterialFactorization& factoriz
   assert(fits && "a batch scratch made without this plan");
   if (!fits) return false;
   const auto start = Clock::now();
-  ParallelBatchAssembly assembly{this, &factorization, poses, scratches};
-  runner->Run(count, &ParallelBatchAssembly::Assemble, &assembly);
+  ParallelBatchAssembly assembly{this, &factorization, poses, scratches, count, batch, plan.parts};
+  if (linear_blend_plan_) {
+    runner->Run(count, &ParallelBatchAssembly::Assemble, &assembly);
+  } else {
+    PrepareBatchFrames(poses, scratches, count);
+    runner->Run(plan.parts, &ParallelBatchAssembly::Rotate, &assembly);
+    runner->Run(plan.parts, &ParallelBatchAssembly::Multiply, &assembly);
+    runner->Run(plan.parts, &ParallelBatchAssembly::Targets, &assembly);
+  }
   double* solutions[kMaxBatchFrames];
   for (int f = 0; f < count; ++f) solutions[f] = scratches[f]->solution.data();
   const auto solve_start = Clock::now();

@@ -113,13 +113,16 @@ struct DeformScratch {
 };
 
 // Buffers for DeformationModel::DeformBatch(): the batched solve's rows (the frames' right-hand
-// sides side by side, in the factor's order). Create with MakeBatchScratch(); one per caller that
-// batches (a worker).
+// sides side by side, in the factor's order) and the frames' rotated deltas. Create with
+// MakeBatchScratch(); one per caller that batches (a worker).
 struct DeformBatchScratch {
   int max_frames = 0;
   // CholeskyFactor::WorkSizeMany(3 * max_frames), or with a parallel plan at least
   // WorkSizeFramesParallel(plan, max_frames) as well.
   std::vector<double> solve_work;
+  // The quaternion blend's rotated deltas of up to max_frames frames side by side
+  // (GeneralRowsPlan::Rotate's `frames`); empty under the linear blend.
+  std::vector<double> rotated;
 
  private:
   friend class DeformationModel;
@@ -212,12 +215,13 @@ class DeformationModel {
   DeformBatchScratch MakeBatchScratch(int max_frames,
                                       const ParallelSolvePlan* parallel = nullptr) const;
   // Deforms `count` frames at once, frame f's poses[f] into scratches[f] (distinct scratches of
-  // this model): each right-hand side is assembled as Deform() does, then all are solved in one
-  // pass over the factor, so the factor's bytes are read once for the batch. Each frame equals
-  // Deform()'s to round-off (1e-12 of the diagonal, tested). With a linear response there is no
-  // solve to share and each frame is evaluated alone. No allocation. Refuses (false, nothing
-  // written) a count outside [1, batch->max_frames], another model's factorisation, scratch or
-  // batch scratch, as Deform() does. `timings`, when given, are the whole batch's: every
+  // this model): the right-hand sides are assembled as Deform() does (the quaternion blend's
+  // general rows for all frames in one pass, GeneralRowsPlan::MultiplyGeneral), then all are
+  // solved in one pass over the factor, so the factor's bytes are read once for the batch. Each
+  // frame equals Deform()'s to round-off (1e-12 of the diagonal, tested). With a linear response
+  // there is no solve to share and each frame is evaluated alone. No allocation. Refuses (false,
+  // nothing written) a count outside [1, batch->max_frames], another model's factorisation, scratch
+  // or batch scratch, as Deform() does. `timings`, when given, are the whole batch's: every
   // right-hand side (and packing them side by side), then the one solve (and unpacking it).
   bool DeformBatch(const MaterialFactorization& factorization, const Pose* const* poses,
                    DeformScratch* const* scratches, int count, DeformBatchScratch* batch,
@@ -231,8 +235,9 @@ class DeformationModel {
   bool DeformParallel(const MaterialFactorization& factorization, const Pose& pose,
                       DeformScratch* scratch, const ParallelSolvePlan& plan, double* work,
                       ParallelRunner* runner, DeformTimings* timings = nullptr) const;
-  // DeformBatch() on several threads: the frames' right-hand sides assembled side by side (each
-  // frame's on one thread), then the batched solve split by subtrees
+  // DeformBatch() on several threads: the frames' right-hand sides assembled side by side (the
+  // quaternion blend's by slot and row ranges for all frames, the linear blend's each frame on one
+  // thread), then the batched solve split by subtrees
   // (CholeskyFactor::SolveFramesParallel), both through `runner`. `plan` as DeformParallel's, and
   // `batch` made by MakeBatchScratch with it (or one with as many parts). Each frame equals
   // Deform()'s to round-off (1e-12 of the diagonal, tested). With a linear response or a plan
@@ -353,6 +358,20 @@ class DeformationModel {
                            int part, int parts) const;
   struct ParallelAssembly;       // DeformParallel's parts
   struct ParallelBatchAssembly;  // DeformBatchParallel's parts
+  // The quaternion blend's batch of right-hand sides, in steps whose parts are independent: each
+  // frame's forward kinematics and signed quaternions (PrepareSlotRotations), then part `part` of
+  // `parts` of every frame's rotated deltas into batch->rotated, then of every frame's rows of
+  // L'^T r (the general rows of all frames at once), then of every frame's constraint targets
+  // (the joint nodes' with part 0).
+  void PrepareBatchFrames(const Pose* const* poses, DeformScratch* const* scratches,
+                          int count) const;
+  void RotateBatchPart(const MaterialFactorization& factorization, DeformScratch* const* scratches,
+                       int count, DeformBatchScratch* batch, int part, int parts) const;
+  void MultiplyBatchPart(const MaterialFactorization& factorization,
+                         DeformScratch* const* scratches, int count,
+                         const DeformBatchScratch& batch, int part, int parts) const;
+  void AddBatchTargetsPart(const Pose* const* poses, DeformScratch* const* scratches, int count,
+                           int part, int parts) const;
   // The doubles of a batch scratch's solve work (MakeBatchScratch).
   std::size_t BatchSolveWorkSize(int max_frames, const ParallelSolvePlan* parallel) const;
   // What DeformBatch and DeformBatchParallel refuse (false): see DeformBatch.

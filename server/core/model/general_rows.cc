@@ -1,6 +1,7 @@
 #include "core/model/general_rows.h"
 
 #include <algorithm>
+#include <cassert>
 #include <map>
 #include <utility>
 
@@ -242,20 +243,46 @@ void GeneralRowsPlan::AddAnchorTargets(const Eigen::Matrix3d* rotations,
 
 void GeneralRowsPlan::Rotate(const double* quaternions, const double* slot_weights, double* rotated,
                              int part, int parts) const {
+  RotateFrames(&quaternions, 1, slot_weights, rotated, part, parts);
+}
+
+void GeneralRowsPlan::RotateFrames(const double* const* quaternions, int frames,
+                                   const double* slot_weights, double* rotated, int part,
+                                   int parts) const {
+  assert(frames >= 1 && frames <= kMaxFrames);
   const auto [first, end] = EqualPart(slot_count_ / kSlotBlock, part, parts);
-  if (first < end) kernel_.rotate(Groups(), quaternions, slot_weights, rotated, first, end);
+  if (first >= end) return;
+  for (int group = 0; group < frames; group += kMaxFramesSideBySide) {
+    kernel_.rotate(Groups(), quaternions + group, std::min(kMaxFramesSideBySide, frames - group),
+                   slot_weights, rotated + group * rotated_size(), first, end);
+  }
 }
 
 void GeneralRowsPlan::Multiply(const Eigen::Matrix3d* rotations, const double* rigid_sums,
                                const double* rotated, double* out, int part, int parts) const {
+  MultiplyGeneral(rotated, 1, &out, part, parts);
+  MultiplyRigid(rotations, rigid_sums, out, part, parts);
+}
+
+void GeneralRowsPlan::MultiplyGeneral(const double* rotated, int frames, double* const* outs,
+                                      int part, int parts) const {
+  assert(frames >= 1 && frames <= kMaxFrames);
   const auto [first_pack, end_pack] = EqualPart(pack_count(), part, parts);
-  if (first_pack < end_pack) {
-    kernel_.multiply(Packs(), rotated, out, first_pack, end_pack);
-  }
   const auto [first_long, end_long] = EqualPart(static_cast<int>(long_rows_.size()), part, parts);
-  if (first_long < end_long) {
-    kernel_.multiply_long(LongRows(), rotated, out, first_long, end_long);
+  for (int group = 0; group < frames; group += kMaxFramesSideBySide) {
+    const int count = std::min(kMaxFramesSideBySide, frames - group);
+    const double* group_rotated = rotated + group * rotated_size();
+    if (first_pack < end_pack) {
+      kernel_.multiply(Packs(), group_rotated, count, outs + group, first_pack, end_pack);
+    }
+    if (first_long < end_long) {
+      kernel_.multiply_long(LongRows(), group_rotated, count, outs + group, first_long, end_long);
+    }
   }
+}
+
+void GeneralRowsPlan::MultiplyRigid(const Eigen::Matrix3d* rotations, const double* rigid_sums,
+                                    double* out, int part, int parts) const {
   const auto [first_rigid, end_rigid] =
       EqualPart(static_cast<int>(rigid_rows_.size()) / kSlotBlock, part, parts);
   if (first_rigid < end_rigid) {

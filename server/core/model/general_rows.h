@@ -93,16 +93,19 @@ struct RowPacksView {
 
 // The kernels of one instruction set (internal/general_rows_kernel_*.cc).
 struct GeneralRowsKernel {
-  // Blocks [first_block, end_block) of kSlotBlock slots: rotated (kRotatedStride doubles a slot) =
-  // slot_weights * (the group's blend of `quaternions`, 4 doubles x y z w each) * deltas.
-  void (*rotate)(const SlotGroupsView& groups, const double* quaternions,
+  // Blocks [first_block, end_block) of kSlotBlock slots of `frames` (1 to kMaxFramesSideBySide)
+  // frames: frame f's rotated
+  // delta of slot s (kRotatedStride doubles at kRotatedStride (s frames + f)) = slot_weights *
+  // (the group's blend of quaternions[f], 4 doubles x y z w each) * deltas.
+  void (*rotate)(const SlotGroupsView& groups, const double* const* quaternions, int frames,
                  const double* slot_weights, double* rotated, int first_block, int end_block);
-  // Packs [first_pack, end_pack) of L'^T r into out ((n + m) by 3, row-major; written).
-  void (*multiply)(const RowPacksView& packs, const double* rotated, double* out, int first_pack,
-                   int end_pack);
+  // Packs [first_pack, end_pack) of L'^T r of each of `frames` (1 to kMaxFramesSideBySide)
+  // frames (`rotated` as `rotate` wrote them) into outs[f] ((n + m) by 3, row-major; written).
+  void (*multiply)(const RowPacksView& packs, const double* rotated, int frames,
+                   double* const* outs, int first_pack, int end_pack);
   // Long rows [first, end) the same way.
-  void (*multiply_long)(const LongRowsView& rows, const double* rotated, double* out, int first,
-                        int end);
+  void (*multiply_long)(const LongRowsView& rows, const double* rotated, int frames,
+                        double* const* outs, int first, int end);
   // Blocks [first_block, end_block) of kSlotBlock rigid rows: out's row i = R_bone c_i, R_bone
   // the bone's rotation (`rotations`: 9 doubles each, column-major) and c_i the row's rigid sum
   // (`sums`, (n + m) by 3 row-major).
@@ -133,6 +136,11 @@ class GeneralRowsPlan {
   std::size_t rotated_size() const {
     return kRotatedStride * static_cast<std::size_t>(slot_count_);
   }
+  // The most frames RotateFrames and MultiplyGeneral take at once.
+  static constexpr int kMaxFrames = kMaxSolveColumns / 3;
+  // The most frames whose rotated deltas lie side by side; more go in groups of this many, one
+  // after the other, so that a pass over the rows reads a group's slots (256 bytes each).
+  static constexpr int kMaxFramesSideBySide = 8;
   // The signed quaternions a frame needs (4 doubles each): one per bone of each group.
   int quaternion_count() const { return static_cast<int>(quaternion_bones_.size()); }
   // w_j^2 of each slot's vertex j (0 in the padding), for a factorisation's row weights (n).
@@ -145,11 +153,23 @@ class GeneralRowsPlan {
   // SignQuaternions' output and SlotWeights'. Parts are independent.
   void Rotate(const double* quaternions, const double* slot_weights, double* rotated, int part,
               int parts) const;
+  // The same for `frames` (1 to kMaxFrames) frames at once, frame f's from quaternions[f], into
+  // frames * rotated_size() doubles for MultiplyGeneral: groups of kMaxFramesSideBySide frames
+  // one after the other, and within a group each slot's frames side by side.
+  void RotateFrames(const double* const* quaternions, int frames, const double* slot_weights,
+                    double* rotated, int part, int parts) const;
   // Part `part` of `parts` of the rows of L'^T r into `out` ((n + m) by 3, row-major; written,
   // not added): a rigid row as rotations[bone] * its RigidRowSums entry (`rigid_sums`), a general
   // row from `rotated` (every part's Rotate done). Parts write disjoint rows. No allocation.
   void Multiply(const Eigen::Matrix3d* rotations, const double* rigid_sums, const double* rotated,
                 double* out, int part, int parts) const;
+  // Multiply's two halves: the general rows of `frames` (1 to kMaxFrames) frames at once from
+  // their rotated deltas side by side (RotateFrames'), frame f's into outs[f], each row's
+  // entries read once for all of them; and one frame's rigid rows.
+  void MultiplyGeneral(const double* rotated, int frames, double* const* outs, int part,
+                       int parts) const;
+  void MultiplyRigid(const Eigen::Matrix3d* rotations, const double* rigid_sums, double* out,
+                     int part, int parts) const;
 
   // Part `part` of `parts` of the anchors' targets: their rows of `out` += anchor_weight^2 *
   // sum_e w_e (R_e rest + t_e) (`rotations` and `bones` indexed by bone), once every part's

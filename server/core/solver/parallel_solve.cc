@@ -6,7 +6,7 @@
 #include <numeric>
 #include <utility>
 
-#include "internal/compile_time_count.h"
+#include "core/base/compile_time_count.h"
 
 namespace deform {
 namespace {

@@ -306,7 +306,9 @@ TEST(DeformationModel, ABatchSolvedOnSeveralThreadsEqualsTheFramesSolvedOneByOne
     const ParallelSolvePlan plan = factorization.factor().PlanParallel(parts);
     ASSERT_EQ(plan.parts, parts);
     DeformBatchScratch batch = model->MakeBatchScratch(most, &plan);
-    EXPECT_EQ(batch.solve_work.size() * sizeof(double), model->BatchScratchBytes(most, &plan));
+    EXPECT_EQ((batch.solve_work.size() + batch.rotated.size()) * sizeof(double),
+              model->BatchScratchBytes(most, &plan));
+    EXPECT_EQ(batch.rotated.size(), most * model->general_rows().rotated_size());
     EXPECT_GE(model->BatchScratchBytes(most, &plan), model->BatchScratchBytes(most));
     ThreadTeam team(parts);
     SerialRunner serial;

@@ -166,6 +166,67 @@ TEST_P(GeneralRowsTest, TheProductEqualsTheFullProductOfTheNormalisedBlend) {
   EXPECT_GT(expected.norm(), 1.0);
 }
 
+// A batch's frames, their rotated deltas side by side and their general rows multiplied in one
+// pass, each equal the frame's own product to round-off, for every kernel, frame count (chunks of
+// eight frames and their remainders) and split into parts.
+TEST_P(GeneralRowsTest, FramesSideBySideEqualEachFramesOwnProduct) {
+  if (!SolveKernelAvailable(GetParam())) GTEST_SKIP() << "this CPU lacks the instruction set";
+  using Rows = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+  const Fixture f;
+  const RigidRows rigid = RigidRows::Find(f.system, f.weights);
+  const std::vector<double> sums = RigidRowSums(f.system, rigid, f.w2);
+  const GeneralRowsPlan plan = GeneralRowsPlan::Build(f.system, rigid, f.weights, GetParam());
+  const std::vector<double> slot_weights = plan.SlotWeights(f.w2);
+  const int most = GeneralRowsPlan::kMaxFrames;
+  // Frame k's bones: the fixture's, each turned by its own angle about its own axis.
+  std::vector<std::vector<double>> quaternions(most);
+  std::vector<std::vector<Eigen::Matrix3d>> rotations(most);
+  std::vector<Rows> own(most, Rows(Fixture::n + Fixture::m, 3));
+  std::vector<double> rotated(plan.rotated_size());
+  for (int k = 0; k < most; ++k) {
+    std::vector<RigidTransform> bones = f.bones;
+    for (int b = 0; b < static_cast<int>(bones.size()); ++b) {
+      bones[b].rotation =
+          Eigen::AngleAxisd(0.1 * k + 0.05 * b, Eigen::Vector3d(b, 1, k).normalized()) *
+          bones[b].rotation;
+      rotations[k].push_back(bones[b].rotation.toRotationMatrix());
+    }
+    quaternions[k].resize(4 * static_cast<std::size_t>(plan.quaternion_count()));
+    plan.SignQuaternions(bones, quaternions[k].data());
+    plan.Rotate(quaternions[k].data(), slot_weights.data(), rotated.data(), 0, 1);
+    plan.Multiply(rotations[k].data(), sums.data(), rotated.data(), own[k].data(), 0, 1);
+  }
+  for (const int frames : {1, 2, 3, 5, 8, 9, 13, most}) {
+    for (const int parts : {1, 2, 3}) {
+      std::vector<double> side_by_side(frames * plan.rotated_size(), -1e300);
+      std::vector<Rows> products(frames, Rows(Fixture::n + Fixture::m, 3));
+      std::vector<double*> outs;
+      for (Rows& product : products) {
+        product.setConstant(std::numeric_limits<double>::quiet_NaN());
+        outs.push_back(product.data());
+      }
+      std::vector<const double*> frame_quaternions;
+      for (int k = 0; k < frames; ++k) frame_quaternions.push_back(quaternions[k].data());
+      for (int part = 0; part < parts; ++part) {
+        plan.RotateFrames(frame_quaternions.data(), frames, slot_weights.data(),
+                          side_by_side.data(), part, parts);
+      }
+      for (int part = parts - 1; part >= 0; --part) {
+        plan.MultiplyGeneral(side_by_side.data(), frames, outs.data(), part, parts);
+        for (int k = 0; k < frames; ++k) {
+          plan.MultiplyRigid(rotations[k].data(), sums.data(), outs[k], part, parts);
+        }
+      }
+      for (int k = 0; k < frames; ++k) {
+        ASSERT_TRUE(products[k].allFinite()) << frames << " frames, " << parts << " parts";
+        EXPECT_LT((products[k] - own[k]).norm(), 1e-14 * own[k].norm())
+            << "frame " << k << " of " << frames << ", " << parts << " parts";
+      }
+    }
+  }
+  EXPECT_GT((own[1] - own[0]).norm(), 0.01 * own[0].norm()) << "the frames differ";
+}
+
 INSTANTIATE_TEST_SUITE_P(AllKernels, GeneralRowsTest,
                          testing::Values(SolveKernel::kBaseline, SolveKernel::kAvx2Fma,
                                          SolveKernel::kAvx512),

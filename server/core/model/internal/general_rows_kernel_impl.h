@@ -12,6 +12,7 @@
 #include <immintrin.h>
 #endif
 
+#include "core/base/compile_time_count.h"
 #include "core/model/general_rows.h"
 
 #pragma GCC diagnostic push
@@ -49,11 +50,15 @@ inline Lanes Broadcast(double x) {
 static_assert(GeneralRowsPlan::kRotatedStride == 4, "a slot is four doubles");
 using Slot = double __attribute__((vector_size(32)));
 
-inline Slot LoadSlot(const double* rotated, int slot) {
+inline Slot LoadSlot(const double* p) {
   Slot v;
-  std::memcpy(&v, rotated + GeneralRowsPlan::kRotatedStride * static_cast<std::ptrdiff_t>(slot),
-              sizeof v);
+  std::memcpy(&v, p, sizeof v);
   return v;
+}
+// Where slot `slot`'s rotated deltas begin: `frames` of them side by side, kRotatedStride doubles
+// each.
+inline const double* SlotFrames(const double* rotated, int slot, int frames) {
+  return rotated + GeneralRowsPlan::kRotatedStride * static_cast<std::ptrdiff_t>(slot) * frames;
 }
 // out's row `row` = (x, y, z) of `sum`.
 inline void StoreRow(double* out, int row, Slot sum) {
@@ -127,7 +132,7 @@ inline int GroupHolding(const int* offsets, int group_count, int index) {
          1;
 }
 
-void RotateSlotsImpl(const SlotGroupsView& groups, const double* quaternions,
+void RotateSlotsImpl(const SlotGroupsView& groups, const double* const* quaternions, int frames,
                      const double* __restrict slot_weights, double* __restrict rotated,
                      int first_block, int end_block) {
   const int first = first_block * GeneralRowsPlan::kSlotBlock;
@@ -140,70 +145,124 @@ void RotateSlotsImpl(const SlotGroupsView& groups, const double* quaternions,
   for (; g < groups.group_count && groups.slot_offsets[g] < end; ++g) {
     const int group_begin = groups.slot_offsets[g];
     const int slots = groups.slot_offsets[g + 1] - group_begin;
-    const double* q = quaternions + 4 * static_cast<std::ptrdiff_t>(groups.quaternion_offsets[g]);
+    const std::ptrdiff_t group_quaternions = 4 * std::ptrdiff_t{groups.quaternion_offsets[g]};
     const int bones = groups.quaternion_offsets[g + 1] - groups.quaternion_offsets[g];
     const double* w = groups.weights + groups.weight_offsets[g];
     const int stop = std::min(end, groups.slot_offsets[g + 1]);
     for (int s = std::max(first, group_begin); s < stop; s += kLanes) {
       const int l = s - group_begin;
-      // The blend q = sum_k w_k q_k of this group's signed quaternions.
-      Lanes qx = Broadcast(0), qy = qx, qz = qx, qw = qx;
-      for (int k = 0; k < bones; ++k) {
-        const Lanes wk = Load(w + static_cast<std::ptrdiff_t>(k) * slots + l);
-        qx += wk * q[4 * k];
-        qy += wk * q[4 * k + 1];
-        qz += wk * q[4 * k + 2];
-        qw += wk * q[4 * k + 3];
-      }
-      // v rotated by q / |q|: v + 2 / |q|^2 (w (u x v) + u x (u x v)), u = (qx, qy, qz).
       const Lanes vx = Load(dx + s), vy = Load(dy + s), vz = Load(dz + s);
-      const Lanes tx = qy * vz - qz * vy, ty = qz * vx - qx * vz, tz = qx * vy - qy * vx;
-      const Lanes ux = qy * tz - qz * ty, uy = qz * tx - qx * tz, uz = qx * ty - qy * tx;
-      const Lanes scale = 2.0 / (qx * qx + qy * qy + qz * qz + qw * qw);
       const Lanes w2 = Load(slot_weights + s);
-      const Lanes rx = w2 * (vx + scale * (qw * tx + ux));
-      const Lanes ry = w2 * (vy + scale * (qw * ty + uy));
-      const Lanes rz = w2 * (vz + scale * (qw * tz + uz));
-      double* target = rotated + GeneralRowsPlan::kRotatedStride * static_cast<std::ptrdiff_t>(s);
-      for (int lane = 0; lane < kLanes; ++lane) {
-        const Slot r = {rx[lane], ry[lane], rz[lane], 0.0};
-        std::memcpy(target + GeneralRowsPlan::kRotatedStride * lane, &r, sizeof r);
+      // The frames' slots side by side: every line of these kLanes slots is written here, whole.
+      double* target =
+          rotated + GeneralRowsPlan::kRotatedStride * static_cast<std::ptrdiff_t>(s) * frames;
+      for (int f = 0; f < frames; ++f) {
+        const double* q = quaternions[f] + group_quaternions;
+        // The blend q = sum_k w_k q_k of this group's signed quaternions.
+        Lanes qx = Broadcast(0), qy = qx, qz = qx, qw = qx;
+        for (int k = 0; k < bones; ++k) {
+          const Lanes wk = Load(w + static_cast<std::ptrdiff_t>(k) * slots + l);
+          qx += wk * q[4 * k];
+          qy += wk * q[4 * k + 1];
+          qz += wk * q[4 * k + 2];
+          qw += wk * q[4 * k + 3];
+        }
+        // v rotated by q / |q|: v + 2 / |q|^2 (w (u x v) + u x (u x v)), u = (qx, qy, qz).
+        const Lanes tx = qy * vz - qz * vy, ty = qz * vx - qx * vz, tz = qx * vy - qy * vx;
+        const Lanes ux = qy * tz - qz * ty, uy = qz * tx - qx * tz, uz = qx * ty - qy * tx;
+        const Lanes scale = 2.0 / (qx * qx + qy * qy + qz * qz + qw * qw);
+        const Lanes rx = w2 * (vx + scale * (qw * tx + ux));
+        const Lanes ry = w2 * (vy + scale * (qw * ty + uy));
+        const Lanes rz = w2 * (vz + scale * (qw * tz + uz));
+        for (int lane = 0; lane < kLanes; ++lane) {
+          const Slot r = {rx[lane], ry[lane], rz[lane], 0.0};
+          std::memcpy(target + GeneralRowsPlan::kRotatedStride * (lane * frames + f), &r, sizeof r);
+        }
       }
     }
   }
 }
 
-void MultiplyPacksImpl(const RowPacksView& packs, const double* __restrict rotated,
-                       double* __restrict out, int first_pack, int end_pack) {
+// Calls run(Count<frames>()) for 1 <= frames <= GeneralRowsPlan::kMaxFramesSideBySide.
+template <typename Run>
+inline void WithFrames(int frames, Run&& run) {
+  WithCount<GeneralRowsPlan::kMaxFramesSideBySide>(frames, run);
+}
+
+// Packs [first_pack, end_pack) for kFrames frames side by side: kRowsAtOnce rows of a pack at a
+// time, so that kRowsAtOnce x kFrames (8 or fewer) sums are in flight and each row's entry (a
+// column and a value) is read once for all the frames.
+template <int kFrames>
+void MultiplyPacksOfFrames(const RowPacksView& packs, const double* __restrict rotated,
+                           double* const* outs, int first_pack, int end_pack) {
   constexpr int kRows = GeneralRowsPlan::kPackRows;
+  constexpr int kRowsAtOnce = kFrames == 1 ? 8 : kFrames == 2 ? 4 : kFrames <= 4 ? 2 : 1;
+  static_assert(kRows % kRowsAtOnce == 0, "a pack is whole groups of rows");
   for (int p = first_pack; p < end_pack; ++p) {
-    Slot sums[kRows] = {};
-    for (int e = packs.entry_offsets[p]; e < packs.entry_offsets[p + 1]; ++e) {
-      const int* columns = packs.columns + static_cast<std::ptrdiff_t>(kRows) * e;
-      const double* values = packs.values + static_cast<std::ptrdiff_t>(kRows) * e;
-      for (int r = 0; r < kRows; ++r) sums[r] += values[r] * LoadSlot(rotated, columns[r]);
-    }
     const int* rows = packs.rows + static_cast<std::ptrdiff_t>(kRows) * p;
-    for (int r = 0; r < kRows; ++r) StoreRow(out, rows[r], sums[r]);
+    for (int r0 = 0; r0 < kRows; r0 += kRowsAtOnce) {
+      Slot sums[kRowsAtOnce][kFrames] = {};
+      for (int e = packs.entry_offsets[p]; e < packs.entry_offsets[p + 1]; ++e) {
+        const std::ptrdiff_t at = static_cast<std::ptrdiff_t>(kRows) * e + r0;
+        for (int r = 0; r < kRowsAtOnce; ++r) {
+          const double value = packs.values[at + r];
+          const double* slot = SlotFrames(rotated, packs.columns[at + r], kFrames);
+          for (int f = 0; f < kFrames; ++f) {
+            sums[r][f] += value * LoadSlot(slot + GeneralRowsPlan::kRotatedStride * f);
+          }
+        }
+      }
+      for (int r = 0; r < kRowsAtOnce; ++r) {
+        for (int f = 0; f < kFrames; ++f) StoreRow(outs[f], rows[r0 + r], sums[r][f]);
+      }
+    }
   }
 }
 
-void MultiplyLongRowsImpl(const LongRowsView& rows, const double* __restrict rotated,
-                          double* __restrict out, int first, int end) {
-  for (int k = first; k < end; ++k) {
-    // Four partial sums, so that consecutive entries do not wait on each other's adds.
-    constexpr int kChains = 4;
-    Slot sums[kChains] = {};
+void MultiplyPacksImpl(const RowPacksView& packs, const double* __restrict rotated, int frames,
+                       double* const* outs, int first_pack, int end_pack) {
+  WithFrames(frames, [&](auto count) {
+    MultiplyPacksOfFrames<decltype(count)::value>(packs, rotated, outs, first_pack, end_pack);
+  });
+}
+
+// Long rows [first_row, end_row) for kFrames frames side by side, with kChains sums a frame so
+// that at least four multiply-adds are independent.
+template <int kFrames>
+void MultiplyLongRowsOfFrames(const LongRowsView& rows, const double* __restrict rotated,
+                              double* const* outs, int first_row, int end_row) {
+  constexpr int kChains = kFrames == 1 ? 4 : kFrames == 2 ? 2 : 1;
+  for (int k = first_row; k < end_row; ++k) {
+    Slot sums[kFrames][kChains] = {};
     int p = rows.offsets[k];
     const int stop = rows.offsets[k + 1];
     for (; p + kChains <= stop; p += kChains) {
       for (int c = 0; c < kChains; ++c) {
-        sums[c] += rows.values[p + c] * LoadSlot(rotated, rows.columns[p + c]);
+        const double* slot = SlotFrames(rotated, rows.columns[p + c], kFrames);
+        for (int f = 0; f < kFrames; ++f) {
+          sums[f][c] += rows.values[p + c] * LoadSlot(slot + GeneralRowsPlan::kRotatedStride * f);
+        }
       }
     }
-    for (; p < stop; ++p) sums[0] += rows.values[p] * LoadSlot(rotated, rows.columns[p]);
-    StoreRow(out, rows.rows[k], (sums[0] + sums[2]) + (sums[1] + sums[3]));
+    for (; p < stop; ++p) {
+      const double* slot = SlotFrames(rotated, rows.columns[p], kFrames);
+      for (int f = 0; f < kFrames; ++f) {
+        sums[f][0] += rows.values[p] * LoadSlot(slot + GeneralRowsPlan::kRotatedStride * f);
+      }
+    }
+    for (int f = 0; f < kFrames; ++f) {
+      Slot total = sums[f][0];
+      for (int c = 1; c < kChains; ++c) total += sums[f][c];
+      StoreRow(outs[f], rows.rows[k], total);
+    }
   }
+}
+
+void MultiplyLongRowsImpl(const LongRowsView& rows, const double* __restrict rotated, int frames,
+                          double* const* outs, int first_row, int end_row) {
+  WithFrames(frames, [&](auto count) {
+    MultiplyLongRowsOfFrames<decltype(count)::value>(rows, rotated, outs, first_row, end_row);
+  });
 }
 
 void MultiplyRigidRowsImpl(const RigidGroupsView& groups, const double* rotations,

@@ -18,7 +18,7 @@
 #include <cstdint>
 #include <utility>
 
-#include "compile_time_count.h"
+#include "core/base/compile_time_count.h"
 #include "core/solver/supernodal_solve.h"
 
 #if defined(__AVX__)

@@ -1,6 +1,6 @@
 // A run-time count in a small range dispatched to code compiled for each count: a narrow
-// supernode's width, a batch's vectors per row, a batch's frames. Used by the kernel variants
-// (supernodal_solve_impl.h) and by the parallel solve's row copies.
+// supernode's width, a batch's vectors per row, a batch's frames. Used by the solver's and the
+// right-hand side's kernel variants and by the parallel solve's row copies.
 //
 // Everything here is in an anonymous namespace and only standard headers are included, so the
 // kernel variants, each built with its own instruction set, can include it without sharing a
