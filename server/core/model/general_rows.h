@@ -94,9 +94,8 @@ struct RowPacksView {
 // The kernels of one instruction set (internal/general_rows_kernel_*.cc).
 struct GeneralRowsKernel {
   // Blocks [first_block, end_block) of kSlotBlock slots of `frames` (1 to kMaxFramesSideBySide)
-  // frames: frame f's rotated
-  // delta of slot s (kRotatedStride doubles at kRotatedStride (s frames + f)) = slot_weights *
-  // (the group's blend of quaternions[f], 4 doubles x y z w each) * deltas.
+  // frames: frame f's rotated delta of slot s (kRotatedStride doubles at kRotatedStride (s frames
+  // + f)) = slot_weights * (the group's blend of quaternions[f], 4 doubles x y z w each) * deltas.
   void (*rotate)(const SlotGroupsView& groups, const double* const* quaternions, int frames,
                  const double* slot_weights, double* rotated, int first_block, int end_block);
   // Packs [first_pack, end_pack) of L'^T r of each of `frames` (1 to kMaxFramesSideBySide)
