@@ -574,16 +574,9 @@ void DeformationModel::MultiplyBatchPart(const MaterialFactorization& factorizat
   double* outs[kMaxBatchFrames] = {};
   for (int f = 0; f < count; ++f) outs[f] = scratches[f]->solution.data();
   const double* sums = factorization.rigid_row_sums_.data();
-  // A group of frames side by side at a time, its rigid rows right after its general rows, so
-  // that the output lines both write are written again while the group's outputs are cached.
-  constexpr int kGroup = GeneralRowsPlan::kMaxFramesSideBySide;
-  for (int group = 0; group < count; group += kGroup) {
-    const int frames = std::min(kGroup, count - group);
-    general_rows_.MultiplyGeneral(batch.rotated.data() + group * general_rows_.rotated_size(),
-                                  frames, outs + group, part, parts);
-    for (int f = group; f < group + frames; ++f) {
-      general_rows_.MultiplyRigid(scratches[f]->slot_rotations.data(), sums, outs[f], part, parts);
-    }
+  general_rows_.MultiplyGeneral(batch.rotated.data(), count, outs, part, parts);
+  for (int f = 0; f < count; ++f) {
+    general_rows_.MultiplyRigid(scratches[f]->slot_rotations.data(), sums, outs[f], part, parts);
   }
 }
 

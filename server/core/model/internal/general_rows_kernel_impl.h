@@ -38,7 +38,6 @@ inline Lanes Load(const double* p) {
   std::memcpy(&v, p, sizeof v);
   return v;
 }
-inline void Store(double* p, Lanes v) { std::memcpy(p, &v, sizeof v); }
 inline Lanes Broadcast(double x) {
   Lanes v;
   for (int l = 0; l < kLanes; ++l) v[l] = x;
