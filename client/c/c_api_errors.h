@@ -44,4 +44,20 @@ bool Missing(const T* pointer, const char* function, const char* what, deform_st
   return true;
 }
 
+// A getter's whole body: INVALID_ARGUMENT naming the parameter when `object` or `out` is null,
+// else *out = read(*object) and DEFORM_OK. `function` as for Guarded; the names as for Missing.
+template <typename Object, typename Out, typename Read>
+deform_status Get(const char* function, const Object* object, const char* object_name, Out* out,
+                  const char* out_name, Read&& read) noexcept {
+  return Guarded(function, [&] {
+    deform_status status;
+    if (Missing(object, function, object_name, &status) ||
+        Missing(out, function, out_name, &status)) {
+      return status;
+    }
+    *out = read(*object);
+    return Succeed();
+  });
+}
+
 }  // namespace deform::c_api

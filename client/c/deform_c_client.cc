@@ -94,6 +94,7 @@ static_assert(sizeof(deform_connect_options) == 88, "deform_connect_options' lay
 
 using deform::c_api::Fail;
 using deform::c_api::FromGrpc;
+using deform::c_api::Get;
 using deform::c_api::Guarded;
 using deform::c_api::Missing;
 using deform::c_api::Succeed;
@@ -183,51 +184,23 @@ deform_status deform_mesh_open(deform_client* client, const char* mesh_id, defor
 void deform_mesh_free(deform_mesh* mesh) { delete mesh; }
 
 deform_status deform_mesh_id(const deform_mesh* mesh, const char** id) {
-  const char* const fn = __func__;
-  return Guarded(fn, [&] {
-    deform_status status;
-    if (Missing(mesh, fn, "mesh", &status) || Missing(id, fn, "id", &status)) {
-      return status;
-    }
-    *id = mesh->summary.mesh_id().c_str();
-    return Succeed();
-  });
+  return Get(__func__, mesh, "mesh", id, "id",
+             [](const deform_mesh& m) { return m.summary.mesh_id().c_str(); });
 }
 
 deform_status deform_mesh_name(const deform_mesh* mesh, const char** name) {
-  const char* const fn = __func__;
-  return Guarded(fn, [&] {
-    deform_status status;
-    if (Missing(mesh, fn, "mesh", &status) || Missing(name, fn, "name", &status)) {
-      return status;
-    }
-    *name = mesh->summary.name().c_str();
-    return Succeed();
-  });
+  return Get(__func__, mesh, "mesh", name, "name",
+             [](const deform_mesh& m) { return m.summary.name().c_str(); });
 }
 
 deform_status deform_mesh_vertex_count(const deform_mesh* mesh, uint32_t* count) {
-  const char* const fn = __func__;
-  return Guarded(fn, [&] {
-    deform_status status;
-    if (Missing(mesh, fn, "mesh", &status) || Missing(count, fn, "count", &status)) {
-      return status;
-    }
-    *count = mesh->summary.vertex_count();
-    return Succeed();
-  });
+  return Get(__func__, mesh, "mesh", count, "count",
+             [](const deform_mesh& m) { return m.summary.vertex_count(); });
 }
 
 deform_status deform_mesh_triangle_count(const deform_mesh* mesh, uint32_t* count) {
-  const char* const fn = __func__;
-  return Guarded(fn, [&] {
-    deform_status status;
-    if (Missing(mesh, fn, "mesh", &status) || Missing(count, fn, "count", &status)) {
-      return status;
-    }
-    *count = mesh->summary.triangle_count();
-    return Succeed();
-  });
+  return Get(__func__, mesh, "mesh", count, "count",
+             [](const deform_mesh& m) { return m.summary.triangle_count(); });
 }
 
 deform_status deform_mesh_rest_geometry(deform_mesh* mesh, float* positions, size_t capacity_floats,
@@ -264,15 +237,8 @@ deform_status deform_mesh_rest_geometry(deform_mesh* mesh, float* positions, siz
 }
 
 deform_status deform_mesh_joint_count(const deform_mesh* mesh, uint32_t* count) {
-  const char* const fn = __func__;
-  return Guarded(fn, [&] {
-    deform_status status;
-    if (Missing(mesh, fn, "mesh", &status) || Missing(count, fn, "count", &status)) {
-      return status;
-    }
-    *count = static_cast<uint32_t>(mesh->summary.joints_size());
-    return Succeed();
-  });
+  return Get(__func__, mesh, "mesh", count, "count",
+             [](const deform_mesh& m) { return static_cast<uint32_t>(m.summary.joints_size()); });
 }
 
 deform_status deform_mesh_joint(const deform_mesh* mesh, uint32_t joint, deform_joint_info* info) {

@@ -124,6 +124,7 @@ deform_status SendPose(deform_stream* stream, v1::PoseUpdate* pose, std::uint64_
 
 using deform::c_api::Fail;
 using deform::c_api::FromGrpc;
+using deform::c_api::Get;
 using deform::c_api::Guarded;
 using deform::c_api::Missing;
 using deform::c_api::Succeed;
@@ -173,15 +174,8 @@ deform_status deform_stream_open(deform_client* client, const char* mesh_id,
 }
 
 deform_status deform_stream_vertex_count(const deform_stream* stream, uint32_t* count) {
-  const char* const fn = __func__;
-  return Guarded(fn, [&] {
-    deform_status status;
-    if (Missing(stream, fn, "stream", &status) || Missing(count, fn, "count", &status)) {
-      return status;
-    }
-    *count = stream->vertex_count;
-    return Succeed();
-  });
+  return Get(__func__, stream, "stream", count, "count",
+             [](const deform_stream& s) { return s.vertex_count; });
 }
 
 deform_status deform_stream_send_pose(deform_stream* stream, const deform_joint_angle* angles,

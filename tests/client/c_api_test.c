@@ -261,6 +261,11 @@ static void test_arguments_without_a_server(void) {
   CHECK(strcmp(deform_status_name(-3), "UNKNOWN_STATUS") == 0);
   CHECK(deform_stream_next_frame(NULL, NULL, 0, 0, NULL) == DEFORM_INVALID_ARGUMENT);
   CHECK(strcmp(deform_last_error(), "deform_stream_next_frame: stream is NULL") == 0);
+  uint32_t count = 7;
+  CHECK(deform_mesh_vertex_count(NULL, &count) == DEFORM_INVALID_ARGUMENT && count == 7);
+  CHECK(strcmp(deform_last_error(), "deform_mesh_vertex_count: mesh is NULL") == 0);
+  CHECK(deform_stream_vertex_count(NULL, &count) == DEFORM_INVALID_ARGUMENT && count == 7);
+  CHECK(strcmp(deform_last_error(), "deform_stream_vertex_count: stream is NULL") == 0);
   deform_client_free(NULL);
   deform_mesh_free(NULL);
   deform_stream_free(NULL);
@@ -273,6 +278,8 @@ static void test_phantom_session(const char* target) {
   const char* mesh_id = NULL;
   const char* name = NULL;
   CHECK(deform_mesh_id(mesh, &mesh_id) == DEFORM_OK && strncmp(mesh_id, "mesh-", 5) == 0);
+  CHECK(deform_mesh_name(mesh, NULL) == DEFORM_INVALID_ARGUMENT);
+  CHECK(strcmp(deform_last_error(), "deform_mesh_name: name is NULL") == 0);
   CHECK(deform_mesh_name(mesh, &name) == DEFORM_OK && strcmp(name, "c-api phantom") == 0);
   uint32_t n = 0, triangles = 0;
   CHECK(deform_mesh_vertex_count(mesh, &n) == DEFORM_OK && n > 1000);
