@@ -17,6 +17,7 @@
 #include "core/model/body_binding.h"
 #include "core/model/rigid_cores.h"
 #include "core/model/weight_binding.h"
+#include "core/solver/parallel_solve.h"
 
 namespace deform {
 namespace {
@@ -407,16 +408,8 @@ bool DeformationModel::DeformBatch(const MaterialFactorization& factorization,
     return true;
   }
   const auto start = Clock::now();
-  if (linear_blend_plan_) {
-    for (int f = 0; f < count; ++f) {
-      AssembleOwnedRightHandSide(factorization, *poses[f], scratches[f]);
-    }
-  } else {
-    PrepareBatchFrames(poses, scratches, count);
-    RotateBatchPart(factorization, scratches, count, batch, 0, 1);
-    MultiplyBatchPart(factorization, scratches, count, *batch, 0, 1);
-    AddBatchTargetsPart(poses, scratches, count, 0, 1);
-  }
+  SerialRunner serial;
+  AssembleBatch(factorization, poses, scratches, count, batch, &serial, 1);
   // Each frame's right-hand side is solved where it is: the batched solve gathers the frames'
   // rows into its own and scatters the solutions back.
   double* solutions[kMaxBatchFrames];
@@ -589,7 +582,7 @@ void DeformationModel::AddBatchTargetsPart(const Pose* const* poses,
   }
 }
 
-struct DeformationModel::ParallelBatchAssembly {
+struct DeformationModel::BatchAssembly {
   const DeformationModel* model;
   const MaterialFactorization* factorization;
   const Pose* const* poses;
@@ -600,24 +593,39 @@ struct DeformationModel::ParallelBatchAssembly {
 
   // The linear blend: frame `index`'s right-hand side, whole, on the thread that takes it.
   static void Assemble(void* context, int index) {
-    const auto& a = *static_cast<const ParallelBatchAssembly*>(context);
+    const auto& a = *static_cast<const BatchAssembly*>(context);
     a.model->AssembleOwnedRightHandSide(*a.factorization, *a.poses[index], a.scratches[index]);
   }
   // The quaternion blend's steps (RotateBatchPart and on), each once every part of the one
   // before is done.
   static void Rotate(void* context, int index) {
-    const auto& a = *static_cast<const ParallelBatchAssembly*>(context);
+    const auto& a = *static_cast<const BatchAssembly*>(context);
     a.model->RotateBatchPart(*a.factorization, a.scratches, a.count, a.batch, index, a.parts);
   }
   static void Multiply(void* context, int index) {
-    const auto& a = *static_cast<const ParallelBatchAssembly*>(context);
+    const auto& a = *static_cast<const BatchAssembly*>(context);
     a.model->MultiplyBatchPart(*a.factorization, a.scratches, a.count, *a.batch, index, a.parts);
   }
   static void Targets(void* context, int index) {
-    const auto& a = *static_cast<const ParallelBatchAssembly*>(context);
+    const auto& a = *static_cast<const BatchAssembly*>(context);
     a.model->AddBatchTargetsPart(a.poses, a.scratches, a.count, index, a.parts);
   }
 };
+
+void DeformationModel::AssembleBatch(const MaterialFactorization& factorization,
+                                     const Pose* const* poses, DeformScratch* const* scratches,
+                                     int count, DeformBatchScratch* batch, ParallelRunner* runner,
+                                     int parts) const {
+  BatchAssembly assembly{this, &factorization, poses, scratches, count, batch, parts};
+  if (linear_blend_plan_) {
+    runner->Run(count, &BatchAssembly::Assemble, &assembly);
+    return;
+  }
+  PrepareBatchFrames(poses, scratches, count);
+  runner->Run(parts, &BatchAssembly::Rotate, &assembly);
+  runner->Run(parts, &BatchAssembly::Multiply, &assembly);
+  runner->Run(parts, &BatchAssembly::Targets, &assembly);
+}
 
 bool DeformationModel::DeformBatchParallel(const MaterialFactorization& factorization,
                                            const Pose* const* poses,
@@ -633,15 +641,7 @@ bool DeformationModel::DeformBatchParallel(const MaterialFactorization& factoriz
   assert(fits && "a batch scratch made without this plan");
   if (!fits) return false;
   const auto start = Clock::now();
-  ParallelBatchAssembly assembly{this, &factorization, poses, scratches, count, batch, plan.parts};
-  if (linear_blend_plan_) {
-    runner->Run(count, &ParallelBatchAssembly::Assemble, &assembly);
-  } else {
-    PrepareBatchFrames(poses, scratches, count);
-    runner->Run(plan.parts, &ParallelBatchAssembly::Rotate, &assembly);
-    runner->Run(plan.parts, &ParallelBatchAssembly::Multiply, &assembly);
-    runner->Run(plan.parts, &ParallelBatchAssembly::Targets, &assembly);
-  }
+  AssembleBatch(factorization, poses, scratches, count, batch, runner, plan.parts);
   double* solutions[kMaxBatchFrames];
   for (int f = 0; f < count; ++f) solutions[f] = scratches[f]->solution.data();
   const auto solve_start = Clock::now();

@@ -356,8 +356,14 @@ class DeformationModel {
                         int part, int parts) const;
   void MultiplyRotatedPart(const MaterialFactorization& factorization, DeformScratch* scratch,
                            int part, int parts) const;
-  struct ParallelAssembly;       // DeformParallel's parts
-  struct ParallelBatchAssembly;  // DeformBatchParallel's parts
+  struct ParallelAssembly;  // DeformParallel's parts
+  struct BatchAssembly;     // AssembleBatch's parts
+  // The right-hand sides of a batch (DeformBatch, DeformBatchParallel), each step's parts run
+  // through `runner`: under the linear blend a frame a part, under the quaternion blend `parts`
+  // parts of each step below.
+  void AssembleBatch(const MaterialFactorization& factorization, const Pose* const* poses,
+                     DeformScratch* const* scratches, int count, DeformBatchScratch* batch,
+                     ParallelRunner* runner, int parts) const;
   // The quaternion blend's batch of right-hand sides, in steps whose parts are independent: each
   // frame's forward kinematics and signed quaternions (PrepareSlotRotations), then part `part` of
   // `parts` of every frame's rotated deltas into batch->rotated, then of every frame's rows of
