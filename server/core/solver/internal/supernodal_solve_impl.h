@@ -236,7 +236,7 @@ inline void SubtractRow1x3(const Value* __restrict row, const double* __restrict
 // The factor's values are read as one stream: ascending in the forward pass, supernode after
 // supernode, and descending supernode by supernode in the backward pass. Each pass asks for the
 // bytes it will read kPrefetchBytes later (ahead in the forward pass, below in the backward pass)
-// as it reads the ones in hand (all but the three-column backward pass: see BackwardUpdate), so
+// as it reads the ones in hand (the three-column backward pass in its own way: see kStripVecs), so
 // that a factor larger than the cache arrives while the kernel computes instead of after it:
 // without it the 133k arm's solve took about the sum of its arithmetic (factor made cache-resident)
 // and of reading its factor from memory, not the larger of the two. Into the outer caches
@@ -304,6 +304,18 @@ inline void PrefetchLine(std::uintptr_t address) {
 #else
   __builtin_prefetch(reinterpret_cast<const void*>(address), 0, 1);
 #endif
+}
+
+// Asks for the cache lines of [address, address + bytes) into the nearest cache (prefetcht0).
+inline void PrefetchLinesNearest(std::uintptr_t address, std::ptrdiff_t bytes) {
+  const std::uintptr_t end = address + static_cast<std::uintptr_t>(bytes);
+  for (std::uintptr_t line = address & ~std::uintptr_t{63}; line < end; line += 64) {
+#if defined(__x86_64__) || defined(__i386__)
+    asm volatile("prefetcht0 %0" : : "m"(*reinterpret_cast<const char*>(line)));
+#else
+    __builtin_prefetch(reinterpret_cast<const void*>(line), 0, 3);
+#endif
+  }
 }
 
 enum class Pass { kForward, kBackward };
@@ -539,16 +551,23 @@ inline void ForEachBackwardChunk(const SupernodeBlock<Value>& s, int row_stride,
 // times the forward pass's samples over the same bytes; with strips 1.24 (perf of the harness
 // below) and 1.34 (of deform_bench).
 //
-// The three-column backward pass does not prefetch the factor: read as this descending stream,
-// the core's own prefetchers keep up, and software prefetches got in their way. Alternately in one
-// process (AVX2, Zen 3, DRAM 16.6 GB/s on one core), medians of 40 solves: the arm's Solve3 26.7
-// ms with strips and no prefetch, 27.6 with the diagonal blocks' prefetches only, 30.3 with all,
-// 29.7 for the rows four at a time as before (with all); the 26k leg's (100 solves) 2.81, 2.92,
-// 2.90 and 2.87 ms. In an earlier round the rows four at a time took 37.2 without prefetches
-// against 36.0 with them: they needed them. The batched backward pass keeps its prefetches:
-// without them the 26k leg's batch of eight took 10.0 against 9.2 ms, the arm's 64.2 against
-// 60.3.
+// The three-column backward pass prefetches a factor that streams from memory in its own way.
+// Each strip of columns reads a few lines of every row of a chunk, rows a block's width apart, so
+// the first strip takes every row's lines as misses in a pattern the core's prefetchers do not
+// follow. So the first strip of a chunk asks, as it reads row r, for row r - kBackwardRowsAhead
+// whole into the nearest cache (every strip after it then reads the chunk from there), and for
+// row r's lines kPrefetchBytes below into the outer caches, as the other passes do. On a Zen 5
+// EPYC VM with AVX-512 (DRAM read 29-33 GB/s on one core), deform_bench alternately in one build,
+// four rounds: the arm's TriangularSolve 13.8-14.1 ms against 15.4-16.7 without (its DRAM bound
+// 8.6-9.4), the 26k leg's 1.35-1.42 against 1.33-1.83; either prefetch alone gained about half
+// (the nearest-cache one alone 14.4-14.9 ms on the arm, the outer-cache one alone nothing), and
+// 8 or 32 rows ahead measured alike. (On a Zen 3 VM with 16.6 GB/s, with the strips, the
+// outer-cache prefetch of every line, the diagonal blocks' included, made the arm's solve slower:
+// 30.3 against 26.7 ms with none, medians of 40 solves; this pair has not been measured there.) The
+// batched backward pass prefetches a line a row (BackwardColumnsMany): without it the 26k leg's
+// batch of eight took 10.0 against 9.2 ms there.
 constexpr int kStripVecs = 4;
+constexpr std::int64_t kBackwardRowsAhead = 16;
 
 // p's columns [first, first + 4 kVecs) -= sum over rows [begin, end) below `supernode`'s
 // diagonal block (block row r there) * y[rows[r]], the rows taken last first.
@@ -558,10 +577,17 @@ inline void BackwardStrip(const SupernodeBlock<Value>& supernode, const Planar& 
   const Value* __restrict block = supernode.values + first;
   const int* __restrict rows = supernode.rows;
   const int width = supernode.width;
+  const bool prefetch = supernode.prefetch && first == 0;
+  const std::uintptr_t values = reinterpret_cast<std::uintptr_t>(supernode.values);
+  const std::ptrdiff_t row_bytes = width * static_cast<std::ptrdiff_t>(sizeof(Value));
   Vec4 sx[kVecs], sy[kVecs], sz[kVecs];
   for (int v = 0; v < kVecs; ++v) sx[v] = sy[v] = sz[v] = Splat4(0);
   for (std::int64_t r = end - 1; r >= begin; --r) {
     const Value* row = block + r * width;
+    if (prefetch) {
+      PrefetchLinesNearest(values + (r - kBackwardRowsAhead) * row_bytes, row_bytes);
+      PrefetchFactor<Pass::kBackward>(supernode, supernode.values + r * width, width);
+    }
     const double* solved = Row(y, rows[r]);
     const Vec4 bx = Splat4(solved[0]), by = Splat4(solved[1]), bz = Splat4(solved[2]);
     for (int v = 0; v < kVecs; ++v) {
@@ -789,19 +815,27 @@ constexpr int BatchVecsFor(int columns) { return (columns + kBatchLanes - 1) / k
 // accumulators (at most sixteen vectors), one strip of loaded vectors and a broadcast fit the
 // registers.
 //
-// With AVX-512's thirty-two registers a whole row is one strip (a batch of eight frames: 3
-// vectors, in blocks of 4 rows). With sixteen (AVX2, and SSE2's pairs) strips of at most three
-// vectors, in blocks of 4 rows: 12 accumulators, 3 loaded vectors and a broadcast. A whole row of
-// eight frames (6 vectors) allowed blocks of 2 rows only, and even their 12 accumulators and 6
-// loaded vectors did not fit: GCC read the solved vectors from memory at each multiply-add and
-// kept sums on the stack. With strips (and SubtractSolvedColumns inlined), against whole rows
-// (and it called), medians of four to six rounds alternating in one process (AVX2, Zen 3), a
-// batch of eight frames: 0.32 against 0.38 ms on the 1.6k leg, 104 against 115 on the arm, and
-// 16.0 against 16.0 on the 26k leg, whose batch's 5 MB of solution rows (24 columns each) are
+// With AVX-512's thirty-two registers a strip is one vector, in blocks of 8 rows: each loaded
+// solved vector serves eight rows. Against a whole row as one strip (a batch of eight frames: 3
+// vectors in blocks of 4 rows; sixteen: 6 in blocks of 2), alternately in one run on a Zen 5
+// EPYC VM (DRAM read 29-33 GB/s on one core), deform_bench's BatchedSolve: the 26k leg's four
+// frames 2.77-2.93 against 3.56-3.77 ms, eight 4.17-4.26 against 5.54-5.74, sixteen 7.83-8.15
+// against 16.3; the 1.6k leg's eight 0.109-0.114 against 0.148-0.154; the arm's eight 32.8-33.5
+// against 40.5-40.9. Strips of at most three vectors (as AVX2's) or two measured between the two.
+// ParallelBatchedSolve (the parts' lists on two threads) gained at four frames (26k leg 1.50-1.55
+// against 2.07-2.24 ms, arm 12.2-12.8 against 15.6-16.0) and lost a little at eight (2.22-2.30
+// against 2.08-2.24, arm 16.1-18.5 against 15.7-15.8). With sixteen (AVX2, and SSE2's pairs) strips
+// of at most three vectors, in blocks of 4 rows: 12 accumulators, 3 loaded vectors and a broadcast.
+// A whole row of eight frames (6 vectors) allowed blocks of 2 rows only, and even their 12
+// accumulators and 6 loaded vectors did not fit: GCC read the solved vectors from memory at each
+// multiply-add and kept sums on the stack. With strips (and SubtractSolvedColumns inlined), against
+// whole rows (and it called), medians of four to six rounds alternating in one process (AVX2, Zen
+// 3), a batch of eight frames: 0.32 against 0.38 ms on the 1.6k leg, 104 against 115 on the arm,
+// and 16.0 against 16.0 on the 26k leg, whose batch's 5 MB of solution rows (24 columns each) are
 // ten times the core's 512 KB L2 (the likely bound there). Strips of two were no faster.
 #if defined(__AVX512F__)
 constexpr int kBatchRegisters = 32;
-constexpr int StripsFor(int) { return 1; }
+constexpr int StripsFor(int vecs) { return vecs; }
 #else
 constexpr int kBatchRegisters = 16;
 constexpr int StripsFor(int vecs) { return (vecs + 2) / 3; }
