@@ -4,6 +4,7 @@
 // compiled variant gives the same answer.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 
 namespace deform {
@@ -119,18 +120,24 @@ inline int BatchRowStride(int lanes, int columns) {
 // 4.28-4.40).
 inline constexpr int kBatchRowsAhead = 8;
 
-// Asks for the cache lines of `doubles` doubles from `row` into the nearest cache (prefetcht0;
-// inline assembly on x86, as PrefetchLine in supernodal_solve_impl.h explains).
-inline void PrefetchBatchRow(const double* row, int doubles) {
-  const std::uintptr_t begin = reinterpret_cast<std::uintptr_t>(row) & ~std::uintptr_t{63};
-  const std::uintptr_t end = reinterpret_cast<std::uintptr_t>(row + doubles);
-  for (std::uintptr_t line = begin; line < end; line += 64) {
+// Asks for the cache lines of [address, address + bytes) into the nearest cache (prefetcht0;
+// inline assembly on x86, as PrefetchLine in supernodal_solve_impl.h explains). The address is an
+// integer, so it may lie outside any array (a prefetch never faults).
+inline void PrefetchLinesNearest(std::uintptr_t address, std::ptrdiff_t bytes) {
+  const std::uintptr_t end = address + static_cast<std::uintptr_t>(bytes);
+  for (std::uintptr_t line = address & ~std::uintptr_t{63}; line < end; line += 64) {
 #if defined(__x86_64__) || defined(__i386__)
     asm volatile("prefetcht0 %0" : : "m"(*reinterpret_cast<const char*>(line)));
 #else
     __builtin_prefetch(reinterpret_cast<const void*>(line), 0, 3);
 #endif
   }
+}
+
+// The cache lines of `doubles` doubles from `row`, into the nearest cache.
+inline void PrefetchBatchRow(const double* row, int doubles) {
+  PrefetchLinesNearest(reinterpret_cast<std::uintptr_t>(row),
+                       static_cast<std::ptrdiff_t>(doubles) * sizeof(double));
 }
 
 // One kernel's passes: supernodal_solve_impl.h compiled for its instruction set.

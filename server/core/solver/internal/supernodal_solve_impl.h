@@ -306,18 +306,6 @@ inline void PrefetchLine(std::uintptr_t address) {
 #endif
 }
 
-// Asks for the cache lines of [address, address + bytes) into the nearest cache (prefetcht0).
-inline void PrefetchLinesNearest(std::uintptr_t address, std::ptrdiff_t bytes) {
-  const std::uintptr_t end = address + static_cast<std::uintptr_t>(bytes);
-  for (std::uintptr_t line = address & ~std::uintptr_t{63}; line < end; line += 64) {
-#if defined(__x86_64__) || defined(__i386__)
-    asm volatile("prefetcht0 %0" : : "m"(*reinterpret_cast<const char*>(line)));
-#else
-    __builtin_prefetch(reinterpret_cast<const void*>(line), 0, 3);
-#endif
-  }
-}
-
 enum class Pass { kForward, kBackward };
 
 // The factor's lines at distance kPrefetchBytes from [values, values + count) of `s`'s block in
