@@ -49,6 +49,18 @@ bool SolveKernelAvailable(SolveKernel kernel) {
   return false;
 }
 
+bool ForwardStreamIsNonTemporal() {
+#if defined(__x86_64__) || defined(__i386__)
+  static const bool amd = [] {
+    __builtin_cpu_init();  // may run during static initialisation (supernodal_solve_impl.h)
+    return __builtin_cpu_is("amd") != 0;
+  }();
+  return amd;
+#else
+  return false;
+#endif
+}
+
 SolveKernel BestSolveKernel() {
   static const SolveKernel best = [] {
     for (const SolveKernel kernel : {SolveKernel::kAvx512, SolveKernel::kAvx2Fma}) {

@@ -140,6 +140,12 @@ inline void PrefetchBatchRow(const double* row, int doubles) {
                        static_cast<std::ptrdiff_t>(doubles) * sizeof(double));
 }
 
+// Whether the three-column forward pass asks for a factor streamed from memory non-temporally
+// (prefetchnta: into the nearest cache, not kept in the outer ones as it leaves) rather than into
+// the outer caches: on AMD's processors, whose last-level cache is filled by what the cores' L2
+// evicts (measured: kPrefetchBytes in supernodal_solve_impl.h). Decided once, by the CPU's vendor.
+bool ForwardStreamIsNonTemporal();
+
 // One kernel's passes: supernodal_solve_impl.h compiled for its instruction set.
 struct SolveKernelFunctions {
   Solve3Function solve3;

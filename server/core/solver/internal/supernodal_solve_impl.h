@@ -240,9 +240,23 @@ inline void SubtractRow1x3(const Value* __restrict row, const double* __restrict
 // that a factor larger than the cache arrives while the kernel computes instead of after it:
 // without it the 133k arm's solve took about the sum of its arithmetic (factor made cache-resident)
 // and of reading its factor from memory, not the larger of the two. Into the outer caches
-// (prefetcht2): a non-temporal hint was twice as slow. The distance and the hint were chosen by
-// measurement (deform_bench's TriangularSolve and BatchedSolve on the arm; 8 to 64 KB measured
-// alike).
+// (prefetcht2), except the three-column forward pass's on AMD processors (below). The distance and
+// the hint were chosen by measurement (deform_bench's TriangularSolve and BatchedSolve on the arm;
+// 8 to 64 KB measured alike).
+//
+// The hint. On the 2.6 GHz Xeon VM (DRAM read 10-12 GB/s on one core) a non-temporal hint
+// (prefetchnta) for both passes was twice as slow. On the Zen 5 EPYC VM (DRAM read 29-37 GB/s) the
+// three-column forward pass with it reads the arm's 151 MB factor at about the stream rate: that
+// pass alone 4.5-5.4 ms against 5.1-6.2 into the outer caches; the arm's TriangularSolve, medians
+// of eight rounds alternately in one build, 11.5 against 14.5 ms, and against the build before,
+// twenty rounds, 13.8 against 15.3 (0.91x by round); the 26k leg's and the batched passes alike.
+// Likely why: AMD's last-level cache is filled by what a core's L2 evicts, and a line fetched
+// non-temporally is not put there, so the forward pass's stream neither spends that traffic nor
+// evicts the lines of the factor that the backward pass left there. The same hint in the
+// three-column backward pass (for its outer-cache prefetch, or for all of its prefetches) and in
+// the batched passes measured slower there (bench/RESULTS.md), so they keep prefetcht2, as do
+// other vendors' processors, where this pass has not been measured alone
+// (ForwardStreamIsNonTemporal).
 constexpr std::ptrdiff_t kPrefetchBytes = 16384;
 // A factor that fits a core's own cache (2 MiB of L2 on the machines measured) is not
 // prefetched: it stays there between solves, and the prefetches only cost issue slots (the 1.6k
@@ -271,6 +285,9 @@ struct SupernodeBlock {
   bool prefetch;          // the factor is streamed from memory (StreamsFromMemory)
 };
 
+// ForwardStreamIsNonTemporal(), read once (see kPrefetchBytes).
+const bool kForwardStreamIsNonTemporal = ForwardStreamIsNonTemporal();
+
 // The factor's values as stored: double, or float32 (widened to double as they are read).
 template <typename Value>
 inline const Value* ValuesOf(const SupernodalFactorView& f);
@@ -294,15 +311,24 @@ inline SupernodeBlock<Value> BlockOf(const SupernodalFactorView& f, int sn) {
                                StreamsFromMemory<Value>(f)};
 }
 
-// Asks for the cache line at `address` into the outer caches (prefetcht2). Inline assembly on
-// x86: GCC 12's mod/ref analysis counts __builtin_prefetch as no side effect, and deleted every
-// call of PrefetchFactor as a function that does nothing (none were left in the objects; with
-// -fno-ipa-modref they stay).
+// How a prefetch asks for a line: into the outer caches (prefetcht2), or into the nearest cache
+// without being put into the outer ones when it leaves (prefetchnta; see kPrefetchBytes).
+enum class Hint { kOuterCaches, kNonTemporal };
+
+// Asks for the cache line at `address` with `kHint`. Inline assembly on x86: GCC 12's mod/ref
+// analysis counts __builtin_prefetch as no side effect, and deleted every call of PrefetchFactor as
+// a function that does nothing (none were left in the objects; with -fno-ipa-modref they stay).
+template <Hint kHint = Hint::kOuterCaches>
 inline void PrefetchLine(std::uintptr_t address) {
 #if defined(__x86_64__) || defined(__i386__)
-  asm volatile("prefetcht2 %0" : : "m"(*reinterpret_cast<const char*>(address)));
+  if constexpr (kHint == Hint::kNonTemporal) {
+    asm volatile("prefetchnta %0" : : "m"(*reinterpret_cast<const char*>(address)));
+  } else {
+    asm volatile("prefetcht2 %0" : : "m"(*reinterpret_cast<const char*>(address)));
+  }
 #else
-  __builtin_prefetch(reinterpret_cast<const void*>(address), 0, 1);
+  __builtin_prefetch(reinterpret_cast<const void*>(address), 0,
+                     kHint == Hint::kNonTemporal ? 0 : 1);
 #endif
 }
 
@@ -335,18 +361,25 @@ struct SpreadPrefetch {
   void Step(std::ptrdiff_t k) const {
     if (k < lines) PrefetchLine(begin + 64 * static_cast<std::uintptr_t>(k));
   }
+  template <Hint kHint = Hint::kOuterCaches>
   void Rest(std::ptrdiff_t steps) const {
     for (std::ptrdiff_t k = steps; k < lines; ++k) {
-      PrefetchLine(begin + 64 * static_cast<std::uintptr_t>(k));
+      PrefetchLine<kHint>(begin + 64 * static_cast<std::uintptr_t>(k));
     }
   }
 };
 
-// All of SpreadPrefetch's lines at once.
+// All of SpreadPrefetch's lines at once: the three-column passes' prefetch, non-temporal in the
+// forward pass where kForwardStreamIsNonTemporal.
 template <Pass kPass, typename Value>
 inline void PrefetchFactor(const SupernodeBlock<Value>& s, const Value* values,
                            std::ptrdiff_t count) {
-  SpreadPrefetch::Of<kPass>(s, values, count).Rest(0);
+  const SpreadPrefetch lines = SpreadPrefetch::Of<kPass>(s, values, count);
+  if (kPass == Pass::kForward && kForwardStreamIsNonTemporal) {
+    lines.Rest<Hint::kNonTemporal>(0);
+  } else {
+    lines.Rest(0);
+  }
 }
 
 // The solution rows during the solve (supernodal_solve.h).
