@@ -466,6 +466,7 @@ inline void BackwardDiagonal(const SupernodeBlock<Value>& supernode, double* __r
     const Value* r1 = r0 + width;
     const Value* r2 = r1 + width;
     const Value* r3 = r2 + width;
+    PrefetchFactor<Pass::kBackward>(supernode, r0, 4 * width);
     double* in[3] = {p.x + f, p.y + f, p.z + f};
     double solved[12];  // solved[3 j + d]: unknown f + j, column d
     const double i0 = 1.0 / r0[f], i1 = 1.0 / r1[f + 1], i2 = 1.0 / r2[f + 2], i3 = 1.0 / r3[f + 3];
@@ -491,6 +492,7 @@ inline void BackwardDiagonal(const SupernodeBlock<Value>& supernode, double* __r
   for (; c > 0; --c) {
     const int f = c - 1;
     const Value* row = block + static_cast<std::ptrdiff_t>(f) * width;
+    PrefetchFactor<Pass::kBackward>(supernode, row, width);
     const double inverse = 1.0 / row[f];
     const double solved[3] = {p.x[f] * inverse, p.y[f] * inverse, p.z[f] * inverse};
     double* t = Row(ys, f);
@@ -587,6 +589,15 @@ inline void ForEachBackwardChunk(const SupernodeBlock<Value>& s, int row_stride,
 // 30.3 against 26.7 ms with none, medians of 40 solves; this pair has not been measured there.) The
 // batched backward pass prefetches a line a row (BackwardColumnsMany): without it the 26k leg's
 // batch of eight took 10.0 against 9.2 ms there.
+//
+// Its diagonal blocks (BackwardDiagonal, a block of four rows at a time) and its narrow
+// supernodes' rows below (at once, as the forward pass's) ask for their lines kPrefetchBytes below
+// too, so that the stream of requests runs on without a gap while the pass reads them (the arm's
+// diagonal blocks are 28 of its 151 MB): until then the bytes below each diagonal block were
+// asked for by nobody. The Zen 5 VM (DRAM read 31-36 GB/s), six rounds alternately against the
+// build before: the arm's TriangularSolve 10.2-12.0 ms (median 11.0) against 11.2-14.1 (12.1), its
+// solve with the caches emptied first 12.8-14.0 against 12.5-15.4, its float32 factor's 8.2-8.7
+// against 8.3-9.5; the 26k leg's TriangularSolve 1.20-1.29 against 1.25-1.32.
 constexpr int kStripVecs = 4;
 constexpr std::int64_t kBackwardRowsAhead = 16;
 
@@ -739,6 +750,8 @@ inline void BackwardSupernode(const SupernodalFactorView& f, int sn, double* __r
   if (s.width > 4) {
     BackwardUpdate(s, p, y);
   } else {
+    PrefetchFactor<Pass::kBackward>(s, s.values + s.width * s.width,
+                                    (s.num_rows - s.width) * s.width);
     WithCount<4>(s.width, [&](auto w) {
       BackwardUpdateNarrow<Value, decltype(w)::value>(s.values, s.rows, s.num_rows, p, y);
     });
