@@ -10,7 +10,7 @@
 #               tests on the large shared meshes as they are (the slowest takes ~16 s). The
 #               benchmarks' ctest tests (bench/animation) are not built here (Release suite only).
 #               Leaks: scripts/sanitizers/lsan.supp lists OpenMesh's one-time registry only.
-#   TSan:       build-tsan ($DEFORM_TSAN_BUILD_DIR), deform_service_tests, run on the suites in
+#   TSan:       build-tsan ($DEFORM_TSAN_BUILD_DIR), the service's test programs (TSAN_PROGRAMS), run on the suites in
 #               TSAN_SUITES: the frame slots, outbox, pending pose, write pump, shared reactor,
 #               stiffness switch, worker pool and its parallel runner, registry, token table and the allocation-free
 #               frame paths, where threads meet through our mutexes, condition variables and
@@ -19,7 +19,7 @@
 #               protobuf and absl are not instrumented, so the handover between gRPC's threads
 #               (absl::Mutex on futexes, atomics inside libgrpc) is invisible and TSan reports
 #               every reactor callback as racing with the reactor's constructor (10,517 reports
-#               in one run of deform_service_tests, ~70 with our reactor code on top); hiding
+#               in one run of the service tests, ~70 with our reactor code on top); hiding
 #               them would mean suppressing our own code. Those tests run under ASan+UBSan above.
 #               scripts/sanitizers/tsan.supp is for third-party code only and lists nothing.
 #
@@ -35,8 +35,11 @@ TSAN_DIR="${DEFORM_TSAN_BUILD_DIR:-build-tsan}"
 only="${1:-all}"  # all, asan or tsan
 # What ctest runs in build-asan: every test program, and what the process tests execute.
 TSAN_SUITES=(AnnotatedMutexTest DeformOutboxTest FrameSlotsTest FrameSolverTest PendingPoseSlotTest
-  PoseInputTest SharedReactorTest StiffnessSwitchTest StreamWritePumpTest WorkerPoolTest
-  MeshRegistryTest StatusMappingTest TokenTableTest PoolRunnerTest)
+  PoseInputTest SelfOwningHandlerTest StiffnessSwitchTest StreamWritePumpTest WorkerPoolTest
+  MeshRegistryTest StatusMappingTest TokenTableTest WorkerPoolParallelRunnerTest)
+# The test programs (one per service layer, tests/service/<layer>) that hold those suites.
+TSAN_PROGRAMS=(deform_service_base_tests deform_service_workers_tests deform_service_registry_tests
+  deform_service_transport_tests deform_service_deform_tests deform_service_access_tests)
 
 scripts/install-deps.sh scripts/packages/build.txt scripts/packages/checks.txt
 launcher=()
@@ -63,18 +66,22 @@ fi
 if [ "$only" = all ] || [ "$only" = tsan ]; then
   tsan_start=$(date +%s)
   configure_tsan_build "$TSAN_DIR"
-  cmake --build "$TSAN_DIR" --parallel "$(nproc)" --target deform_service_tests
+  cmake --build "$TSAN_DIR" --parallel "$(nproc)" --target "${TSAN_PROGRAMS[@]}"
   echo "check-sanitizers: TSan build done after $(($(date +%s) - tsan_start)) s"
   export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:suppressions=$PWD/scripts/sanitizers/tsan.supp"
   filter=$(printf '%s.*:' "${TSAN_SUITES[@]}")
-  listed=$("$TSAN_DIR/tests/deform_service_tests" --gtest_list_tests --gtest_filter="${filter%:}")
+  listed=""
+  for program in "${TSAN_PROGRAMS[@]}"; do
+    listed+=$("$TSAN_DIR/tests/$program" --gtest_list_tests --gtest_filter="${filter%:}")$'\n'
+  done
   for suite in "${TSAN_SUITES[@]}"; do  # a renamed suite must not leave the check empty
     grep -qx "$suite\." <<<"$listed" ||
-      { echo "check-sanitizers: no suite $suite in deform_service_tests" >&2; exit 1; }
+      { echo "check-sanitizers: no suite $suite in ${TSAN_PROGRAMS[*]}" >&2; exit 1; }
   done
-  # Five rounds for more interleavings (the 55 tests take under a second a round).
-  "$TSAN_DIR/tests/deform_service_tests" --gtest_brief=1 --gtest_filter="${filter%:}" \
-    --gtest_repeat=5
+  # Five rounds for more interleavings (the suites take under a second a round).
+  for program in "${TSAN_PROGRAMS[@]}"; do
+    "$TSAN_DIR/tests/$program" --gtest_brief=1 --gtest_filter="${filter%:}" --gtest_repeat=5
+  done
   echo "check-sanitizers: TSan service tests passed after $(($(date +%s) - tsan_start)) s"
 fi
 echo "check-sanitizers: PASSED in $(($(date +%s) - start)) s"

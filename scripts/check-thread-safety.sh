@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Clang's thread-safety analysis over the code whose locks carry annotations (server/service:
-# DEFORM_GUARDED_BY, DEFORM_REQUIRES, ... from server/service/thread_annotations.h), with every
+# DEFORM_GUARDED_BY, DEFORM_REQUIRES, ... from server/service/base/thread_annotations.h), with every
 # warning an error. Exits non-zero, the findings printed, when a guarded member is touched without
 # its lock, a *Locked helper is called without it, or any other Clang warning appears there.
 #
@@ -16,7 +16,9 @@ source scripts/ccache-env.sh
 start=$(date +%s)
 BUILD_DIR="${DEFORM_TSA_BUILD_DIR:-build-tsa}"
 # The targets whose sources carry annotations.
-ANNOTATED_TARGETS=(deform_service)
+ANNOTATED_TARGETS=(deform_service_base deform_service_metrics deform_service_access
+  deform_service_workers deform_service_registry deform_service_transport deform_service_messages
+  deform_service_context deform_service_load deform_service_deform deform_service_rpc)
 
 scripts/install-deps.sh scripts/packages/build.txt scripts/packages/checks.txt
 
@@ -25,7 +27,7 @@ canary_log=$(mktemp)
 trap 'rm -f "$canary_log"' EXIT
 if clang++ -std=c++17 -fsyntax-only -Wthread-safety -Werror -Iserver -x c++ - \
   >"$canary_log" 2>&1 <<'CANARY'; then
-#include "service/annotated_mutex.h"
+#include "service/base/annotated_mutex.h"
 class Counter {
  public:
   void Increment() { ++count_; }  // no lock: must be reported

@@ -1,5 +1,5 @@
 // The order of a frame's vertices against the local model's. deformd returns frames in the file's
-// vertex order (its MeshPresentation): for OBJ, PLY, STL, OFF and the phantom that is the solved
+// vertex order (its MeshFileMetadata): for OBJ, PLY, STL, OFF and the phantom that is the solved
 // mesh's order itself (the server and LoadModelInput read the bytes with the same readers); for a
 // glTF rig, the file's unwelded vertices, each mapped to its welded vertex by
 // ModelInput::file_vertex_to_mesh (the same ReadGltf on the same bytes on both sides).

@@ -49,10 +49,10 @@
 #include <vector>
 
 #include "core/io/model_input.h"
-#include "service/deform_server.h"
-#include "service/identity.h"
-#include "service/service_options.h"
-#include "web/web_server.h"
+#include "service/rpc/deform_server.h"
+#include "service/access/identity.h"
+#include "service/base/service_options.h"
+#include "service/rpc/web_server.h"
 
 namespace {
 
@@ -356,7 +356,7 @@ int main(int argc, char** argv) {
       spdlog::error("--http: no viewer files beside the executable; give --http-root DIR");
       return 1;
     }
-    web = std::make_unique<deform::web::WebServer>(&server.core(), web_options);
+    web = std::make_unique<deform::web::WebServer>(&server.context(), web_options);
     server.AddTransportStop([&web](std::chrono::milliseconds grace) { web->Stop(grace); });
   }
   const deform::Status started = server.Start();

@@ -6,8 +6,8 @@
 #include <cstdint>
 
 #include "deform/v1/deform.pb.h"
-#include "service/load_header.h"
-#include "service/proto_conversion.h"
+#include "service/load/load_header.h"
+#include "service/messages/proto_conversion.h"
 #include "tests/fuzz/fuzz_model.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

@@ -7,7 +7,7 @@
 #include <cstdint>
 
 #include "deform/v1/deform.pb.h"
-#include "service/pose_input.h"
+#include "service/deform/pose_input.h"
 #include "tests/fuzz/fuzz_model.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

@@ -6,7 +6,7 @@
 #include <cstdint>
 
 #include "deform/v1/deform.pb.h"
-#include "service/proto_conversion.h"
+#include "service/messages/proto_conversion.h"
 #include "tests/fuzz/fuzz_model.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

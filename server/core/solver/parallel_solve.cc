@@ -226,32 +226,17 @@ ThreadTeam::~ThreadTeam() {
 }
 
 void ThreadTeam::RunParts(std::unique_lock<std::mutex>& lock) {
-  while (next_ < count_) {
-    const int index = next_++;
-    void (*part)(void*, int) = part_;
-    void* context = context_;
-    lock.unlock();
-    part(context, index);
-    lock.lock();
-    ++finished_;
-    done_.notify_all();
-  }
+  parts_.RunParts(lock, [this] { done_.notify_all(); });
 }
 
 void ThreadTeam::Run(int count, void (*part)(void* context, int index), void* context) {
   std::unique_lock<std::mutex> lock(mutex_);
-  part_ = part;
-  context_ = context;
-  count_ = count;
-  next_ = 0;
-  finished_ = 0;
+  parts_.Open(count, part, context);
   ++job_;
   wake_.notify_all();
   RunParts(lock);
-  done_.wait(lock, [this] { return finished_ == count_; });
-  part_ = nullptr;
-  context_ = nullptr;
-  count_ = 0;
+  done_.wait(lock, [this] { return parts_.all_finished(); });
+  parts_.Close();
 }
 
 void ThreadTeam::Help() {

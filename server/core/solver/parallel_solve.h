@@ -43,6 +43,50 @@ class ParallelRunner {
   ~ParallelRunner() = default;
 };
 
+// The parts of one computation as runners hand them out: taken in order by whichever thread asks
+// next, counted as they finish. The one home of that loop for every runner with helper threads
+// (ThreadTeam here, the service's runner on its worker pool). Not thread-safe by itself: every
+// member is used under the runner's lock.
+struct PartsInProgress {
+  void (*part)(void*, int) = nullptr;  // null: no computation open
+  void* context = nullptr;
+  int count = 0;
+  int next = 0;
+  int finished = 0;
+
+  void Open(int parts, void (*run)(void*, int), void* run_context) {
+    part = run;
+    context = run_context;
+    count = parts;
+    next = 0;
+    finished = 0;
+  }
+  // After the last part has finished: a helper starting late finds nothing to run.
+  void Close() {
+    part = nullptr;
+    context = nullptr;
+    count = 0;
+  }
+  bool all_finished() const { return finished == count; }
+
+  // Takes and runs parts until none is left. `lock` (a BasicLockable) is held on entry and on
+  // return, and released while each part runs; `part_finished()` is called with it held after
+  // each part.
+  template <typename Lock, typename PartFinished>
+  void RunParts(Lock& lock, PartFinished part_finished) {
+    while (part != nullptr && next < count) {
+      const int index = next++;
+      void (*const run)(void*, int) = part;
+      void* const argument = context;
+      lock.unlock();
+      run(argument, index);
+      lock.lock();
+      ++finished;
+      part_finished();
+    }
+  }
+};
+
 // Every part on the calling thread, in order.
 class SerialRunner final : public ParallelRunner {
  public:
@@ -71,11 +115,7 @@ class ThreadTeam final : public ParallelRunner {
   std::mutex mutex_;
   std::condition_variable wake_;  // a new job, or stopping
   std::condition_variable done_;  // a part finished
-  void (*part_)(void*, int) = nullptr;
-  void* context_ = nullptr;
-  int count_ = 0;
-  int next_ = 0;
-  int finished_ = 0;
+  PartsInProgress parts_;
   std::uint64_t job_ = 0;
   bool stopping_ = false;
   std::vector<std::thread> helpers_;

@@ -1,0 +1,37 @@
+#include "service/context/service_context.h"
+
+namespace deform::service {
+
+bool ActiveStreams::Add(Drainable* stream) {
+  MutexLock lock(&mutex_);
+  if (draining_) return false;
+  streams_.insert(stream);
+  return true;
+}
+
+void ActiveStreams::Remove(Drainable* stream) {
+  MutexLock lock(&mutex_);
+  streams_.erase(stream);
+}
+
+void ActiveStreams::DrainAll() {
+  MutexLock lock(&mutex_);
+  draining_ = true;
+  for (Drainable* stream : streams_) stream->Drain();
+}
+
+int ActiveStreams::count() const {
+  MutexLock lock(&mutex_);
+  return static_cast<int>(streams_.size());
+}
+
+ServiceContext::ServiceContext(const ServerOptions& options)
+    : solve_settings_{WorkerPool::ResolveThreads(options.workers), options.batch_frames,
+                      options.parallel_solve_min_factor_bytes, options.float32_factor_min_bytes},
+      admission_(options.limits),
+      registry_(&admission_),
+      pool_(options.workers, options.batch_frames),
+      uploads_(std::chrono::milliseconds(options.limits.upload_idle_timeout_ms),
+               std::chrono::milliseconds(options.limits.upload_time_limit_ms)) {}
+
+}  // namespace deform::service

@@ -1,0 +1,110 @@
+// What every handler of the service shares (ServiceContext): who may call (the authenticator),
+// admission, the mesh registry and store, the worker pool, the upload watchdog, the open streams,
+// the metrics, and the shutdown signal. The RPC classes and the stream handlers of both
+// transports look things up here; no gRPC types here.
+//
+// Ownership: the server owns one ServiceContext; it must outlive every handler (the server shuts
+// down its transports and then the worker pool before destroying it).
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <unordered_set>
+
+#include "core/base/cancel_token.h"
+#include "service/base/annotated_mutex.h"
+#include "service/access/admission.h"
+#include "service/access/identity.h"
+#include "service/registry/mesh_registry.h"
+#include "service/registry/mesh_store.h"
+#include "service/metrics/service_metrics.h"
+#include "service/base/service_options.h"
+#include "service/base/thread_annotations.h"
+#include "service/access/upload_watchdog.h"
+#include "service/workers/worker_pool.h"
+
+namespace deform::service {
+
+// Something that can be asked to end early because the server is shutting down.
+class Drainable {
+ public:
+  // Ends the stream soon (with UNAVAILABLE). Must not block; must not call back into
+  // ActiveStreams (it is called with the ActiveStreams lock held).
+  virtual void Drain() = 0;
+
+ protected:
+  ~Drainable() = default;
+};
+
+// The open Deform streams, so that a shutdown can end them instead of waiting for the clients.
+// Thread-safe.
+class ActiveStreams {
+ public:
+  // Registers `stream`; false (not registered) once DrainAll() has been called.
+  bool Add(Drainable* stream) DEFORM_EXCLUDES(mutex_);
+  void Remove(Drainable* stream) DEFORM_EXCLUDES(mutex_);
+  // Calls Drain() on every registered stream; later Add() calls fail.
+  void DrainAll() DEFORM_EXCLUDES(mutex_);
+  int count() const DEFORM_EXCLUDES(mutex_);
+
+ private:
+  mutable Mutex mutex_;
+  std::unordered_set<Drainable*> streams_ DEFORM_GUARDED_BY(mutex_);
+  bool draining_ DEFORM_GUARDED_BY(mutex_) = false;
+};
+
+// Thread safety: the accessors may be called from any thread; each object they return states its
+// own (set_store only before serving).
+class ServiceContext {
+ public:
+  explicit ServiceContext(const ServerOptions& options);
+  ServiceContext(const ServiceContext&) = delete;
+  ServiceContext& operator=(const ServiceContext&) = delete;
+
+  const ServiceLimits& limits() const { return admission_.limits(); }
+  // How meshes are prepared for the workers (the loader's PlanMeshSolve and float32 threshold).
+  const SolveSettings& solve_settings() const { return solve_settings_; }
+  // Who may call (token file, or the single implicit tenant).
+  Authenticator& auth() { return auth_; }
+  const Authenticator& auth() const { return auth_; }
+  // What may be loaded and held: mesh slots, the memory budget, stream quotas.
+  Admission& admission() { return admission_; }
+  MeshRegistry& registry() { return registry_; }
+  WorkerPool& pool() { return pool_; }
+  UploadWatchdog& uploads() { return uploads_; }
+  ActiveStreams& streams() { return streams_; }
+  // Where loaded meshes are kept across restarts (--store); null: nowhere.
+  MeshStore* store() const { return store_.get(); }
+  // Before serving only.
+  void set_store(std::unique_ptr<MeshStore> store) { store_ = std::move(store); }
+  // Cancelled when the server shuts down: the parent of every build's token (cancel_token.h).
+  CancelToken& shutting_down() { return shutting_down_; }
+  // Ids for log lines: each stream's and each load's, counting from 1.
+  std::uint64_t NextStreamId() { return next_stream_id_.fetch_add(1); }
+  std::uint64_t NextLoadId() { return next_load_id_.fetch_add(1); }
+  // Serialized bytes of the notices waiting unwritten in every Deform stream (DeformOutbox).
+  std::atomic<std::int64_t>& notice_backlog_bytes() { return notice_backlog_bytes_; }
+  // Counters and histograms of frames, notices, RPCs, builds (service_metrics.h).
+  ServiceMetrics& metrics() { return metrics_; }
+
+ private:
+  const SolveSettings solve_settings_;
+  Authenticator auth_;
+  Admission admission_;
+  MeshRegistry registry_;
+  WorkerPool pool_;
+  UploadWatchdog uploads_;
+  ActiveStreams streams_;
+  std::unique_ptr<MeshStore> store_;
+  CancelToken shutting_down_;
+  std::atomic<std::uint64_t> next_stream_id_{1};
+  std::atomic<std::uint64_t> next_load_id_{1};
+  std::atomic<std::int64_t> notice_backlog_bytes_{0};
+  ServiceMetrics metrics_;
+};
+
+}  // namespace deform::service

@@ -1,0 +1,99 @@
+#include "service/load/mesh_loader.h"
+
+#include <spdlog/spdlog.h>
+
+#include <utility>
+
+#include "service/base/log_text.h"
+
+namespace deform::service {
+namespace {
+
+double MillisecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+// "double", "float32, rest pose within 1.4e-07 of the diagonal", or why it stayed double.
+std::string FactorPrecisionText(const DeformationModel& model) {
+  const MaterialFactorization& factorization = *model.default_factorization();
+  if (factorization.factor().stores_float32()) {
+    return fmt::format("float32, rest pose within {:.1e} of the diagonal",
+                       factorization.float32_probe_error());
+  }
+  if (factorization.float32_probe_error() >= 0) {
+    return fmt::format("double: float32 would move the rest pose by {:.1e} of the diagonal",
+                       factorization.float32_probe_error());
+  }
+  return "double";
+}
+
+StatusOr<std::shared_ptr<const MeshEntry>> Build(ServiceContext* context, Admission::MeshSlot slot,
+                                                 LoadJob job, const LoadProgress& progress) {
+  job.options.limits.max_vertices = context->limits().max_vertices;
+  job.options.float32_factor_min_bytes = context->solve_settings().float32_factor_min_bytes;
+  const std::size_t bytes_before_build =
+      DeformationModel::EstimateBytesBeforeBuild(job.mesh.num_vertices(), job.mesh.num_triangles());
+  const int vertices = job.mesh.num_vertices();
+  BuildHooks hooks;
+  hooks.validated = [&] {
+    DEFORM_RETURN_IF_ERROR(context->admission().ReserveMemory(
+        &slot, bytes_before_build, "a mesh of " + std::to_string(vertices) + " vertices"));
+    if (progress) progress(LoadStage::kValidated, MillisecondsSince(job.start));
+    return Status::Ok();
+  };
+  hooks.cancel = job.cancel;
+  hooks.precomputed = [&] {
+    if (progress) progress(LoadStage::kWeights, MillisecondsSince(job.start));
+  };
+  DEFORM_ASSIGN_OR_RETURN(
+      std::shared_ptr<const DeformationModel> model,
+      DeformationModel::Build(std::move(job.mesh), std::move(job.skeleton), job.options,
+                              job.weights.has_value() ? &*job.weights : nullptr, hooks));
+  if (progress) progress(LoadStage::kFactorised, MillisecondsSince(job.start));
+  MeshSolvePlan solve = PlanMeshSolve(*model, context->solve_settings());
+  DEFORM_ASSIGN_OR_RETURN(
+      std::shared_ptr<const MeshEntry> entry,
+      context->registry().Register(std::move(slot), job.name, std::move(model),
+                                   std::move(job.file_metadata), std::move(solve), std::move(job.id)));
+  spdlog::info(
+      "mesh={} tenant={} name='{}' loaded: {} vertices, precompute {:.1f} ms, factor {:.1f} ms "
+      "({}), about {} KiB",
+      entry->id, EscapeForLog(entry->tenant), EscapeForLog(entry->name), vertices,
+      entry->precompute_ms, entry->factor_ms, FactorPrecisionText(*entry->model),
+      entry->memory_bytes >> 10);
+  std::string phases;
+  for (const DeformationModel::BuildPhase& phase : entry->model->build_phases()) {
+    phases +=
+        fmt::format("{}{} {:.0f} ms", phases.empty() ? "" : ", ", phase.name, phase.seconds * 1e3);
+  }
+  spdlog::debug("mesh={} build phases: {}", entry->id, phases);
+  for (const std::string& warning : entry->model->binding_report().warnings) {
+    spdlog::warn("mesh={} binding: {}", entry->id, EscapeForLog(warning));
+  }
+  if (!entry->file_metadata.unused_file_vertices.empty()) {
+    spdlog::warn("mesh={} {} file vertices used by no triangle follow the used vertex before them",
+                 entry->id, entry->file_metadata.unused_file_vertices.size());
+  }
+  return entry;
+}
+
+}  // namespace
+
+StatusOr<std::shared_ptr<const MeshEntry>> BuildAndRegister(ServiceContext* context,
+                                                            Admission::MeshSlot slot,
+                                                            LoadJob job,
+                                                            const LoadProgress& progress) {
+  const auto started = std::chrono::steady_clock::now();
+  ServiceMetrics* metrics = job.metrics;
+  StatusOr<std::shared_ptr<const MeshEntry>> entry =
+      Build(context, std::move(slot), std::move(job), progress);
+  if (metrics != nullptr) {
+    metrics->BuildFinished(
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count(),
+        entry.ok());
+  }
+  return entry;
+}
+
+}  // namespace deform::service

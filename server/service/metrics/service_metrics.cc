@@ -1,0 +1,166 @@
+#include "service/metrics/service_metrics.h"
+
+#include <prometheus/counter.h>
+#include <prometheus/gauge.h>
+#include <prometheus/histogram.h>
+#include <prometheus/registry.h>
+#include <prometheus/text_serializer.h>
+
+namespace deform::service {
+namespace {
+
+constexpr std::array<const char*, ServiceMetrics::kEncodings> kEncodingNames = {
+    "float32", "float32", "quantized", "predicted"};
+constexpr std::array<const char*, ServiceMetrics::kNoticeKinds> kNoticeKindNames = {
+    "unspecified", "pose_rejected", "stiffness_rejected", "stiffness_applied"};
+constexpr std::array<const char*, ServiceMetrics::kStatusCodes> kStatusCodeNames = {
+    "OK",        "CANCELLED",      "UNKNOWN",           "INVALID_ARGUMENT",   "DEADLINE_EXCEEDED",
+    "NOT_FOUND", "ALREADY_EXISTS", "PERMISSION_DENIED", "RESOURCE_EXHAUSTED", "FAILED_PRECONDITION",
+    "ABORTED",   "OUT_OF_RANGE",   "UNIMPLEMENTED",     "INTERNAL",           "UNAVAILABLE",
+    "DATA_LOSS", "UNAUTHENTICATED"};
+// The methods labelled by name; any other (health, reflection, unknown) is "other", so a client
+// cannot grow the number of series.
+constexpr std::array<const char*, ServiceMetrics::kMethods - 1> kMethodNames = {
+    "LoadMesh", "GetMeshInfo", "ListMeshes", "UnloadMesh", "Deform"};
+constexpr std::string_view kServicePrefix = "/deform.v1.DeformService/";
+
+int MethodIndex(std::string_view method) {
+  if (method.substr(0, kServicePrefix.size()) == kServicePrefix) {
+    const std::string_view name = method.substr(kServicePrefix.size());
+    for (int i = 0; i < static_cast<int>(kMethodNames.size()); ++i) {
+      if (name == kMethodNames[i]) return i;
+    }
+  }
+  return ServiceMetrics::kMethods - 1;
+}
+
+prometheus::Histogram::BucketBoundaries Exponential(double first, double factor, int count) {
+  prometheus::Histogram::BucketBoundaries bounds;
+  double bound = first;
+  for (int i = 0; i < count; ++i, bound *= factor) bounds.push_back(bound);
+  return bounds;
+}
+
+}  // namespace
+
+ServiceMetrics::ServiceMetrics() : registry_(std::make_shared<prometheus::Registry>()) {
+  using prometheus::BuildCounter;
+  using prometheus::BuildGauge;
+  using prometheus::BuildHistogram;
+  auto& frames = BuildCounter()
+                     .Name("deformd_frames_sent_total")
+                     .Help("Deform frames written to clients, by encoding")
+                     .Register(*registry_);
+  auto& frame_bytes = BuildCounter()
+                          .Name("deformd_frame_bytes_sent_total")
+                          .Help("Serialised bytes of the Deform frames written, by encoding")
+                          .Register(*registry_);
+  for (int i = 0; i < kEncodings; ++i) {
+    // Index 0 shares float32's series (an unset encoding is float32).
+    frames_sent_[i] = i == 0 ? nullptr : &frames.Add({{"encoding", kEncodingNames[i]}});
+    frame_bytes_sent_[i] = i == 0 ? nullptr : &frame_bytes.Add({{"encoding", kEncodingNames[i]}});
+  }
+  frames_sent_[0] = frames_sent_[1];
+  frame_bytes_sent_[0] = frame_bytes_sent_[1];
+  frame_server_seconds_ =
+      &BuildHistogram()
+           .Name("deformd_frame_server_seconds")
+           .Help("Server time of a written frame: queue, right-hand side, solve and encode")
+           .Register(*registry_)
+           .Add({}, Exponential(0.000125, 2, 14));
+  poses_skipped_ = &BuildCounter()
+                        .Name("deformd_poses_skipped_total")
+                        .Help("Poses replaced by a newer pose before they were solved")
+                        .Register(*registry_)
+                        .Add({});
+  auto& notices = BuildCounter()
+                      .Name("deformd_notices_sent_total")
+                      .Help("Notices written to Deform clients, by kind")
+                      .Register(*registry_);
+  for (int i = 1; i < kNoticeKinds; ++i) {
+    notices_sent_[i] = &notices.Add({{"kind", kNoticeKindNames[i]}});
+  }
+  auto& rpcs = BuildCounter()
+                   .Name("deformd_rpcs_total")
+                   .Help("Finished RPCs by method and status code")
+                   .Register(*registry_);
+  for (int m = 0; m < kMethods; ++m) {
+    const char* method = m < kMethods - 1 ? kMethodNames[m] : "other";
+    for (int c = 0; c < kStatusCodes; ++c) {
+      rpcs_[m][c] = &rpcs.Add({{"method", method}, {"code", kStatusCodeNames[c]}});
+    }
+  }
+  auto& builds = BuildHistogram()
+                     .Name("deformd_build_seconds")
+                     .Help("Mesh builds (LoadMesh, --preload, --store), by result")
+                     .Register(*registry_);
+  const auto build_bounds = Exponential(0.01, 2, 16);  // 10 ms .. 5.5 min
+  build_ok_seconds_ = &builds.Add({{"result", "ok"}}, build_bounds);
+  build_error_seconds_ = &builds.Add({{"result", "error"}}, build_bounds);
+  refactorisation_seconds_ = &BuildHistogram()
+                                  .Name("deformd_refactorisation_seconds")
+                                  .Help("Stiffness refactorisations of Deform streams")
+                                  .Register(*registry_)
+                                  .Add({}, Exponential(0.001, 2, 14));
+  const auto gauge = [this](const char* name, const char* help) {
+    return &BuildGauge().Name(name).Help(help).Register(*registry_).Add({});
+  };
+  streams_open_ = gauge("deformd_streams_open", "Open Deform streams");
+  meshes_loaded_ = gauge("deformd_meshes_loaded", "Meshes loaded");
+  loads_in_progress_ = gauge("deformd_loads_in_progress", "Mesh loads in progress");
+  memory_used_ = gauge("deformd_memory_budget_used_bytes",
+                       "Memory budget used by loaded meshes and unloaded ones still streamed");
+  memory_reserved_ =
+      gauge("deformd_memory_budget_reserved_bytes", "Memory budget held by loads in progress");
+  memory_streams_ = gauge("deformd_memory_budget_streams_bytes",
+                          "Memory budget held by streams' buffers and own factorisations");
+  memory_budget_ = gauge("deformd_memory_budget_bytes", "The memory budget (--max-memory-mb)");
+  notice_backlog_ =
+      gauge("deformd_notice_backlog_bytes", "Serialised bytes of notices waiting unwritten");
+}
+
+ServiceMetrics::~ServiceMetrics() = default;
+
+void ServiceMetrics::FrameWritten(int encoding, std::size_t bytes, double server_seconds,
+                                  std::uint64_t skipped_poses) {
+  if (encoding < 0 || encoding >= kEncodings) encoding = 1;
+  frames_sent_[encoding]->Increment();
+  frame_bytes_sent_[encoding]->Increment(static_cast<double>(bytes));
+  frame_server_seconds_->Observe(server_seconds);
+  if (skipped_poses > 0) poses_skipped_->Increment(static_cast<double>(skipped_poses));
+}
+
+void ServiceMetrics::NoticeWritten(int kind) {
+  if (kind <= 0 || kind >= kNoticeKinds) return;
+  notices_sent_[kind]->Increment();
+}
+
+void ServiceMetrics::RpcFinished(std::string_view method, int code) {
+  if (code < 0 || code >= kStatusCodes) code = 2;  // UNKNOWN
+  rpcs_[MethodIndex(method)][code]->Increment();
+}
+
+void ServiceMetrics::BuildFinished(double seconds, bool ok) {
+  (ok ? build_ok_seconds_ : build_error_seconds_)->Observe(seconds);
+}
+
+void ServiceMetrics::RefactorisationFinished(double seconds) {
+  refactorisation_seconds_->Observe(seconds);
+}
+
+void ServiceMetrics::SetGauges(const Gauges& gauges) {
+  streams_open_->Set(gauges.streams_open);
+  meshes_loaded_->Set(gauges.meshes_loaded);
+  loads_in_progress_->Set(gauges.loads_in_progress);
+  memory_used_->Set(static_cast<double>(gauges.memory_used_bytes));
+  memory_reserved_->Set(static_cast<double>(gauges.memory_reserved_bytes));
+  memory_streams_->Set(static_cast<double>(gauges.memory_streams_bytes));
+  memory_budget_->Set(static_cast<double>(gauges.memory_budget_bytes));
+  notice_backlog_->Set(static_cast<double>(gauges.notice_backlog_bytes));
+}
+
+std::string ServiceMetrics::Serialize() const {
+  return prometheus::TextSerializer().Serialize(registry_->Collect());
+}
+
+}  // namespace deform::service

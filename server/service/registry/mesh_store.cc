@@ -1,0 +1,242 @@
+#include "service/registry/mesh_store.h"
+
+#include <fcntl.h>
+#include <openssl/evp.h>
+#include <spdlog/spdlog.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "service/access/identity.h"
+#include "service/base/log_text.h"
+#include "service/registry/mesh_id.h"
+
+namespace deform::service {
+namespace {
+
+constexpr std::string_view kMagic = "deformd-store v1\n";
+constexpr std::size_t kDigestBytes = 32;
+
+std::string ErrnoText() { return std::strerror(errno); }
+
+template <typename T>
+std::string LittleEndian(T value) {
+  std::string bytes(sizeof(T), '\0');
+  for (std::size_t i = 0; i < sizeof(T); ++i) {
+    bytes[i] = static_cast<char>((static_cast<std::uint64_t>(value) >> (8 * i)) & 0xff);
+  }
+  return bytes;
+}
+
+// Writes pieces to a file descriptor while hashing them.
+class HashingWriter {
+ public:
+  explicit HashingWriter(int fd) : fd_(fd), context_(EVP_MD_CTX_new()) {
+    EVP_DigestInit_ex(context_, EVP_sha256(), nullptr);
+  }
+  ~HashingWriter() { EVP_MD_CTX_free(context_); }
+  bool Write(std::string_view bytes) {
+    EVP_DigestUpdate(context_, bytes.data(), bytes.size());
+    return WriteRaw(bytes);
+  }
+  bool WriteDigest() {
+    unsigned char digest[EVP_MAX_MD_SIZE];
+    unsigned int length = 0;
+    EVP_DigestFinal_ex(context_, digest, &length);
+    return WriteRaw(std::string_view(reinterpret_cast<const char*>(digest), length));
+  }
+
+ private:
+  bool WriteRaw(std::string_view bytes) {
+    while (!bytes.empty()) {
+      const ssize_t written = ::write(fd_, bytes.data(), bytes.size());
+      if (written < 0) {
+        if (errno == EINTR) continue;
+        return false;
+      }
+      bytes.remove_prefix(static_cast<std::size_t>(written));
+    }
+    return true;
+  }
+  int fd_;
+  EVP_MD_CTX* context_;
+};
+
+// Reads the little-endian integer of T at *offset; false past the end.
+template <typename T>
+bool ReadInteger(std::string_view data, std::size_t* offset, T* value) {
+  if (data.size() - *offset < sizeof(T)) return false;
+  std::uint64_t result = 0;
+  for (std::size_t i = 0; i < sizeof(T); ++i) {
+    result |= std::uint64_t{static_cast<unsigned char>(data[*offset + i])} << (8 * i);
+  }
+  *offset += sizeof(T);
+  *value = static_cast<T>(result);
+  return true;
+}
+
+template <typename Length>
+bool ReadField(std::string_view data, std::size_t* offset, std::string_view* field) {
+  Length length = 0;
+  if (!ReadInteger(data, offset, &length)) return false;
+  if (data.size() - *offset < length) return false;
+  *field = data.substr(*offset, length);
+  *offset += length;
+  return true;
+}
+
+StatusOr<StoredMesh> ParseEntry(std::string_view data) {
+  if (data.size() < kMagic.size() + kDigestBytes || data.substr(0, kMagic.size()) != kMagic) {
+    return Status::InvalidArgument("not a deformd store entry (bad magic or too short)");
+  }
+  const std::string_view body = data.substr(0, data.size() - kDigestBytes);
+  unsigned char digest[EVP_MAX_MD_SIZE];
+  unsigned int length = 0;
+  EVP_Digest(body.data(), body.size(), digest, &length, EVP_sha256(), nullptr);
+  if (length != kDigestBytes ||
+      std::memcmp(digest, data.data() + body.size(), kDigestBytes) != 0) {
+    return Status::InvalidArgument("checksum mismatch (truncated or altered)");
+  }
+  std::size_t offset = kMagic.size();
+  std::string_view id, tenant, header, mesh;
+  if (!ReadField<std::uint32_t>(body, &offset, &id) ||
+      !ReadField<std::uint32_t>(body, &offset, &tenant) ||
+      !ReadField<std::uint64_t>(body, &offset, &header) ||
+      !ReadField<std::uint64_t>(body, &offset, &mesh) || offset != body.size()) {
+    return Status::InvalidArgument("malformed field lengths");
+  }
+  StoredMesh stored;
+  stored.id = std::string(id);
+  stored.tenant = std::string(tenant);
+  if (!LooksLikeMeshId(stored.id)) return Status::InvalidArgument("malformed mesh id");
+  if (!IsValidTenantName(stored.tenant)) return Status::InvalidArgument("malformed tenant");
+  if (!stored.header.ParseFromArray(header.data(), static_cast<int>(header.size()))) {
+    return Status::InvalidArgument("the LoadMesh header does not parse");
+  }
+  stored.mesh_bytes = std::string(mesh);
+  return stored;
+}
+
+}  // namespace
+
+StatusOr<std::unique_ptr<MeshStore>> MeshStore::Open(const std::string& dir) {
+  if (dir.empty()) return Status::FailedPrecondition("the store directory is empty");
+  if (::mkdir(dir.c_str(), 0700) != 0 && errno != EEXIST) {
+    return Status::FailedPrecondition("cannot create the store directory '" + dir +
+                                      "': " + ErrnoText());
+  }
+  struct stat info {};
+  if (::stat(dir.c_str(), &info) != 0 || !S_ISDIR(info.st_mode)) {
+    return Status::FailedPrecondition("the store '" + dir + "' is not a directory");
+  }
+  if (info.st_uid != ::geteuid()) {
+    return Status::FailedPrecondition("the store directory '" + dir +
+                                      "' belongs to another user");
+  }
+  if ((info.st_mode & 0777) != 0700 && ::chmod(dir.c_str(), 0700) != 0) {
+    return Status::FailedPrecondition("cannot make the store directory '" + dir +
+                                      "' private (0700): " + ErrnoText());
+  }
+  std::unique_ptr<MeshStore> store(new MeshStore(dir));
+  std::error_code error;
+  for (const auto& file : std::filesystem::directory_iterator(dir, error)) {
+    const std::string name = file.path().filename().string();
+    if (name.size() > 9 && name[0] == '.' && name.substr(name.size() - 8) == ".pending") {
+      spdlog::warn("store: deleting the unfinished entry '{}'", EscapeForLog(name));
+      std::filesystem::remove(file.path(), error);
+    }
+  }
+  return store;
+}
+
+Status MeshStore::WritePending(const StoredMesh& mesh) const {
+  const std::string path = PendingPath(mesh.id);
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+  if (fd < 0) {
+    spdlog::error("store: cannot create '{}': {}", EscapeForLog(path), ErrnoText());
+    return Status::Internal("the server cannot keep the mesh in its store (see its log)");
+  }
+  const std::string header = mesh.header.SerializeAsString();
+  HashingWriter writer(fd);
+  bool ok = writer.Write(kMagic) &&
+            writer.Write(LittleEndian(static_cast<std::uint32_t>(mesh.id.size()))) &&
+            writer.Write(mesh.id) &&
+            writer.Write(LittleEndian(static_cast<std::uint32_t>(mesh.tenant.size()))) &&
+            writer.Write(mesh.tenant) &&
+            writer.Write(LittleEndian(static_cast<std::uint64_t>(header.size()))) &&
+            writer.Write(header) &&
+            writer.Write(LittleEndian(static_cast<std::uint64_t>(mesh.mesh_bytes.size()))) &&
+            writer.Write(mesh.mesh_bytes) && writer.WriteDigest();
+  ok = ::fsync(fd) == 0 && ok;
+  const std::string error = ErrnoText();
+  ::close(fd);
+  if (!ok) {
+    ::unlink(path.c_str());
+    spdlog::error("store: cannot write '{}': {}", EscapeForLog(path), error);
+    return Status::Internal("the server cannot keep the mesh in its store (see its log)");
+  }
+  return Status::Ok();
+}
+
+void MeshStore::Commit(const std::string& id) const {
+  if (::rename(PendingPath(id).c_str(), EntryPath(id).c_str()) != 0) {
+    spdlog::error("store: mesh={} cannot be kept ({}): it will not come back after a restart", id,
+                  ErrnoText());
+    ::unlink(PendingPath(id).c_str());
+    return;
+  }
+  // The rename is durable once the directory is synced.
+  const int dir_fd = ::open(dir_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dir_fd >= 0) {
+    ::fsync(dir_fd);
+    ::close(dir_fd);
+  }
+}
+
+void MeshStore::Discard(const std::string& id) const { ::unlink(PendingPath(id).c_str()); }
+
+void MeshStore::Remove(const std::string& id) const {
+  if (::unlink(EntryPath(id).c_str()) != 0 && errno != ENOENT) {
+    spdlog::error("store: mesh={} cannot be deleted: {}", id, ErrnoText());
+  }
+}
+
+std::vector<StoredMesh> MeshStore::LoadAll() const {
+  std::vector<std::string> files;
+  std::error_code error;
+  for (const auto& file : std::filesystem::directory_iterator(dir_, error)) {
+    const std::string name = file.path().filename().string();
+    if (name.size() > 5 && name[0] != '.' && name.substr(name.size() - 5) == ".mesh") {
+      files.push_back(file.path().string());
+    }
+  }
+  if (error) spdlog::error("store: cannot list '{}': {}", EscapeForLog(dir_), error.message());
+  std::sort(files.begin(), files.end());
+  std::vector<StoredMesh> meshes;
+  for (const std::string& path : files) {
+    std::ifstream in(path, std::ios::binary);
+    std::ostringstream data;
+    data << in.rdbuf();
+    StatusOr<StoredMesh> stored = in ? ParseEntry(data.str())
+                                     : StatusOr<StoredMesh>(Status::NotFound("cannot read it"));
+    if (stored.ok() && EntryPath(stored->id) != path) {
+      stored = Status::InvalidArgument("its id '" + stored->id + "' does not match its file name");
+    }
+    if (!stored.ok()) {
+      spdlog::error("store: skipping the corrupt entry '{}': {}", EscapeForLog(path),
+                    stored.status().message());
+      continue;
+    }
+    meshes.push_back(std::move(*stored));
+  }
+  return meshes;
+}
+
+}  // namespace deform::service

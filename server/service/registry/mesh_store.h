@@ -1,0 +1,67 @@
+// The mesh store (deformd --store DIR): loaded meshes kept on disk as they were uploaded (the
+// LoadMesh header: name, method options, the phantom's size or the upload's format, skeleton and
+// weights; and the mesh file's bytes), with their id and owner, so that a restarted server builds
+// them again under the same ids for the same tenants without a client re-uploading.
+//
+// Layout: one file per mesh, DIR/<id>.mesh, readable and writable by the server's user only
+// (0600, in a directory kept at 0700). A load writes DIR/.<id>.pending first (before parsing, so
+// the upload's bytes need not stay in memory), fsyncs it, and renames it to <id>.mesh once the
+// mesh is registered (Commit) or deletes it when the load fails (Discard): a crash leaves either
+// a complete entry or a pending file, which Open() deletes. Unloading deletes the entry (Remove).
+//
+// File format (little-endian): "deformd-store v1\n", u32 length + id, u32 length + tenant,
+// u64 length + serialized deform.v1.LoadMeshHeader, u64 length + mesh bytes, then the SHA-256 of
+// all that. An entry whose checksum, lengths, id or tenant do not check out is corrupt: LoadAll()
+// logs and skips it (the file stays for inspection); it never stops the server.
+//
+// Not encrypted: the host's disk encryption protects the files at rest (docs/operations.md, "Threat model").
+// Thread-safe (each call works on its own files).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/base/status.h"
+#include "deform/v1/deform.pb.h"
+
+namespace deform::service {
+
+struct StoredMesh {
+  std::string id;
+  std::string tenant;
+  v1::LoadMeshHeader header;
+  std::string mesh_bytes;  // the upload's mesh file; empty for a phantom
+};
+
+class MeshStore {
+ public:
+  // Creates `dir` (0700) if missing; otherwise it must be a directory owned by this user, and
+  // its mode is set to 0700. Deletes leftover pending files. FAILED_PRECONDITION naming the
+  // problem otherwise.
+  static StatusOr<std::unique_ptr<MeshStore>> Open(const std::string& dir);
+
+  // Writes `mesh` as a pending entry (durably). INTERNAL on an I/O error (the file and the error
+  // are logged, not told to the client).
+  Status WritePending(const StoredMesh& mesh) const;
+  // Makes a pending entry the mesh's entry; an error is logged (the mesh then is not kept).
+  void Commit(const std::string& id) const;
+  // Deletes a pending entry.
+  void Discard(const std::string& id) const;
+  // Deletes a mesh's entry (on unload); a missing entry is not an error.
+  void Remove(const std::string& id) const;
+
+  // Every readable entry, in file-name order; corrupt entries are logged and skipped.
+  std::vector<StoredMesh> LoadAll() const;
+
+  const std::string& dir() const { return dir_; }
+  std::string EntryPath(const std::string& id) const { return dir_ + "/" + id + ".mesh"; }
+
+ private:
+  explicit MeshStore(std::string dir) : dir_(std::move(dir)) {}
+  std::string PendingPath(const std::string& id) const { return dir_ + "/." + id + ".pending"; }
+
+  std::string dir_;
+};
+
+}  // namespace deform::service

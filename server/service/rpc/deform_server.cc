@@ -1,0 +1,228 @@
+#include "service/rpc/deform_server.h"
+
+#include <grpcpp/ext/proto_server_reflection_plugin.h>
+#include <grpcpp/grpcpp.h>
+#include <grpcpp/health_check_service_interface.h>
+#include <spdlog/spdlog.h>
+
+#include <vector>
+
+#include "health.pb.h"
+#include "service/base/annotated_mutex.h"
+#include "service/rpc/deform_service.h"
+#include "service/load/load_request.h"
+#include "service/base/log_text.h"
+#include "service/load/mesh_loader.h"
+#include "service/registry/mesh_store.h"
+#include "service/rpc/metrics_endpoint.h"
+#include "service/metrics/rpc_metrics_interceptor.h"
+#include "service/context/service_context.h"
+#include "service/transport/transport_security.h"
+
+namespace deform::service {
+namespace {
+
+// One server per address (gRPC turns SO_REUSEPORT on by default: a second server would start and
+// take half the connections), keepalive pings and an idle limit.
+void ApplyConnectionOptions(const ConnectionOptions& options, grpc::ServerBuilder* builder) {
+  builder->AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
+  builder->AddChannelArgument(GRPC_ARG_KEEPALIVE_TIME_MS, options.keepalive_time_ms);
+  builder->AddChannelArgument(GRPC_ARG_KEEPALIVE_TIMEOUT_MS, options.keepalive_timeout_ms);
+  builder->AddChannelArgument(GRPC_ARG_KEEPALIVE_PERMIT_WITHOUT_CALLS, 1);
+  builder->AddChannelArgument(GRPC_ARG_HTTP2_MAX_PINGS_WITHOUT_DATA, 0);
+  builder->AddChannelArgument(GRPC_ARG_MAX_CONNECTION_IDLE_MS, options.max_connection_idle_ms);
+  builder->AddChannelArgument(GRPC_ARG_HTTP2_MIN_RECV_PING_INTERVAL_WITHOUT_DATA_MS,
+                              options.min_client_ping_interval_ms);
+}
+
+// The metrics page: the gauges from the service's state now, then everything serialised.
+std::string RenderMetrics(ServiceContext* context) {
+  ServiceMetrics::Gauges gauges;
+  gauges.streams_open = context->streams().count();
+  gauges.meshes_loaded = context->registry().mesh_count();
+  gauges.loads_in_progress = context->admission().loads_in_progress();
+  gauges.memory_used_bytes = context->admission().memory_bytes_used();
+  gauges.memory_reserved_bytes = context->admission().memory_bytes_reserved();
+  gauges.memory_streams_bytes = context->admission().memory_bytes_streams();
+  gauges.memory_budget_bytes = context->limits().max_memory_bytes;
+  gauges.notice_backlog_bytes = context->notice_backlog_bytes().load(std::memory_order_relaxed);
+  context->metrics().SetGauges(gauges);
+  return context->metrics().Serialize();
+}
+
+// Builds `stored` again under its id and owner and registers it (`start` is when its restore
+// began).
+StatusOr<std::shared_ptr<const MeshEntry>> Restore(ServiceContext* context, StoredMesh* stored,
+                                                   std::chrono::steady_clock::time_point start) {
+  DEFORM_ASSIGN_OR_RETURN(LoadJob job,
+                          LoadJobFromRequest(stored->header, &stored->mesh_bytes, context->limits()));
+  job.id = stored->id;
+  job.start = start;
+  job.metrics = &context->metrics();
+  DEFORM_ASSIGN_OR_RETURN(Admission::MeshSlot reservation,
+                          context->admission().ReserveMesh(stored->tenant));
+  return BuildAndRegister(context, std::move(reservation), std::move(job));
+}
+
+}  // namespace
+
+struct DeformServer::Impl {
+  explicit Impl(const ServerOptions& server_options)
+      : options(server_options), context(server_options), service(&context) {}
+
+  const ServerOptions options;
+  ServiceContext context;
+  DeformServiceImpl service;
+  std::unique_ptr<grpc::Server> server;
+  std::unique_ptr<MetricsEndpoint> metrics;  // null without options.metrics_address
+  int port = 0;
+  std::vector<std::function<void(std::chrono::milliseconds)>> transport_stops;
+  Mutex shutdown_mutex;  // serialises Shutdown()
+  bool shut_down DEFORM_GUARDED_BY(shutdown_mutex) = false;
+};
+
+DeformServer::DeformServer(const ServerOptions& options) : impl_(std::make_unique<Impl>(options)) {}
+
+DeformServer::~DeformServer() { Shutdown(); }
+
+Status DeformServer::Start() {
+  if (impl_->server != nullptr) return Status::FailedPrecondition("the server is already started");
+  grpc::EnableDefaultHealthCheckService(true);
+  // Reflection describes only services whose descriptors are linked in (grpc/grpc#36665): touching
+  // the health proto's descriptor keeps it, so reflection lists grpc.health.v1.Health.
+  (void)grpc::health::v1::HealthCheckRequest::descriptor();
+  grpc::reflection::InitProtoReflectionServerBuilderPlugin();
+  std::string transport;
+  DEFORM_ASSIGN_OR_RETURN(
+      std::shared_ptr<grpc::ServerCredentials> credentials,
+      MakeServerCredentials(impl_->options.security, impl_->options.listen_address, &transport));
+  grpc::ServerBuilder builder;
+  builder.AddListeningPort(impl_->options.listen_address, credentials, &impl_->port);
+  builder.RegisterService(&impl_->service);
+  builder.SetMaxReceiveMessageSize(impl_->options.max_message_bytes);
+  builder.SetMaxSendMessageSize(impl_->options.max_message_bytes);
+  ApplyConnectionOptions(impl_->options.connections, &builder);
+  std::vector<std::unique_ptr<grpc::experimental::ServerInterceptorFactoryInterface>> interceptors;
+  interceptors.push_back(std::make_unique<RpcMetricsInterceptorFactory>(&impl_->context.metrics()));
+  builder.experimental().SetInterceptorCreators(std::move(interceptors));
+  if (!impl_->options.metrics_address.empty()) {
+    ServiceContext* context = &impl_->context;
+    DEFORM_ASSIGN_OR_RETURN(
+        impl_->metrics,
+        MetricsEndpoint::Start(impl_->options.metrics_address,
+                               impl_->options.security.allow_plaintext, &context->auth(),
+                               [context] { return RenderMetrics(context); }));
+  }
+  impl_->server = builder.BuildAndStart();
+  if (impl_->server == nullptr || impl_->port == 0) {
+    impl_->server.reset();
+    impl_->metrics.reset();
+    return Status::FailedPrecondition("cannot listen on '" + impl_->options.listen_address + "'");
+  }
+  if (grpc::HealthCheckServiceInterface* health = impl_->server->GetHealthCheckService()) {
+    health->SetServingStatus(v1::DeformService::service_full_name(), true);
+  }
+  spdlog::info("listening on {} ({}) with {} workers", listening_address(), transport,
+               impl_->context.pool().size());
+  if (!impl_->context.auth().uses_tokens()) {
+    spdlog::warn(
+        "no token file: every caller is the single implicit tenant '{}' and sees every "
+        "mesh (give --token-file for per-client tokens)",
+        Identity::Implicit().tenant);
+  }
+  return Status::Ok();
+}
+
+Status DeformServer::UseStore(const std::string& dir, int* restored) {
+  DEFORM_ASSIGN_OR_RETURN(std::unique_ptr<MeshStore> store, MeshStore::Open(dir));
+  ServiceContext& context = impl_->context;
+  int count = 0;
+  for (StoredMesh& stored : store->LoadAll()) {
+    const auto start = std::chrono::steady_clock::now();
+    const StatusOr<std::shared_ptr<const MeshEntry>> entry = Restore(&context, &stored, start);
+    if (!entry.ok()) {
+      spdlog::error("store: mesh={} tenant={} not restored: {}", stored.id,
+                    EscapeForLog(stored.tenant), entry.status().ToString());
+      continue;
+    }
+    ++count;
+    spdlog::info("store: mesh={} tenant={} restored in {:.0f} ms", stored.id,
+                 EscapeForLog(stored.tenant),
+                 std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                     .count());
+  }
+  spdlog::info("store: {} meshes restored from '{}'", count, EscapeForLog(dir));
+  context.set_store(std::move(store));
+  if (restored != nullptr) *restored = count;
+  return Status::Ok();
+}
+
+Status DeformServer::UseTokenFile(const std::string& path) {
+  return impl_->context.auth().LoadTokenFile(path);
+}
+
+Status DeformServer::ReloadTokens() {
+  const Status reloaded = impl_->context.auth().Reload();
+  if (reloaded.ok()) {
+    spdlog::info("token file reloaded");
+  } else {
+    spdlog::error("token file reload failed, the previous tokens stay in force: {}",
+                  reloaded.ToString());
+  }
+  return reloaded;
+}
+
+int DeformServer::port() const { return impl_->port; }
+
+int DeformServer::metrics_port() const {
+  return impl_->metrics != nullptr ? impl_->metrics->port() : 0;
+}
+
+std::string DeformServer::listening_address() const {
+  const std::string& address = impl_->options.listen_address;
+  const std::size_t colon = address.rfind(':');
+  const std::string host = colon == std::string::npos ? address : address.substr(0, colon);
+  return host + ":" + std::to_string(impl_->port);
+}
+
+StatusOr<std::shared_ptr<const MeshEntry>> DeformServer::Preload(ModelInput input,
+                                                                 const std::string& name,
+                                                                 const std::string& tenant) {
+  DEFORM_ASSIGN_OR_RETURN(Admission::MeshSlot reservation,
+                          impl_->context.admission().ReserveMesh(tenant));
+  LoadJob job;
+  job.name = name.empty() ? input.description : name;
+  job.mesh = std::move(input.mesh);
+  job.skeleton = std::move(input.skeleton);
+  job.options = ModelOptions::Paper();
+  job.metrics = &impl_->context.metrics();
+  return BuildAndRegister(&impl_->context, std::move(reservation), std::move(job));
+}
+
+void DeformServer::Shutdown(std::chrono::milliseconds grace) {
+  MutexLock lock(&impl_->shutdown_mutex);
+  if (impl_->shut_down) return;
+  impl_->shut_down = true;
+  if (impl_->server != nullptr) {
+    spdlog::info("draining: {} open streams", impl_->context.streams().count());
+    if (grpc::HealthCheckServiceInterface* health = impl_->server->GetHealthCheckService()) {
+      health->SetServingStatus(false);
+    }
+    impl_->context.streams().DrainAll();
+    impl_->context.shutting_down().Cancel();  // builds in progress stop at the end of their phase
+    impl_->server->Shutdown(std::chrono::system_clock::now() + grace);
+    impl_->server->Wait();
+  }
+  for (const auto& stop : impl_->transport_stops) stop(grace / 10);
+  impl_->context.pool().Shutdown();
+  impl_->metrics.reset();
+  spdlog::info("stopped");
+}
+
+void DeformServer::AddTransportStop(std::function<void(std::chrono::milliseconds)> stop) {
+  impl_->transport_stops.push_back(std::move(stop));
+}
+
+ServiceContext& DeformServer::context() { return impl_->context; }
+
+}  // namespace deform::service

@@ -1,0 +1,61 @@
+#include "service/rpc/unary_calls.h"
+
+#include <string>
+
+#include "service/access/audit_log.h"
+#include "service/messages/frame_encoding.h"
+#include "service/messages/proto_conversion.h"
+#include "service/base/request_limits.h"
+
+namespace deform::service {
+namespace {
+
+std::string ResultText(const Status& status) { return status.ok() ? "OK" : status.ToString(); }
+
+}  // namespace
+
+StatusOr<Identity> AuthenticateCall(const ServiceContext& context, std::string_view authorization,
+                                    std::string_view action, std::string_view mesh_id) {
+  StatusOr<Identity> caller = context.auth().Authenticate(authorization);
+  if (!caller.ok()) Audit("-", action, mesh_id, caller.status().ToString());
+  return caller;
+}
+
+Status GetMeshInfoCall(ServiceContext& context, std::string_view authorization,
+                       const v1::GetMeshInfoRequest& request, v1::GetMeshInfoResponse* response) {
+  DEFORM_RETURN_IF_ERROR(CheckLength(request.mesh_id(), kMaxMeshIdBytes, "mesh_id"));
+  const char* action = request.include_geometry() ? "download" : "get_mesh_info";
+  DEFORM_ASSIGN_OR_RETURN(Identity caller,
+                          AuthenticateCall(context, authorization, action, request.mesh_id()));
+  auto entry = context.registry().Find(request.mesh_id(), caller);
+  Audit(caller.tenant, action, request.mesh_id(), ResultText(entry.status()));
+  if (!entry.ok()) return entry.status();
+  FillMeshSummary(**entry, response->mutable_summary());
+  if (request.include_geometry()) FillMeshGeometry(**entry, response);
+  if (request.include_prediction_weights()) {
+    FillPredictionWeights(**entry, response->mutable_prediction_weights());
+  }
+  return Status::Ok();
+}
+
+Status ListMeshesCall(ServiceContext& context, std::string_view authorization,
+                      const v1::ListMeshesRequest& /*request*/, v1::ListMeshesResponse* response) {
+  DEFORM_ASSIGN_OR_RETURN(Identity caller, AuthenticateCall(context, authorization, "list", ""));
+  const auto meshes = context.registry().List(caller);
+  for (const auto& entry : meshes) FillMeshSummary(*entry, response->add_meshes());
+  Audit(caller.tenant, "list", "", "OK: " + std::to_string(meshes.size()) + " meshes");
+  return Status::Ok();
+}
+
+Status UnloadMeshCall(ServiceContext& context, std::string_view authorization,
+                      const v1::UnloadMeshRequest& request, v1::UnloadMeshResponse* /*response*/) {
+  DEFORM_RETURN_IF_ERROR(CheckLength(request.mesh_id(), kMaxMeshIdBytes, "mesh_id"));
+  DEFORM_ASSIGN_OR_RETURN(Identity caller,
+                          AuthenticateCall(context, authorization, "unload", request.mesh_id()));
+  const Status status = context.registry().Unload(request.mesh_id(), caller);
+  if (status.ok() && context.store() != nullptr) context.store()->Remove(request.mesh_id());
+  Audit(caller.tenant, "unload", request.mesh_id(), ResultText(status));
+  return status;
+}
+
+}  // namespace deform::service

@@ -1,0 +1,197 @@
+// --store: meshes come back after a restart under their ids and owners, built from what was
+// uploaded; unloading deletes them; the files are private; a corrupt entry is skipped.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "core/io/mesh_io.h"
+#include "core/io/phantom.h"
+#include "core/io/skeleton_io.h"
+#include "service/access/identity.h"
+#include "service/registry/mesh_id.h"
+#include "tests/service/support/stream_recorder.h"
+#include "tests/service/support/temp_dir.h"
+#include "tests/service/support/test_server.h"
+
+namespace deform {
+namespace {
+
+using test_support::StreamRecorder;
+using test_support::TempDir;
+using test_support::TestServer;
+using test_support::TestServerOptions;
+
+client::ClientOptions WithToken(const std::string& token) {
+  client::ClientOptions options;
+  options.token = token;
+  return options;
+}
+
+std::vector<std::string> EntryFiles(const std::string& dir) {
+  std::vector<std::string> names;
+  for (const auto& file : std::filesystem::directory_iterator(dir)) {
+    names.push_back(file.path().filename().string());
+  }
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+int Mode(const std::string& path) {
+  struct stat info {};
+  EXPECT_EQ(::stat(path.c_str(), &info), 0) << path;
+  return static_cast<int>(info.st_mode & 0777);
+}
+
+class MeshStoreTest : public ::testing::Test {
+ protected:
+  MeshStoreTest() {
+    tokens_ = dir_.Write("tokens", service::Sha256Hex("token-a") + " ward-a tenant\n" +
+                                       service::Sha256Hex("token-b") + " ward-b tenant\n");
+    store_ = dir_.Path("store");
+  }
+
+  TempDir dir_;
+  std::string tokens_;
+  std::string store_;
+};
+
+// A server started on the store with tokens, as deformd --store --token-file does.
+class StoredServer {
+ public:
+  StoredServer(const std::string& store, const std::string& tokens) {
+    server_ = std::make_unique<service::DeformServer>(TestServerOptions());
+    EXPECT_TRUE(server_->UseTokenFile(tokens).ok());
+    const Status used = server_->UseStore(store, &restored_);
+    EXPECT_TRUE(used.ok()) << used.ToString();
+    EXPECT_TRUE(server_->Start().ok());
+  }
+  std::unique_ptr<client::DeformClient> NewClient(const std::string& token) const {
+    return std::make_unique<client::DeformClient>(
+        "127.0.0.1:" + std::to_string(server_->port()), WithToken(token));
+  }
+  int restored() const { return restored_; }
+
+ private:
+  std::unique_ptr<service::DeformServer> server_;
+  int restored_ = 0;
+};
+
+std::string UploadPhantomAsObj(client::DeformClient& client, const TempDir& dir) {
+  auto phantom = MakeKneePhantom(400);
+  EXPECT_TRUE(phantom.ok());
+  const std::string mesh_path = dir.Path("phantom.obj");
+  EXPECT_TRUE(WriteMeshFile(phantom->mesh, mesh_path).ok());
+  const std::string skeleton_path = dir.Write("phantom.json", SkeletonToJson(phantom->skeleton));
+  v1::MethodOptions options;
+  options.set_rotation_blend(v1::ROTATION_BLEND_LINEAR);
+  v1::MeshSummary summary;
+  const grpc::Status status =
+      client.LoadMeshFiles(mesh_path, skeleton_path, options, &summary);
+  EXPECT_TRUE(status.ok()) << status.error_message();
+  return summary.mesh_id();
+}
+
+TEST_F(MeshStoreTest, MeshesComeBackWithTheirIdsAndOwnersAndUnloadDeletesThem) {
+  std::string upload_id, phantom_id;
+  v1::GetMeshInfoResponse before;
+  {
+    StoredServer server(store_, tokens_);
+    EXPECT_EQ(server.restored(), 0);
+    auto ward_a = server.NewClient("token-a");
+    auto ward_b = server.NewClient("token-b");
+    upload_id = UploadPhantomAsObj(*ward_a, dir_);
+    ASSERT_TRUE(ward_a->GetMeshInfo(upload_id, true, &before).ok());
+    v1::MeshSummary summary;
+    ASSERT_TRUE(ward_b->LoadPhantom(300, {}, &summary, {}, "bed 7").ok());
+    phantom_id = summary.mesh_id();
+  }
+  EXPECT_EQ(Mode(store_), 0700);
+  EXPECT_EQ(EntryFiles(store_),
+            (std::vector<std::string>{std::min(upload_id, phantom_id) + ".mesh",
+                                      std::max(upload_id, phantom_id) + ".mesh"}));
+  for (const std::string& name : EntryFiles(store_)) EXPECT_EQ(Mode(store_ + "/" + name), 0600);
+
+  StoredServer restarted(store_, tokens_);
+  EXPECT_EQ(restarted.restored(), 2);
+  auto ward_a = restarted.NewClient("token-a");
+  auto ward_b = restarted.NewClient("token-b");
+  std::vector<v1::MeshSummary> meshes;
+  ASSERT_TRUE(ward_a->ListMeshes(&meshes).ok());
+  ASSERT_EQ(meshes.size(), 1u);  // the owner is kept: ward A sees only its upload
+  EXPECT_EQ(meshes[0].mesh_id(), upload_id);
+  v1::GetMeshInfoResponse after;
+  ASSERT_TRUE(ward_a->GetMeshInfo(upload_id, true, &after).ok());
+  EXPECT_EQ(after.summary().name(), before.summary().name());
+  EXPECT_EQ(after.summary().vertex_count(), before.summary().vertex_count());
+  EXPECT_EQ(after.rest_positions(), before.rest_positions());
+  EXPECT_EQ(after.triangles(), before.triangles());
+  EXPECT_EQ(after.summary().rotation_blend(), v1::ROTATION_BLEND_LINEAR);  // options kept
+  EXPECT_EQ(ward_a->GetMeshInfo(phantom_id, false, &after).error_code(),
+            grpc::StatusCode::NOT_FOUND);
+  ASSERT_TRUE(ward_b->GetMeshInfo(phantom_id, false, &after).ok());
+  EXPECT_EQ(after.summary().name(), "bed 7");
+
+  // The restored mesh serves frames under its old id.
+  StreamRecorder recorder;
+  auto stream = ward_a->OpenStream(upload_id, recorder.Callbacks());
+  v1::PoseUpdate pose;
+  pose.set_sequence(1);
+  ASSERT_TRUE(stream->SendPose(pose));
+  EXPECT_TRUE(recorder.WaitForFrames(1));
+  stream->Close();
+  EXPECT_TRUE(stream->Wait().ok());
+
+  ASSERT_TRUE(ward_a->UnloadMesh(upload_id).ok());
+  EXPECT_EQ(EntryFiles(store_), std::vector<std::string>{phantom_id + ".mesh"});
+}
+
+TEST_F(MeshStoreTest, ACorruptEntryIsSkippedAndTheRestRestored) {
+  std::string good_id;
+  {
+    StoredServer server(store_, tokens_);
+    v1::MeshSummary summary;
+    ASSERT_TRUE(server.NewClient("token-a")->LoadPhantom(300, {}, &summary).ok());
+    good_id = summary.mesh_id();
+  }
+  // A truncated copy of the good entry, a garbage entry and an altered byte.
+  std::ifstream in(store_ + "/" + good_id + ".mesh", std::ios::binary);
+  const std::string good((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string truncated_id = service::NewMeshId();
+  std::ofstream(store_ + "/" + truncated_id + ".mesh", std::ios::binary)
+      << good.substr(0, good.size() / 2);
+  std::ofstream(store_ + "/" + service::NewMeshId() + ".mesh") << "garbage";
+  std::string altered = good;
+  altered[altered.size() / 2] ^= 0x20;
+  std::ofstream(store_ + "/" + service::NewMeshId() + ".mesh", std::ios::binary) << altered;
+  std::ofstream(store_ + "/." + service::NewMeshId() + ".pending") << "an unfinished load";
+
+  StoredServer restarted(store_, tokens_);
+  EXPECT_EQ(restarted.restored(), 1);
+  std::vector<v1::MeshSummary> meshes;
+  ASSERT_TRUE(restarted.NewClient("token-a")->ListMeshes(&meshes).ok());
+  ASSERT_EQ(meshes.size(), 1u);
+  EXPECT_EQ(meshes[0].mesh_id(), good_id);
+  for (const std::string& name : EntryFiles(store_)) EXPECT_NE(name[0], '.') << name;
+}
+
+TEST_F(MeshStoreTest, AFailedLoadLeavesNothingInTheStore) {
+  StoredServer server(store_, tokens_);
+  auto ward_a = server.NewClient("token-a");
+  v1::LoadMeshHeader header;
+  header.mutable_upload()->set_format(v1::MESH_FORMAT_OBJ);
+  header.mutable_upload()->set_skeleton_format(v1::SKELETON_FORMAT_TGF);
+  header.mutable_upload()->set_skeleton("1 0 0 0\n2 0 1 0\n#\n1 2\n");
+  v1::MeshSummary summary;
+  EXPECT_EQ(ward_a->LoadMesh(header, "v 0 0 0\nf 1 2 3\n", &summary).error_code(),
+            grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_TRUE(EntryFiles(store_).empty());
+}
+
+}  // namespace
+}  // namespace deform

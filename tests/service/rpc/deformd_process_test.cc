@@ -1,0 +1,148 @@
+// The real deformd and command-line clients in processes: SIGHUP rotates tokens; plaintext on a
+// non-loopback address needs --plaintext; the health probe and deform-vr talk TLS with a token;
+// --store brings a mesh back after a restart under its id (the same pose, the same frame).
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include "service/access/identity.h"
+#include "tests/service/support/deformd_process.h"
+#include "tests/service/support/temp_dir.h"
+#include "tests/service/support/test_certificates.h"
+#include "deform_client.h"
+
+namespace deform {
+namespace {
+
+using ::testing::HasSubstr;
+using test_support::DeformdProcess;
+using test_support::TempDir;
+using test_support::TestCertificates;
+
+std::string TokenLine(const std::string& token, const std::string& tenant) {
+  return service::Sha256Hex(token) + " " + tenant + " tenant\n";
+}
+
+grpc::Status List(const std::string& target, const std::string& token) {
+  client::ClientOptions options;
+  options.token = token;
+  options.unary_deadline_ms = 10'000;
+  client::DeformClient client(target, options);
+  std::vector<v1::MeshSummary> meshes;
+  return client.ListMeshes(&meshes);
+}
+
+TEST(DeformdProcessTest, SighupReloadsTheTokenFile) {
+  TempDir dir;
+  const std::string tokens = dir.Write("tokens", TokenLine("first-token", "ward-a"));
+  DeformdProcess deformd({"--listen", "127.0.0.1:0", "--workers", "1", "--token-file", tokens},
+                         dir.Path("log"));
+  ASSERT_TRUE(deformd.WaitForListening()) << deformd.Log();
+  EXPECT_TRUE(List(deformd.target(), "first-token").ok());
+  EXPECT_EQ(List(deformd.target(), "second-token").error_code(),
+            grpc::StatusCode::UNAUTHENTICATED);
+
+  dir.Write("tokens", TokenLine("second-token", "ward-a"));
+  deformd.Signal(SIGHUP);
+  ASSERT_TRUE(deformd.WaitForLog("token file reloaded")) << deformd.Log();
+  EXPECT_TRUE(List(deformd.target(), "second-token").ok());
+  EXPECT_EQ(List(deformd.target(), "first-token").error_code(), grpc::StatusCode::UNAUTHENTICATED);
+
+  dir.Write("tokens", "garbage\n");
+  deformd.Signal(SIGHUP);
+  ASSERT_TRUE(deformd.WaitForLog("reload failed")) << deformd.Log();
+  EXPECT_TRUE(List(deformd.target(), "second-token").ok());
+  EXPECT_EQ(deformd.Stop(), 0);
+  EXPECT_THAT(deformd.Log(), HasSubstr("[audit] tenant=ward-a action=list"));
+}
+
+TEST(DeformdProcessTest, PlaintextOnAllInterfacesOnlyWithThePlaintextFlag) {
+  TempDir dir;
+  DeformdProcess refused({"--listen", "0.0.0.0:0", "--workers", "1"}, dir.Path("refused.log"));
+  EXPECT_EQ(refused.WaitForExit(), 1);
+  EXPECT_THAT(refused.Log(), HasSubstr("--plaintext"));
+
+  DeformdProcess allowed({"--listen", "0.0.0.0:0", "--workers", "1", "--plaintext"},
+                         dir.Path("allowed.log"));
+  EXPECT_TRUE(allowed.WaitForLog("(plaintext)")) << allowed.Log();
+  EXPECT_EQ(allowed.Stop(), 0);
+}
+
+TEST(DeformdProcessTest, CommandLineClientsTalkTlsWithAToken) {
+  TestCertificates certificates;
+  ASSERT_TRUE(certificates.ok());
+  TempDir dir;
+  const std::string tokens = dir.Write("tokens", TokenLine("vr-token", "ward-a"));
+  DeformdProcess deformd({"--listen", "127.0.0.1:0", "--workers", "1", "--token-file", tokens,
+                          "--tls-cert", certificates.Path("server.pem"), "--tls-key",
+                          certificates.Path("server.key"), "--tls-client-ca",
+                          certificates.Path("ca.pem")},
+                         dir.Path("log"));
+  ASSERT_TRUE(deformd.WaitForListening()) << deformd.Log();
+  EXPECT_THAT(deformd.Log(), HasSubstr("(mutual TLS)"));
+  const std::string tls = " --tls-ca " + certificates.Path("ca.pem") + " --tls-cert " +
+                          certificates.Path("client.pem") + " --tls-key " +
+                          certificates.Path("client.key") + " --tls-server-name localhost";
+  const std::string probe = std::string(DEFORM_PROBE_PATH) + " --target " + deformd.target();
+  EXPECT_EQ(std::system((probe + tls + " >/dev/null 2>&1").c_str()), 0);
+  EXPECT_NE(std::system((probe + " >/dev/null 2>&1").c_str()), 0);  // plaintext: refused
+
+  const std::string vr = std::string(DEFORM_VR_PATH) + " --target " + deformd.target() +
+                         " --phantom-vertices 300 --pose knee:flexion:30 --frames 1 --out " +
+                         dir.Path("bent.obj");
+  EXPECT_EQ(std::system(("DEFORM_TOKEN=vr-token " + vr + tls + " >/dev/null 2>&1").c_str()), 0);
+  EXPECT_TRUE(std::ifstream(dir.Path("bent.obj")).good());
+  const int without_token = std::system((vr + tls + " 2>" + dir.Path("vr.err")).c_str());
+  EXPECT_NE(without_token, 0);
+  std::ifstream err(dir.Path("vr.err"));
+  std::string line;
+  std::getline(err, line);
+  EXPECT_THAT(line, HasSubstr("UNAUTHENTICATED"));
+  EXPECT_EQ(deformd.Stop(), 0);
+}
+
+std::string ReadFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+TEST(DeformdProcessTest, StoreBringsAMeshBackAfterARestart) {
+  TempDir dir;
+  const std::vector<std::string> args = {"--listen", "127.0.0.1:0", "--workers", "1", "--store",
+                                         dir.Path("store")};
+  std::string mesh_id;
+  {
+    DeformdProcess deformd(args, dir.Path("first.log"));
+    ASSERT_TRUE(deformd.WaitForListening()) << deformd.Log();
+    const std::string vr = std::string(DEFORM_VR_PATH) + " --target " + deformd.target() +
+                           " --phantom-vertices 300 --pose knee:flexion:60 --frames 1 --keep-mesh" +
+                           " --out " + dir.Path("before.obj") + " >/dev/null 2>&1";
+    ASSERT_EQ(std::system(vr.c_str()), 0);
+    client::DeformClient client(deformd.target());
+    std::vector<v1::MeshSummary> meshes;
+    ASSERT_TRUE(client.ListMeshes(&meshes).ok());
+    ASSERT_EQ(meshes.size(), 1u);
+    mesh_id = meshes[0].mesh_id();
+    EXPECT_EQ(deformd.Stop(), 0);
+  }
+  DeformdProcess restarted(args, dir.Path("second.log"));
+  ASSERT_TRUE(restarted.WaitForListening()) << restarted.Log();
+  EXPECT_THAT(restarted.Log(), HasSubstr("store: mesh=" + mesh_id + " tenant=default restored"));
+  const std::string vr = std::string(DEFORM_VR_PATH) + " --target " + restarted.target() +
+                         " --mesh-id " + mesh_id + " --pose knee:flexion:60 --frames 1 --out " +
+                         dir.Path("after.obj") + " >/dev/null 2>&1";
+  ASSERT_EQ(std::system(vr.c_str()), 0);
+  EXPECT_EQ(ReadFile(dir.Path("after.obj")), ReadFile(dir.Path("before.obj")));
+  client::DeformClient client(restarted.target());
+  ASSERT_TRUE(client.UnloadMesh(mesh_id).ok());
+  EXPECT_FALSE(std::ifstream(dir.Path("store") + "/" + mesh_id + ".mesh").good());
+  EXPECT_EQ(restarted.Stop(), 0);
+}
+
+}  // namespace
+}  // namespace deform
