@@ -7,7 +7,7 @@
 #               scripts/sanitizers/asan-build.sh), everything ctest runs (the test programs,
 #               deformd and the clients the process tests start, the C API, the Python stubs, the
 #               viewer's files; no benchmarks), then ctest, 2 at a time: every test of the suite, the
-#               tests on the large shared meshes as they are (the slowest takes ~16 s). The
+#               tests on the large shared meshes as they are (durations: docs/testing.md). The
 #               benchmarks' ctest tests (bench/animation) are not built here (Release suite only).
 #               Leaks: scripts/sanitizers/lsan.supp lists OpenMesh's one-time registry only.
 #   TSan:       build-tsan ($DEFORM_TSAN_BUILD_DIR), deform_service_tests, run on the suites in
@@ -18,9 +18,9 @@
 #               deform_hostile_client_tests, deformd) are not run under TSan: Debian's gRPC,
 #               protobuf and absl are not instrumented, so the handover between gRPC's threads
 #               (absl::Mutex on futexes, atomics inside libgrpc) is invisible and TSan reports
-#               every reactor callback as racing with the reactor's constructor (10,517 reports
-#               in one run of deform_service_tests, ~70 with our reactor code on top); hiding
-#               them would mean suppressing our own code. Those tests run under ASan+UBSan above.
+#               every reactor callback as racing with the reactor's constructor (thousands of
+#               reports in one run of deform_service_tests: docs/testing.md); hiding them would
+#               mean suppressing our own code. Those tests run under ASan+UBSan above.
 #               scripts/sanitizers/tsan.supp is for third-party code only and lists nothing.
 #
 # clang++ (scripts/packages/checks.txt) with ccache when installed, -O1 and line tables. Sanitizer
@@ -72,7 +72,7 @@ if [ "$only" = all ] || [ "$only" = tsan ]; then
     grep -qx "$suite\." <<<"$listed" ||
       { echo "check-sanitizers: no suite $suite in deform_service_tests" >&2; exit 1; }
   done
-  # Five rounds for more interleavings (the 55 tests take under a second a round).
+  # Five rounds for more interleavings (cheap: these tests start no server).
   "$TSAN_DIR/tests/deform_service_tests" --gtest_brief=1 --gtest_filter="${filter%:}" \
     --gtest_repeat=5
   echo "check-sanitizers: TSan service tests passed after $(($(date +%s) - tsan_start)) s"
