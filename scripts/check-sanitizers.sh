@@ -7,20 +7,21 @@
 #               scripts/sanitizers/asan-build.sh), everything ctest runs (the test programs,
 #               deformd and the clients the process tests start, the C API, the Python stubs, the
 #               viewer's files; no benchmarks), then ctest, 2 at a time: every test of the suite, the
-#               tests on the large shared meshes as they are (the slowest takes ~16 s). The
+#               tests on the large shared meshes as they are (durations: docs/testing.md). The
 #               benchmarks' ctest tests (bench/animation) are not built here (Release suite only).
 #               Leaks: scripts/sanitizers/lsan.supp lists OpenMesh's one-time registry only.
-#   TSan:       build-tsan ($DEFORM_TSAN_BUILD_DIR), the service's test programs (TSAN_PROGRAMS), run on the suites in
-#               TSAN_SUITES: the frame slots, outbox, pending pose, write pump, shared reactor,
+#   TSan:       build-tsan ($DEFORM_TSAN_BUILD_DIR), the service's test programs (TSAN_PROGRAMS), run on
+#               the suites in
+#               TSAN_SUITES: the frame slots, outbox, pending pose, write pump, self-owning handler,
 #               stiffness switch, worker pool and its parallel runner, registry, token table and the allocation-free
 #               frame paths, where threads meet through our mutexes, condition variables and
 #               atomics, which TSan sees. The tests that start gRPC servers or channels (and
 #               deform_hostile_client_tests, deformd) are not run under TSan: Debian's gRPC,
 #               protobuf and absl are not instrumented, so the handover between gRPC's threads
 #               (absl::Mutex on futexes, atomics inside libgrpc) is invisible and TSan reports
-#               every reactor callback as racing with the reactor's constructor (10,517 reports
-#               in one run of the service tests, ~70 with our reactor code on top); hiding
-#               them would mean suppressing our own code. Those tests run under ASan+UBSan above.
+#               every reactor callback as racing with the reactor's constructor (thousands of
+#               reports in one run of the service tests: docs/testing.md); hiding them would
+#               mean suppressing our own code. Those tests run under ASan+UBSan above.
 #               scripts/sanitizers/tsan.supp is for third-party code only and lists nothing.
 #
 # clang++ (scripts/packages/checks.txt) with ccache when installed, -O1 and line tables. Sanitizer

@@ -8,7 +8,8 @@
 # -DDEFORM_THREAD_SAFETY_ANALYSIS=ON, which adds -Wthread-safety -Werror to our targets only (the
 # generated protobuf code gets none). Only the object files of the annotated targets are compiled
 # (no linking, no tests, no core libraries), without optimisation: the analysis runs in the front
-# end. Installs what is missing (scripts/packages/build.txt and checks.txt: clang). About a minute on 2 cores from scratch; ccache makes reruns fast.
+# end. Installs what is missing (scripts/packages/build.txt and checks.txt: clang). ccache makes
+# reruns fast (durations: docs/testing.md).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 # shellcheck source=scripts/ccache-env.sh

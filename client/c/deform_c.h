@@ -29,7 +29,7 @@
  *   deform_stream's functions may be called from any thread (the stream locks itself); each frame
  *   is handed out once, so one reader per stream is the sensible design. No function calls back
  *   into the caller: frames and notices are polled. Calls that contact the server block (loads for
- *   as long as the server precomputes: seconds for large meshes); keep them off a render thread.
+ *   as long as the server precomputes, which grows with the mesh); keep them off a render thread.
  *   deform_stream_next_frame with timeout 0 and the deform_stream_send_* functions never wait for
  *   the network. A handle must not be freed while another thread is inside a call on it.
  *
@@ -199,7 +199,7 @@ typedef struct deform_stream deform_stream;
 /* How frames travel; the library decodes all of them into float positions. */
 typedef enum deform_encoding {
   DEFORM_ENCODING_FLOAT32 = 1,   /* 12 bytes per vertex, exact */
-  DEFORM_ENCODING_QUANTIZED = 2, /* 16-bit in the frame's box, about 3x smaller */
+  DEFORM_ENCODING_QUANTIZED = 2, /* 16-bit in the frame's box, meshoptimizer-coded */
   DEFORM_ENCODING_PREDICTED = 3  /* skinning prediction + residual within max_error */
 } deform_encoding;
 

@@ -86,7 +86,8 @@ deform_status LoadGeometryLocked(deform_mesh* mesh) {
 }
 
 static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "the wire format is little-endian");
-// The README's C# ConnectOptions (P/Invoke, LayoutKind.Sequential) relies on this layout.
+// The C# ConnectOptions of docs/clients/c-api.md (P/Invoke, LayoutKind.Sequential) relies on this
+// layout.
 static_assert(sizeof(deform_connect_options) == 88, "deform_connect_options' layout changed");
 
 }  // namespace

@@ -19,7 +19,8 @@ namespace {
 
 constexpr std::size_t kMaxNotices = 64;
 
-// The README's C# declarations (P/Invoke, LayoutKind.Sequential) rely on these layouts.
+// The C# declarations of docs/clients/c-api.md (P/Invoke, LayoutKind.Sequential) rely on these
+// layouts.
 static_assert(sizeof(deform_frame_info) == 80, "deform_frame_info's layout changed");
 static_assert(sizeof(deform_joint_angle) == 24, "deform_joint_angle's layout changed");
 static_assert(sizeof(deform_root_transform) == 56, "deform_root_transform's layout changed");

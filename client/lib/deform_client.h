@@ -41,7 +41,8 @@ grpc::Status LoadClientTlsFiles(const std::string& ca_file, const std::string& c
                                 const std::string& key_file, ClientTls* tls);
 
 struct ClientOptions {
-  // Largest message accepted (a 133k-vertex mesh's geometry is about 5 MB). Default: 256 MiB.
+  // Largest message accepted (GetMeshInfo's geometry is 12 bytes per vertex and 12 per
+  // triangle; a float32 frame 12 bytes per vertex). Default: 256 MiB.
   int max_receive_message_bytes = 256 << 20;
   // Upload chunk size for LoadMesh. Default: 1 MiB.
   int upload_chunk_bytes = 1 << 20;

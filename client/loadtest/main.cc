@@ -51,12 +51,12 @@ struct LoadtestArgs {
 };
 
 // Keeps freed heap memory mapped for reuse. The load test receives every stream's frames on gRPC's
-// threads (19.6 KB each for the 1.6k leg, 1.6 MB for the arm) and frees them soon after; by
-// default glibc hands the free top of a thread's heap back to the kernel once it exceeds the trim
-// threshold (128 KiB to start with), so the next frames' buffers fault their pages in again. Fixing
-// the trim threshold stops glibc adapting its mmap threshold too, which is therefore raised as
-// well, so that the arm's frames are not fresh mappings each time. Measured on the 1.6k leg's 128
-// streams over a 10 s run: about 220,000 page faults in the load test before, about 13,000 after.
+// threads (12 bytes a vertex in float32: tens of KB to megabytes each) and frees them soon after;
+// by default glibc hands the free top of a thread's heap back to the kernel once it exceeds the
+// trim threshold (128 KiB to start with), so the next frames' buffers fault their pages in again.
+// Fixing the trim threshold stops glibc adapting its mmap threshold too, which is therefore raised
+// as well, so that a large mesh's frames are not fresh mappings each time. The page faults it
+// saves: bench/RESULTS.md, "Frame encodings, transport and the load test".
 void KeepFreedHeapMapped() {
 #if defined(__GLIBC__)
   constexpr int kTrimThresholdBytes = 64 << 20;

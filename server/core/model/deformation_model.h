@@ -4,7 +4,8 @@
 //   1. DeformationModel::Build(mesh, skeleton, options): validation, harmonic bone weights, joint
 //      regions and joint centre nodes, differential coordinates, anchors, the fill-reducing
 //      ordering and symbolic analysis of the normal equations, and a first numeric factorisation
-//      for the default stiffness. Expensive (about 5 s for the 133k-vertex arm).
+//      for the default stiffness. Expensive: it grows with the mesh (docs/performance.md, "Time
+//      to first frame"); call it off any thread that must stay responsive.
 //   2. model->Factorize(stiffness): a new numeric factorisation for other material weights; the
 //      symbolic analysis is reused. Returns a new immutable object; solves running on an older
 //      factorisation are not disturbed.
@@ -64,8 +65,8 @@ class MaterialFactorization {
   // to the bounding-box diagonal; negative where no probe ran. The factor is stored in float32
   // (factor().stores_float32()) when the probe ran and stayed within kFloat32ProbeTolerance: a
   // quarter of the 1e-6 of the diagonal that frames may differ by (the float32 transport's own
-  // rounding), the margin for poses away from the rest pose (on the shared meshes the error at
-  // 0-120 degrees stays within 1.5 times the rest pose's, at most 2.0e-7 of the diagonal).
+  // rounding), the margin for poses away from the rest pose (how far the error moves across poses
+  // on the shared meshes: docs/performance.md, "Float32 factor").
   double float32_probe_error() const { return float32_probe_error_; }
   static constexpr double kFloat32ProbeTolerance = 2.5e-7;
   // The bytes of its right-hand side's precomputed parts: the rigid rows' sums (rigid_rows.h: 3
@@ -147,7 +148,8 @@ struct BuildHooks {
   // Laplacian system, symbolic analysis, numeric factorisation, linear response): once it is
   // cancelled, Build frees what it made and returns FAILED_PRECONDITION "cancelled during
   // <phase>" at the end of the phase in progress. A phase itself is not interrupted (the longest
-  // are the symbolic analysis and the numeric factorisation: README, "Limits"). Null:
+  // are the symbolic analysis and the numeric factorisation: docs/performance.md, "Time to first
+  // frame"). Null:
   // never cancelled. Must outlive the Build call.
   const CancelToken* cancel = nullptr;
 };
@@ -298,8 +300,8 @@ class DeformationModel {
   const std::vector<BuildPhase>& build_phases() const { return build_phases_; }
 
   // The memory a model holds, estimated; the one formula behind every memory budget, calibrated
-  // against the growth of a server's resident memory when it loads the model (the 133k-vertex
-  // arm: 266 MiB measured; README, "Limits").
+  // against the growth of a server's resident memory when it loads the model (the shared arm's
+  // measurement: docs/performance.md, "Memory").
   // EstimatedBytes(), once built: the default factorisation's factor, linear response and rigid
   // rows' sums as they are, the rigid rows' bones, plus kBytesPerVertex per vertex (rest and
   // differential coordinates, Laplacian rows in both orientations, bone weights, region data, the

@@ -45,18 +45,16 @@ struct ModelOptions {
   // How much a region vertex's differential coordinate refers to its joint centre rather than its
   // one-ring: delta_i = v_i - (sum_j v_j + lambda d_i o_c) / (d_i (1 + lambda)), i.e. the joint
   // node weighs lambda times the whole one-ring. Default: 1 (half one-ring mean, half joint
-  // centre), chosen by measurement: on the shared 1.6k leg at 90 degrees of flexion the volume
-  // change is -2.1% with 1 and -4.2% with METHOD.md's literal "one more neighbour" edge (set
-  // joint_node_one_neighbor), against -2.8% for LBS. Finite and in (0, kMaxJointNodeBalance].
+  // centre), chosen by measurement: it keeps more volume than METHOD.md's literal "one more
+  // neighbour" edge (set joint_node_one_neighbor) and than LBS (docs/method.md, "Joint node
+  // edge"). Finite and in (0, kMaxJointNodeBalance].
   double joint_node_balance = 1.0;
   static constexpr double kMaxJointNodeBalance = 100;
   // Weigh the joint node as exactly one more neighbour (METHOD.md's 1/(d_i + 1)). Default: false.
   bool joint_node_one_neighbor = false;
   // Weight of the rows that move anchor vertices with their skinning (rigidly with their bone in
-  // a rigid zone). Default: 40: with every rigid-zone vertex anchored, rigid zones then stay
-  // within 1e-4 of the diagonal of linear blend skinning on the shared leg at 120 degrees (1e-3
-  // at 10, 2.6e-4 at 20; the shared body in a three-joint pose 1.8e-3 at 20), at the same volume
-  // and clearance to 0.003.
+  // a rigid zone). Default: 40, the weight at which rigid zones follow linear blend skinning
+  // closely without costing volume or clearance (docs/method.md, "Anchors").
   double anchor_weight = 40;
   // Anchors are vertices in a bone's rigid zone (weight 1) at least this many region radii away
   // from every joint centre. Default: 2.
@@ -64,8 +62,8 @@ struct ModelOptions {
   // ...and at least this fraction of each connected piece of a rigid zone (its vertices farthest
   // from the joints), so that every zone is held in proportion to its size (anchors.h). In [0, 1].
   // Default: 1, every rigid-zone vertex: a rig's rigid parts then follow their bones as its own
-  // skinning does (anchoring only the far ones let the zone next to a region drift by up to 1% of
-  // the diagonal); the joint regions are what the method solves.
+  // skinning does (anchoring only the far ones let the zone next to a region drift: docs/method.md,
+  // "Anchors"); the joint regions are what the method solves.
   double anchor_min_fraction = 1.0;
   // Without given weights: which bone a vertex follows. Default: kThroughBody.
   BindingMethod binding = BindingMethod::kThroughBody;
@@ -88,10 +86,9 @@ struct ModelOptions {
   // computes in double) when its double factor holds at least this many bytes and the probe of
   // MaterialFactorization::float32_probe_error() keeps its frames within a quarter of 1e-6 of the
   // diagonal of the double factor's; otherwise the factor stays double. Negative: never (the
-  // default). Worth it where the solve is bound by memory: on the shared 133k arm (146 MB) the
-  // solve takes 0.76x the time (0.66x on two threads; README, "A float32 factor"); on the 26k leg
-  // (25 MB) and smaller factors, which the caches hold, widening the floats costs more than the
-  // bytes save (1.05x and 1.25x).
+  // default). Worth it where the solve is bound by memory (a factor larger than the last-level
+  // cache); for factors the caches hold, widening the floats costs more than the bytes save
+  // (docs/performance.md, "Float32 factor").
   std::int64_t float32_factor_min_bytes = -1;
   MeshLimits limits;
 

@@ -3,8 +3,8 @@
 // Joint regions are measured from the limb's radius; where bones are short against the body's
 // thickness (a spine, a neck, a pelvis) neighbouring regions cover a bone's whole length, the bone
 // has no rigid zone, nothing anchors it, and the harmonic weights of distant bones flow across it
-// (bending a hip moved the upper back of the shared body by 1% of its diagonal). These two rules
-// keep each bone's part of the mesh its own.
+// (bending a hip moved the shared body's upper back: docs/method.md, "Joint regions"). These two
+// rules keep each bone's part of the mesh its own.
 #pragma once
 
 #include <vector>

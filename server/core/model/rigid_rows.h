@@ -5,10 +5,10 @@
 // is wholly one bone's (a single bone-weight entry, so T_j = R_b for the same bone b), the row is
 //   (L'^T r)_i = R_b sum_j L'^T_ij w_j^2 delta_j = R_b c_i,
 // with c_i fixed for a stiffness (the weights w_j are the factorisation's). Rows away from the
-// joint regions are such rigid rows (the shared arm: 77% of its rows; the 26k leg, whose regions
-// are wide: 32%), so a frame computes them as one 3x3 product each, and rotates only the deltas
-// that the other rows (general rows) read. The result equals the full product to round-off (a
-// sum in another order: 1e-14 of its norm, tested).
+// joint regions are such rigid rows (most of a limb's rows, fewer where the regions are wide:
+// docs/performance.md, "Right-hand side"), so a frame computes them as one 3x3 product each, and
+// rotates only the deltas that the other rows (general rows) read. The result equals the full
+// product to round-off (a sum in another order: 1e-14 of its norm, tested).
 #pragma once
 
 #include <Eigen/Core>

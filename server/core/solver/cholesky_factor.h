@@ -25,8 +25,8 @@ class CholeskyFactor {
   // positive definite (names the pivot); INVALID_ARGUMENT for another pattern or a null `symbolic`.
   // `cancel` (optional) is checked every kCancelCheckRows rows: once it is cancelled the
   // factorisation stops there with FAILED_PRECONDITION "cancelled during the numeric
-  // factorisation" and frees what it built (at 2,000,000 phantom vertices the whole
-  // factorisation takes about 20 minutes on the build machines; a cancel now waits milliseconds).
+  // factorisation" and frees what it built: a cancel waits for at most kCancelCheckRows rows, not
+  // for the whole factorization of a large mesh (docs/performance.md, "Time to first frame").
   static StatusOr<CholeskyFactor> Factorize(
       std::shared_ptr<const SymbolicCholesky> symbolic,
       const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& a,

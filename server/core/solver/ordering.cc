@@ -79,8 +79,8 @@ StatusOr<std::vector<int>> MetisOrdering(const ColMajorMatrix& a, std::vector<in
   options[METIS_OPTION_SEED] = 1;  // deterministic ordering from run to run
   std::vector<idx_t> perm(nvtxs), iperm(nvtxs);
   // One METIS call at a time all the same (its random generator is the thread's own, above, but
-  // METIS is not documented as safe to call from several threads): an ordering takes
-  // milliseconds to a few seconds, once per mesh loaded.
+  // METIS is not documented as safe to call from several threads): an ordering runs once per
+  // mesh loaded, so the calls waiting on each other cost little.
   static std::mutex metis_calls;
   int rc;
   {

@@ -307,10 +307,9 @@ ParallelSolvePlan PlanParallelSolve(const SupernodalFactorView& f, int parts) {
   }
   if (*std::min_element(load.begin(), load.end()) <= 0) return plan;  // nothing to run alongside
   // The heaviest part first: a runner's calling thread takes the parts in order and its helpers
-  // start a wake-up later, so theirs should be the lighter. deform_bench on the 26k leg (whose
-  // top separator leaves subtrees 7% apart), alternately with the parts in packing order:
-  // ParallelSolve 1.42-1.47 against 1.59-1.60 ms, ParallelBatchedSolve of four frames 2.30-2.36
-  // against 2.43-2.46, of eight 3.21-3.25 against 3.33-3.38.
+  // start a wake-up later, so theirs should be the lighter. Measured faster than the parts in
+  // packing order where the subtrees below the top differ (bench/RESULTS.md, "Parallel solve and
+  // split batches").
   std::vector<int> order(parts);
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return load[a] > load[b]; });

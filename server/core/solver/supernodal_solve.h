@@ -108,16 +108,11 @@ inline int BatchRowStride(int lanes, int columns) {
 // through); each unknown's solution row, kBatchRowsAhead unknowns on, is asked for into the
 // nearest cache (PrefetchBatchRow) while the row in hand is copied: the rows are the scattered
 // side, a few cache lines each anywhere in the batch's solution rows, which outgrow the core's
-// own cache from the 26k leg on (5 MB for eight frames). Measured alternately in one process
-// (AVX2, Zen 3, DRAM 16-18 GB/s), against no prefetch, with the frames' right-hand sides
-// rewritten before each solve as the service's assembly leaves them: the 26k leg's batch of
-// eight 8.05-8.14 against 8.84 ms split over two threads (ParallelSolveFrames, which also fixes
-// the frame count at compile time, as SolveFrames already did), of four 4.53 against 4.76, of
-// sixteen 15.7-15.9 against 17.4-17.7; on one thread eight 11.7-12.3 against 12.8-13.0, sixteen
-// 25.7-27.2 against 28.2-28.3; the arm's eight split 48.0-49.5 against 49.6-51.5; the 1.6k leg's
-// (solution rows in the core's cache) alike. Solve3's rows (four doubles, one line) are not
-// prefetched: there the same gained nothing (the arm 29.6-30.6 ms either way, the 26k leg
-// 4.28-4.40).
+// own cache once a mesh has tens of thousands of vertices. Split batches (ParallelSolveFrames,
+// which also fixes the frame count at compile time, as SolveFrames does) and unsplit ones
+// measured faster with it where the rows outgrow the core's cache, alike where they fit.
+// Solve3's rows (four doubles, one line) are not prefetched: there the same gained nothing. The
+// figures: bench/RESULTS.md, "Batched solves" and "Triangular solve kernels".
 inline constexpr int kBatchRowsAhead = 8;
 
 // Asks for the cache lines of [address, address + bytes) into the nearest cache (prefetcht0;

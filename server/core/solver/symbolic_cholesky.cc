@@ -202,13 +202,10 @@ StatusOr<std::shared_ptr<const SymbolicCholesky>> SymbolicCholesky::Analyze(cons
       ColumnCounts(s->c_column_pointers_, s->c_row_indices_, s->elimination_tree_);
   if (ordering != Ordering::kNatural) {
     // The ordering followed by a postorder of its elimination tree (as CHOLMOD does): the same
-    // fill, with the tree's chains in consecutive columns. On the 26k leg (METIS) 2,339
-    // supernodes instead of 8,507 (6,609 of them single columns), 8% more stored values, and in
-    // the solves 2.4 times fewer rows below the supernodes' diagonal blocks to update (AVX2, Zen 3,
-    // deform_bench medians of five rounds alternating: TriangularSolve 5.1 against 5.6 ms on the
-    // 26k leg and 35.8 against 38.6 on the arm; BatchedSolve of eight frames 13.3 against 13.9 and
-    // 81.8 against 91.5). The numeric refactorisation measured alike within this host's noise
-    // (Factorize on the 26k leg 284-438 against 280-340 ms).
+    // fill, with the tree's chains in consecutive columns, so that the relaxed amalgamation below
+    // merges them into far fewer, wider supernodes with fewer rows below their diagonal blocks to
+    // update. The solves got faster and the numeric factorization stayed alike
+    // (bench/RESULTS.md, "Factorization and time to first frame").
     // A postorder is a topological relabelling of the tree, so the renumbered matrix's tree and
     // column counts are the old ones relabelled; only the permuted pattern is rebuilt.
     const std::vector<int> order = Postorder(s->elimination_tree_, column_counts);

@@ -373,8 +373,8 @@ TEST(RigBinding, BodyWithHandsByTheThighsAndItsParentsMovesOnlyWhatHangsFromTheH
 
 // Short bones against a thick body (the spine, the pelvis): every bone keeps a rigid core and each
 // bone's weights stay in its joints' regions, so bending a hip leaves the chest, the arms and the
-// head where they are (the chest moved by 1.2% of the diagonal when the thigh's weight spread over
-// the whole torso).
+// head where they are (the chest moved when the thigh's weight spread over the whole torso:
+// docs/method.md, "Harmonic weights").
 TEST(RigBinding, BendingTheBodysHipLeavesTheUpperBodyStill) {
   DEFORM_REQUIRE_SHARED_FILE(mesh_path, "body/body_13380.obj");
   DEFORM_REQUIRE_SHARED_FILE(skeleton_path, "body/body.tgf");

@@ -69,12 +69,9 @@ inline void StoreRow(double* out, int row, Slot sum) {
 
 // base[index[l]] for each lane. With AVX-512 a hardware gather (the masked one: GCC 12's unmasked
 // ones read an undefined source register, and -Wmaybe-uninitialized says so); elsewhere one load
-// a lane. AVX2's four-lane gather was slower than four loads and inserts on an AMD Zen 3: the
-// right-hand side (deform_bench's RightHandSide, three rounds alternating, when the packs still
-// gathered their slots from three planes) 0.026-0.031 against 0.015-0.018 ms on the 1.6k leg,
-// 0.38-0.52 against 0.23-0.30 on the 26k leg, 1.6-1.9 against 0.93-1.07 on the arm. (Intel's
-// microcode against Gather Data Sampling, 2023, slowed the gathers of its AVX2 processors too;
-// not measured here.)
+// a lane. AVX2's four-lane gather was slower than four loads and inserts on an AMD Zen 3
+// (bench/RESULTS.md, "Right-hand side"). (Intel's microcode against Gather Data Sampling, 2023,
+// slowed the gathers of its AVX2 processors too; not measured here.)
 inline Lanes Gather(const double* base, const int* index) {
 #if defined(__AVX512F__)
   return _mm512_mask_i32gather_pd(_mm512_setzero_pd(), 0xff,

@@ -238,34 +238,26 @@ inline void SubtractRow1x3(const Value* __restrict row, const double* __restrict
 // bytes it will read kPrefetchBytes later (ahead in the forward pass, below in the backward pass)
 // as it reads the ones in hand (the three-column backward pass in its own way: see kStripVecs), so
 // that a factor larger than the cache arrives while the kernel computes instead of after it:
-// without it the 133k arm's solve took about the sum of its arithmetic (factor made cache-resident)
-// and of reading its factor from memory, not the larger of the two. Into the outer caches
-// (prefetcht2), except the three-column forward pass's on AMD processors (below). The distance and
-// the hint were chosen by measurement (deform_bench's TriangularSolve and BatchedSolve on the arm;
-// 8 to 64 KB measured alike).
+// without it a solve bound by memory takes about the sum of its arithmetic and of reading its
+// factor, not the larger of the two. Into the outer caches (prefetcht2), except the three-column
+// forward pass's on AMD processors (below). The distance and the hint were chosen by measurement
+// (deform_bench's TriangularSolve and BatchedSolve on the arm; nearby distances measured alike:
+// bench/RESULTS.md, "Triangular solve kernels").
 //
-// The hint. On the 2.6 GHz Xeon VM (DRAM read 10-12 GB/s on one core) a non-temporal hint
-// (prefetchnta) for both passes was twice as slow. On the Zen 5 EPYC VM (DRAM read 29-37 GB/s) the
-// three-column forward pass with it reads the arm's 151 MB factor at about the stream rate: that
-// pass alone 4.5-5.4 ms against 5.1-6.2 into the outer caches; the arm's TriangularSolve, medians
-// of eight rounds alternately in one build, 11.5 against 14.5 ms, and against the build before,
-// twenty rounds, 13.8 against 15.3 (0.91x by round); the 26k leg's and the batched passes alike.
-// Likely why: AMD's last-level cache is filled by what a core's L2 evicts, and a line fetched
-// non-temporally is not put there, so the forward pass's stream neither spends that traffic nor
-// evicts the lines of the factor that the backward pass left there. The same hint in the
-// three-column backward pass (for its outer-cache prefetch, or for all of its prefetches) and in
-// the batched passes measured slower there (bench/RESULTS.md), so they keep prefetcht2, as do
-// other vendors' processors, where this pass has not been measured alone
-// (ForwardStreamIsNonTemporal).
+// The hint. Non-temporal (prefetchnta) only for the three-column forward pass, and only on AMD
+// processors (ForwardStreamIsNonTemporal): AMD's last-level cache is filled by what a core's L2
+// evicts, and a line fetched non-temporally is not put there, so the forward pass's stream
+// neither spends that traffic nor evicts the lines of the factor that the backward pass left
+// there. Elsewhere the hint measured slower (both passes on a Xeon, the backward and the batched
+// passes on AMD), so they keep prefetcht2, as do other vendors' processors, where this pass has
+// not been measured alone. The figures: bench/RESULTS.md, "Triangular solve kernels".
 constexpr std::ptrdiff_t kPrefetchBytes = 16384;
-// A factor that fits a core's own cache (2 MiB of L2 on the machines measured) is not
-// prefetched: it stays there between solves, and the prefetches only cost issue slots (the 1.6k
-// leg's 0.7 MB solve 5-10% slower with them). A larger one is, although it may fit the shared
-// last-level cache: whether it is still there at the next frame depends on what else ran in
-// between (the service's other work, a shared machine's neighbours). deform_bench's ColdSolve on
-// the 26k leg's 25 MB factor, caches emptied before each solve: 4.0-4.7 ms with the prefetches
-// against 6.8 without (DRAM bound 4.7-5.9 ms), a batch of eight 9.3-10.4 against 13.5-13.8; back
-// to back (cache-resident) alike.
+// A factor that fits a core's own cache (its L2) is not prefetched: it stays there between
+// solves, and the prefetches only cost issue slots (the smallest shared mesh measured slower with
+// them). A larger one is, although it may fit the shared last-level cache: whether it is still
+// there at the next frame depends on what else ran in between (the service's other work, a shared
+// machine's neighbours). Cold solves (deform_bench's ColdSolve) gain from the prefetch, and
+// cache-resident ones lose nothing: bench/RESULTS.md, "Triangular solve kernels".
 constexpr std::int64_t kPrefetchMinFactorBytes = std::int64_t{4} << 20;
 
 template <typename Value>
@@ -342,11 +334,9 @@ enum class Pass { kForward, kBackward };
 //
 // The batched passes spread theirs (a line per step of a block's loop, which reads about a line a
 // step; in the backward pass a line per row of each strip of columns): asked all at the start of
-// a block, they held up the loads behind them. deform_bench on the 26k leg, alternately:
-// BatchedSolve of one frame 2.65-2.72 against 3.17-3.21 ms, of four 3.63-3.73 against 4.08-4.10,
-// ParallelBatchedSolve of four 2.24-2.47 against 2.55-2.70. The three-column passes keep the
-// burst: spread (two lines a step among seven loads), the 26k leg's TriangularSolve took
-// 2.41-2.47 against 2.32-2.35 ms.
+// a block, they held up the loads behind them. The three-column passes keep the burst: spread
+// among their few loads a step, they measured slower (bench/RESULTS.md, "Batched solves" and
+// "Triangular solve kernels").
 struct SpreadPrefetch {
   std::uintptr_t begin = 0;
   std::ptrdiff_t lines = 0;
@@ -538,13 +528,11 @@ inline void ForwardUpdate(const SupernodeBlock<Value>& supernode, const Planar& 
 // The batched backward pass takes a supernode's rows below its diagonal block in chunks, the last
 // first, of about kBackwardChunkBytes of solution rows and factor rows each (at least
 // kBackwardChunkMinRows rows): every block of columns and every strip of a row reads the chunk's
-// rows again, and a chunk stays in the core's nearest cache (32 KiB or more) between them. Taken
-// whole, a supernode's rows below were read from the outer caches by each of its width / 4 blocks
-// of columns and each strip (eight times for a 16-wide supernode in a batch of eight frames).
-// Measured alternately in one process (AVX2, Zen 3), chunks against whole, medians of 40-60 rounds
-// (the arm's 12-16): the 26k leg's batch of two frames 6.13 against 7.07 ms, four 5.01 against
-// 5.61, eight 10.7 against 11.7, sixteen 20.8 against 21.4; the arm's eight 68-69 against 75-80;
-// the 1.6k leg's eight alike (0.366 / 0.365). Chunks of 6, 12, 24 and 48 KiB measured alike.
+// rows again, and a chunk, smaller than an x86 core's L1 data cache, stays there between them.
+// Taken whole, a supernode's rows below were read from the outer caches by each of its width / 4
+// blocks of columns and each strip (eight times for a 16-wide supernode in a batch of eight
+// frames). Chunks are faster on every mesh whose rows outgrow the nearest cache, and chunk sizes
+// around this one measured alike (bench/RESULTS.md, "Batched solves").
 constexpr std::int64_t kBackwardChunkBytes = 12 * 1024;
 constexpr std::int64_t kBackwardChunkMinRows = 8;
 
@@ -570,34 +558,26 @@ inline void ForEachBackwardChunk(const SupernodeBlock<Value>& s, int row_stride,
 // the rows go last first: the factor is read as one descending stream, as the forward pass reads
 // it ascending. Until then each four rows updated the supernode's planar unknowns in memory
 // across the whole width (SubtractRows4x3: three loads and three stores for every four of the
-// factor's values), and perf of the 133k arm's TriangularSolve had the backward pass at 1.57
-// times the forward pass's samples over the same bytes; with strips 1.24 (perf of the harness
-// below) and 1.34 (of deform_bench).
+// factor's values), and perf had the backward pass far above the forward pass over the same
+// bytes; strips narrowed the gap (bench/RESULTS.md, "Triangular solve kernels").
 //
 // The three-column backward pass prefetches a factor that streams from memory in its own way.
 // Each strip of columns reads a few lines of every row of a chunk, rows a block's width apart, so
 // the first strip takes every row's lines as misses in a pattern the core's prefetchers do not
 // follow. So the first strip of a chunk asks, as it reads row r, for row r - kBackwardRowsAhead
 // whole into the nearest cache (every strip after it then reads the chunk from there), and for
-// row r's lines kPrefetchBytes below into the outer caches, as the other passes do. On a Zen 5
-// EPYC VM with AVX-512 (DRAM read 29-33 GB/s on one core), deform_bench alternately in one build,
-// four rounds: the arm's TriangularSolve 13.8-14.1 ms against 15.4-16.7 without (its DRAM bound
-// 8.6-9.4), the 26k leg's 1.35-1.42 against 1.33-1.83; either prefetch alone gained about half
-// (the nearest-cache one alone 14.4-14.9 ms on the arm, the outer-cache one alone nothing), and
-// 8 or 32 rows ahead measured alike. (On a Zen 3 VM with 16.6 GB/s, with the strips, the
-// outer-cache prefetch of every line, the diagonal blocks' included, made the arm's solve slower:
-// 30.3 against 26.7 ms with none, medians of 40 solves; this pair has not been measured there.) The
-// batched backward pass prefetches a line a row (BackwardColumnsMany): without it the 26k leg's
-// batch of eight took 10.0 against 9.2 ms there.
+// row r's lines kPrefetchBytes below into the outer caches, as the other passes do. The pair is
+// what measured fastest on a Zen 5 with AVX-512; the nearest-cache prefetch carries most of the
+// gain, and nearby look-aheads measured alike. (On a Zen 3, the outer-cache prefetch of every
+// line alone made the solve slower; the pair has not been measured there.) The batched backward
+// pass prefetches a line a row (BackwardColumnsMany), which measured faster than none. The
+// figures: bench/RESULTS.md, "Triangular solve kernels" and "Batched solves".
 //
 // Its diagonal blocks (BackwardDiagonal, a block of four rows at a time) and its narrow
 // supernodes' rows below (at once, as the forward pass's) ask for their lines kPrefetchBytes below
-// too, so that the stream of requests runs on without a gap while the pass reads them (the arm's
-// diagonal blocks are 28 of its 151 MB): until then the bytes below each diagonal block were
-// asked for by nobody. The Zen 5 VM (DRAM read 31-36 GB/s), six rounds alternately against the
-// build before: the arm's TriangularSolve 10.2-12.0 ms (median 11.0) against 11.2-14.1 (12.1), its
-// solve with the caches emptied first 12.8-14.0 against 12.5-15.4, its float32 factor's 8.2-8.7
-// against 8.3-9.5; the 26k leg's TriangularSolve 1.20-1.29 against 1.25-1.32.
+// too, so that the stream of requests runs on without a gap while the pass reads them (a large
+// mesh's diagonal blocks hold a fair share of its factor's bytes): otherwise the bytes below each
+// diagonal block are asked for by nobody (bench/RESULTS.md, "Triangular solve kernels").
 constexpr int kStripVecs = 4;
 constexpr std::int64_t kBackwardRowsAhead = 16;
 
@@ -850,23 +830,14 @@ constexpr int BatchVecsFor(int columns) { return (columns + kBatchLanes - 1) / k
 // registers.
 //
 // With AVX-512's thirty-two registers a strip is one vector, in blocks of 8 rows: each loaded
-// solved vector serves eight rows. Against a whole row as one strip (a batch of eight frames: 3
-// vectors in blocks of 4 rows; sixteen: 6 in blocks of 2), alternately in one run on a Zen 5
-// EPYC VM (DRAM read 29-33 GB/s on one core), deform_bench's BatchedSolve: the 26k leg's four
-// frames 2.77-2.93 against 3.56-3.77 ms, eight 4.17-4.26 against 5.54-5.74, sixteen 7.83-8.15
-// against 16.3; the 1.6k leg's eight 0.109-0.114 against 0.148-0.154; the arm's eight 32.8-33.5
-// against 40.5-40.9. Strips of at most three vectors (as AVX2's) or two measured between the two.
-// ParallelBatchedSolve (the parts' lists on two threads) gained at four frames (26k leg 1.50-1.55
-// against 2.07-2.24 ms, arm 12.2-12.8 against 15.6-16.0) and lost a little at eight (2.22-2.30
-// against 2.08-2.24, arm 16.1-18.5 against 15.7-15.8). With sixteen (AVX2, and SSE2's pairs) strips
-// of at most three vectors, in blocks of 4 rows: 12 accumulators, 3 loaded vectors and a broadcast.
-// A whole row of eight frames (6 vectors) allowed blocks of 2 rows only, and even their 12
-// accumulators and 6 loaded vectors did not fit: GCC read the solved vectors from memory at each
-// multiply-add and kept sums on the stack. With strips (and SubtractSolvedColumns inlined), against
-// whole rows (and it called), medians of four to six rounds alternating in one process (AVX2, Zen
-// 3), a batch of eight frames: 0.32 against 0.38 ms on the 1.6k leg, 104 against 115 on the arm,
-// and 16.0 against 16.0 on the 26k leg, whose batch's 5 MB of solution rows (24 columns each) are
-// ten times the core's 512 KB L2 (the likely bound there). Strips of two were no faster.
+// solved vector serves eight rows. It measured faster than a whole row as one strip (a batch of
+// eight frames: 3 vectors in blocks of 4 rows; sixteen: 6 in blocks of 2) at every batch size,
+// and than strips of two or three vectors. With sixteen registers (AVX2, and SSE2's pairs)
+// strips of at most three vectors, in blocks of 4 rows: 12 accumulators, 3 loaded vectors and a
+// broadcast. A whole row of eight frames (6 vectors) allowed blocks of 2 rows only, and even
+// their 12 accumulators and 6 loaded vectors did not fit: GCC read the solved vectors from memory
+// at each multiply-add and kept sums on the stack. Strips of two were no faster than three. The
+// figures: bench/RESULTS.md, "Batched solves".
 #if defined(__AVX512F__)
 constexpr int kBatchRegisters = 32;
 constexpr int StripsFor(int vecs) { return vecs; }
@@ -910,9 +881,8 @@ inline void ForEachStrip(Body&& body) {
 // values each) whose sums are held in registers.
 //
 // Always inlined: GCC kept some instances out of line, and the caller's sums then went through
-// the stack at every block of rows, a narrow supernode's few values each. Inlined, against out of
-// line (the same run as above), a batch of four frames (one strip, blocked as before): 0.12
-// against 0.24 ms on the 1.6k leg, 9.7 against 13.4 on the 26k leg, 57 against 95 on the arm.
+// the stack at every block of rows, a narrow supernode's few values each; inlined, every mesh's
+// batches measured faster (bench/RESULTS.md, "Batched solves").
 template <typename Value, int kVecs, int kCount, int kRows>
 __attribute__((always_inline)) inline void SubtractSolvedColumns(
     const Value* __restrict rows, int width, int count, const double* __restrict own,
