@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # Installs the project's npm tooling from its lock files (npm ci: exactly the locked versions,
-# nothing else): proto/ (buf) and client/web/ (three.js for the browser viewer, copied beside
-# deformd by the build; puppeteer-core for its browser test, which drives Debian's chromium and
-# downloads no browser). Installs Debian's nodejs and npm first if npm is missing.
+# nothing else): proto/ (buf) and client/web/ (the browser viewer's three.js, meshoptimizer
+# decoder and protobuf runtime, copied beside deformd by the build; protoc-gen-es, with which the
+# build generates the viewer's messages from the proto; puppeteer-core for its browser test, which
+# drives Debian's chromium and downloads no browser). Installs Debian's nodejs and npm first if
+# npm is missing.
 # Idempotent: a folder whose node_modules was installed from its current lock file is skipped.
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -2,8 +2,12 @@
 // protobuf bodies, the streaming calls as WebSockets carrying one protobuf message per binary
 // message, ended by the server's "status CODE MESSAGE" text message. The bearer token (optional)
 // goes in the Authorization header of POSTs and as the "bearer.<base64url>" subprotocol of
-// WebSockets (browsers cannot set headers on an upgrade).
+// WebSockets (browsers cannot set headers on an upgrade). The paths name the RPCs as the proto's
+// DeformService does (/api/ListMeshes, /ws/Deform), the names taken from the generated code.
+import { DeformService, FrameEncoding } from './deform/v1/deform_pb.js';
 import * as wire from './proto_wire.js';
+
+const rpc = DeformService.method;
 
 function base64url(text) {
   const bytes = new TextEncoder().encode(text);
@@ -15,6 +19,8 @@ function base64url(text) {
 export class DeformApi {
   constructor(token = '') { this.token = token; }
 
+  // POSTs one unary call's request message (bytes) to /api/<method name>; resolves with the
+  // response message's bytes.
   async call(method, body) {
     const headers = { 'Content-Type': 'application/x-protobuf' };
     if (this.token) headers.Authorization = `Bearer ${this.token}`;
@@ -27,14 +33,14 @@ export class DeformApi {
   }
 
   async listMeshes() {
-    return wire.decodeListMeshesResponse(await this.call('ListMeshes', wire.encodeListMeshesRequest()));
+    return wire.decodeListMeshesResponse(await this.call(rpc.listMeshes.name, wire.encodeListMeshesRequest()));
   }
 
   // The summary, rest positions and triangles, and (by default) the prediction weights that
   // FRAME_ENCODING_PREDICTED frames are decoded with.
   async meshInfo(meshId, includePredictionWeights = true) {
     return wire.decodeGetMeshInfoResponse(
-      await this.call('GetMeshInfo', wire.encodeGetMeshInfoRequest(meshId, true, includePredictionWeights)));
+      await this.call(rpc.getMeshInfo.name, wire.encodeGetMeshInfoRequest(meshId, true, includePredictionWeights)));
   }
 
   // A WebSocket to /ws/<method> with the protocol's subprotocols.
@@ -49,7 +55,7 @@ export class DeformApi {
   // Loads the phantom; onProgress(stage name, elapsed ms). Resolves with the mesh summary.
   loadPhantom(vertices, onProgress) {
     return new Promise((resolve, reject) => {
-      const socket = this.openSocket('LoadMesh');
+      const socket = this.openSocket(rpc.loadMesh.name);
       let mesh = null;
       socket.onopen = () => {
         socket.send(wire.encodeLoadPhantomHeader(`phantom ${vertices}`, vertices));
@@ -71,13 +77,13 @@ export class DeformApi {
   }
 }
 
-// One Deform stream over a WebSocket, its frames in `encoding` (FrameEncoding value; 1 = float32,
-// the default) with `maxError` (PREDICTED: a fraction of the diagonal; 0 = the server's default).
+// One Deform stream over a WebSocket, its frames in `encoding` (a FrameEncoding value; FLOAT32 by
+// default) with `maxError` (PREDICTED: a fraction of the diagonal; 0 = the server's default).
 // Callbacks: onFrame(frame, byte length, the DeformResponse message's bytes), onNotice(notice),
 // onEnd(code, message).
 export class DeformStream {
-  constructor(api, meshId, { onFrame, onNotice, onEnd, onOpen, encoding = 1, maxError = 0 }) {
-    this.socket = api.openSocket('Deform');
+  constructor(api, meshId, { onFrame, onNotice, onEnd, onOpen, encoding = FrameEncoding.FLOAT32, maxError = 0 }) {
+    this.socket = api.openSocket(rpc.deform.name);
     this.sequence = 0;
     this.open = false;
     this.socket.onopen = () => {

@@ -21,11 +21,15 @@
 // non-positive step, the wrong number of bone transforms). A FrameDecoder keeps no state between
 // frames (a skipped frame costs nothing); its arrays are read-only after construction.
 import { MeshoptDecoder } from './vendor/meshopt_decoder.mjs';
+import { FrameEncoding, FrameEncodingSchema } from './deform/v1/deform_pb.js';
 
-export const FLOAT32 = 1;
-export const QUANTIZED = 2;
-export const PREDICTED = 3;
-export const ENCODING_NAMES = { [FLOAT32]: 'float32', [QUANTIZED]: 'quantized', [PREDICTED]: 'predicted' };
+// The FrameEncoding values decoded here (the proto's, from the generated code), each named by its
+// enum value's name in lower case ('float32', 'quantized', 'predicted').
+export const FLOAT32 = FrameEncoding.FLOAT32;
+export const QUANTIZED = FrameEncoding.QUANTIZED;
+export const PREDICTED = FrameEncoding.PREDICTED;
+export const ENCODING_NAMES = Object.fromEntries(
+  [FLOAT32, QUANTIZED, PREDICTED].map((value) => [value, FrameEncodingSchema.value[value].localName.toLowerCase()]));
 export const BONES_PER_VERTEX = 4;
 export const FLOATS_PER_BONE_TRANSFORM = 12;
 const RECORD_BYTES = 8;  // uint16 a, b, c, 0
@@ -145,7 +149,7 @@ export class FrameDecoder {
     const n = this.vertexCount;
     const f = Math.fround;
     if (encoded.encoding === QUANTIZED) {
-      if (encoded.origin.length !== 3) throw new Error('a quantised frame without its box origin');
+      if (encoded.origin.length !== 3) throw new Error('a quantized frame without its box origin');
       const records = decodeRecords(encoded.data, n);
       const [ox, oy, oz] = encoded.origin;
       const positions = new Float32Array(3 * n);
