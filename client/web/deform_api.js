@@ -1,4 +1,4 @@
-// deformd's HTTP port from the browser (server/web/web_server.h): the unary calls as POSTs of
+// deformd's HTTP port from the browser (server/service/rpc/web_server.h): the unary calls as POSTs of
 // protobuf bodies, the streaming calls as WebSockets carrying one protobuf message per binary
 // message, ended by the server's "status CODE MESSAGE" text message. The bearer token (optional)
 // goes in the Authorization header of POSTs and as the "bearer.<base64url>" subprotocol of

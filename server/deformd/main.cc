@@ -15,7 +15,7 @@
 // (service/metrics_endpoint.h).
 //
 // --http ADDR also serves the browser viewer and the API over HTTP and WebSockets
-// (web/web_server.h) from the same service core; its files come from --http-root, by default the
+// (service/rpc/web_server.h) from the same service context; its files come from --http-root, by default the
 // `web` directory beside the executable (the build copies client/web there), else
 // ../share/deformd/web.
 //

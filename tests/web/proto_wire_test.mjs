@@ -163,7 +163,7 @@ test('the frame encodings the viewer names are the proto\'s', () => {
 });
 
 // deform_api.js with fetch and WebSocket stubbed: each call goes to the HTTP port's path for the
-// proto's RPC (server/web/web_server.h) with the request message proto_wire.js encodes.
+// proto's RPC (server/service/rpc/web_server.h) with the request message proto_wire.js encodes.
 test('the page calls the proto\'s RPCs at the HTTP port\'s paths', async () => {
   const posts = [], sockets = [];
   globalThis.location = { origin: 'http://127.0.0.1:8080' };

@@ -1,5 +1,5 @@
 // Ownership of an object that a transport calls back through a raw pointer until its last
-// callback, and that worker tasks may outlive: a gRPC callback reactor (and, later, a WebSocket
+// callback, and that worker tasks may outlive: a gRPC callback reactor (and a WebSocket
 // connection's handler).
 //
 // gRPC's callback API takes a raw reactor pointer from the service method, calls the reactor's

@@ -55,7 +55,7 @@ namespace deform::service {
 
 using DeformTransport = StreamTransport<v1::DeformRequest, v1::DeformResponse>;
 
-// A new handler for one Deform call over `transport`; it starts reading at once. `core` and the
+// A new handler for one Deform call over `transport`; it starts reading at once. `context` and the
 // transport must outlive it (the transport until its OnDone()).
 StreamHandler* NewDeformStream(ServiceContext* context, Identity caller, DeformTransport* transport);
 

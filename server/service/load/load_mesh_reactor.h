@@ -30,7 +30,7 @@ namespace deform::service {
 
 using LoadMeshTransport = StreamTransport<v1::LoadMeshRequest, v1::LoadMeshResponse>;
 
-// A new handler for one LoadMesh call over `transport`; it starts reading at once. `core` and the
+// A new handler for one LoadMesh call over `transport`; it starts reading at once. `context` and the
 // transport must outlive it (the transport until its OnDone()).
 StreamHandler* NewLoadMeshStream(ServiceContext* context, Identity caller, LoadMeshTransport* transport);
 

@@ -62,7 +62,7 @@ class DeformServer {
   // for the next call. On error the old tokens stay and the error is returned (and logged).
   Status ReloadTokens();
 
-  // Another transport over the same core (deformd's HTTP port, web/web_server.h): Shutdown() calls
+  // Another transport over the same context (deformd's HTTP port, rpc/web_server.h): Shutdown() calls
   // `stop` with a grace period after the streams were drained and gRPC has stopped, before the
   // worker pool stops, so that its streams end while the pool still runs. Before Start().
   void AddTransportStop(std::function<void(std::chrono::milliseconds)> stop);

@@ -1,6 +1,6 @@
 // The deform.v1.DeformService implementation: a thin layer that converts messages, looks things
 // up in the ServiceContext and maps statuses. Streaming RPCs get their own reactors
-// (load_mesh_reactor.h, deform_stream_reactor.h). Thread-safe; `core` must outlive it.
+// (load_mesh_reactor.h, deform_stream_reactor.h). Thread-safe; `context` must outlive it.
 //
 // Every call is authenticated first (context->auth(), from the "authorization" metadata): without a
 // valid token it ends with UNAUTHENTICATED before anything else is looked at. Then the caller's

@@ -1,12 +1,12 @@
 // The service's unary calls and the authentication of every call, independent of the transport:
-// gRPC's DeformServiceImpl (deform_service.h) and the HTTP endpoints (web/http_api.h) both call
+// gRPC's DeformServiceImpl (deform_service.h) and the HTTP endpoints (rpc/web_server.h) both call
 // these, so both get the same checks, tenancy and audit lines.
 //
 // `authorization` is the value of the caller's "authorization" header or metadata ("Bearer
 // TOKEN"; empty when absent). Every call authenticates first (UNAUTHENTICATED before anything
 // else is looked at, with a token file), checks its strings' lengths (request_limits.h), sees only
 // the caller's meshes (MeshRegistry's caller-scoped lookups) and leaves an audit line
-// (audit_log.h). Thread-safe; `core` must outlive the call.
+// (audit_log.h). Thread-safe; `context` must outlive the call.
 #pragma once
 
 #include <string_view>

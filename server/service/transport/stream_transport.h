@@ -1,6 +1,6 @@
 // A streaming call, independent of the transport that carries it: the stream's logic (a
 // StreamHandler: the Deform stream, LoadMesh) runs unchanged over gRPC (grpc_stream_adapter.h)
-// and over a WebSocket (web/websocket_session.h).
+// and over a WebSocket (transport/websocket_session.h).
 //
 // The contract is gRPC's callback reactor's, so the handlers keep gRPC's semantics:
 //  - The handler asks for one request at a time (StartRead); the transport fills it and calls

@@ -5,7 +5,7 @@
 //    Deform stream writes its latest-wins frame slot and its notices in order, LoadMesh its FIFO
 //    of progress messages.
 //  - The transport (a StreamWriteSink) starts a write and ends the stream: gRPC's reactor
-//    (grpc_stream_adapter.h) or a WebSocket session (web/websocket_session.h), both through
+//    (grpc_stream_adapter.h) or a WebSocket session (transport/websocket_session.h), both through
 //    stream_transport.h. Nothing here depends on grpc::ServerBidiReactor;
 //    grpc::Status is only the value type of the final status (its canonical codes).
 //

@@ -1,4 +1,4 @@
-// The WebSocket transport under a StreamHandler (service/stream_transport.h): one connection, one
+// The WebSocket transport under a StreamHandler (stream_transport.h): one connection, one
 // streaming call. Internal to web_server.cc (Boost.Beast types); the wire format is in
 // web_server.h.
 //
