@@ -4,8 +4,10 @@
 
 #include <CLI/CLI.hpp>
 #include <map>
+#include <sstream>
 #include <string>
 
+#include "core/codec/frame_codec.h"
 #include "deform/v1/deform.pb.h"
 
 namespace deform::cli {
@@ -25,12 +27,18 @@ inline std::string FrameEncodingName(deform::v1::FrameEncoding encoding) {
   return "float32";
 }
 
+// The flag's help; the predicted frames' error is the codec's default (core/codec/frame_codec.h).
+inline std::string FrameEncodingHelp() {
+  std::ostringstream help;
+  help << "How frames travel: float32 (12 bytes per vertex), quantized (16 bits in the frame's "
+          "box, meshoptimizer's vertex codec) or predicted (the residual against skinning both "
+          "sides compute, within "
+       << codec::kDefaultPredictedMaxError << " of the diagonal)";
+  return help.str();
+}
+
 inline CLI::Option* AddFrameEncodingFlag(CLI::App& app, deform::v1::FrameEncoding* encoding) {
-  return app
-      .add_option("--encoding", *encoding,
-                  "How frames travel: float32 (12 bytes per vertex), quantized (16 bits in the "
-                  "frame's box, meshoptimizer's vertex codec) or predicted (the residual against "
-                  "skinning both sides compute, within 5e-5 of the diagonal)")
+  return app.add_option("--encoding", *encoding, FrameEncodingHelp())
       ->transform(CLI::CheckedTransformer(FrameEncodingNames(), CLI::ignore_case))
       ->default_str("float32");
 }
