@@ -7,6 +7,7 @@
 #include <sstream>
 #include <string>
 
+#include "cli/enum_flag.h"
 #include "core/codec/frame_codec.h"
 #include "deform/v1/deform.pb.h"
 
@@ -21,10 +22,7 @@ inline const std::map<std::string, deform::v1::FrameEncoding>& FrameEncodingName
 }
 
 inline std::string FrameEncodingName(deform::v1::FrameEncoding encoding) {
-  for (const auto& [name, value] : FrameEncodingNames()) {
-    if (value == encoding) return name;
-  }
-  return "float32";
+  return NameOf(FrameEncodingNames(), encoding, "float32");
 }
 
 // The flag's help; the predicted frames' error is the codec's default (core/codec/frame_codec.h).
@@ -38,9 +36,8 @@ inline std::string FrameEncodingHelp() {
 }
 
 inline CLI::Option* AddFrameEncodingFlag(CLI::App& app, deform::v1::FrameEncoding* encoding) {
-  return app.add_option("--encoding", *encoding, FrameEncodingHelp())
-      ->transform(CLI::CheckedTransformer(FrameEncodingNames(), CLI::ignore_case))
-      ->default_str("float32");
+  return AddEnumFlag(app, "--encoding", encoding, FrameEncodingNames(), FrameEncodingHelp(),
+                     "float32");
 }
 
 // Bytes a frame's positions took on the wire: its encoded positions, or its float32 ones.
