@@ -28,6 +28,7 @@
 #include "bench/arithmetic_peak.h"
 #include "bench/bench_meshes.h"
 #include "bench/memory_bandwidth.h"
+#include "core/base/median.h"
 #include "core/io/model_input.h"
 #include "core/io/phantom.h"
 #include "core/model/deformation_model.h"
@@ -37,20 +38,19 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double Median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v.empty() ? 0 : v[v.size() / 2];
+// The wall time of one call of `run`, in seconds.
+template <typename Run>
+double SecondsOf(Run&& run) {
+  const auto start = Clock::now();
+  run();
+  return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
 // Runs `frame` once per benchmark iteration and returns each run's wall time in seconds.
 template <typename Frame>
 std::vector<double> TimeEach(benchmark::State& state, Frame&& frame) {
   std::vector<double> seconds;
-  for (auto _ : state) {
-    const auto start = Clock::now();
-    frame();
-    seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
-  }
+  for (auto _ : state) seconds.push_back(SecondsOf(frame));
   return seconds;
 }
 
@@ -152,9 +152,7 @@ template <typename Run>
 std::vector<double> TimeRuns(std::size_t runs, Run&& run) {
   std::vector<double> seconds;
   for (std::size_t i = 0; i < std::max<std::size_t>(runs, 20); ++i) {
-    const auto start = Clock::now();
-    run();
-    seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
+    seconds.push_back(SecondsOf(run));
   }
   return seconds;
 }
@@ -199,9 +197,7 @@ std::vector<double> TimeEachCold(benchmark::State& state, Frame&& frame) {
     state.PauseTiming();
     EvictCaches();
     state.ResumeTiming();
-    const auto start = Clock::now();
-    frame();
-    seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
+    seconds.push_back(SecondsOf(frame));
   }
   return seconds;
 }

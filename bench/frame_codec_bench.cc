@@ -8,6 +8,7 @@
 //                     (predicted frames: with their bone transforms, 48 bytes per bone)
 //   max_error_diag    the largest per-coordinate distance of a decoded coordinate from the solved
 //                     one over the trajectory, as a fraction of the bounding-box diagonal
+// Predicted frames are coded at the server's default error (codec::kDefaultPredictedMaxError).
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -24,7 +25,6 @@ namespace deform::bench {
 namespace {
 
 constexpr int kTrajectoryFrames = 24;
-constexpr double kPredictedMaxError = 5e-5;  // of the diagonal: the server's default
 
 struct Trajectory {
   int num_vertices = 0;
@@ -73,7 +73,7 @@ std::shared_ptr<const Trajectory> TrajectoryFor(const BenchMesh& mesh) {
 std::unique_ptr<codec::FrameEncoder> EncoderFor(const Trajectory& t, bool predicted) {
   if (!predicted) return std::make_unique<codec::FrameEncoder>(t.num_vertices);
   return std::make_unique<codec::FrameEncoder>(t.rest, t.weights, t.num_bones,
-                                               2 * kPredictedMaxError * t.diagonal);
+                                               2 * codec::kDefaultPredictedMaxError * t.diagonal);
 }
 
 struct CodedTrajectory {

@@ -18,6 +18,8 @@
 # required (the joints are the rig's).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# shellcheck source=scripts/deformd-process.sh
+source scripts/deformd-process.sh
 BIN="${DEFORM_BUILD_DIR:-build}"
 SHARED="${DEFORM_SHARED_DATA:-../shared/data}"
 
@@ -34,16 +36,7 @@ while [ $# -gt 0 ]; do
   esac
 done
 
-WORK="$(mktemp -d)"
-SERVER=""
-cleanup() {
-  if [ -n "$SERVER" ]; then
-    kill -TERM "$SERVER" 2>/dev/null || true
-    wait "$SERVER" 2>/dev/null || true
-  fi
-  rm -rf "$WORK"
-}
-trap cleanup EXIT
+deformd_make_work
 
 # The walk on the shared body's TGF skeleton (joints joint0..joint69): joint4 / joint9 the left /
 # right hip (flexion is a negative x rotation), joint5 / joint10 the knees (flexion positive x),
@@ -98,22 +91,14 @@ fi
 
 # Port 0: the kernel picks a free port. 50051 is left to the demo and to others' servers.
 start_server() {
-  "$BIN/server/deformd/deformd" --listen 127.0.0.1:0 --log-level info >"$WORK/deformd.log" 2>&1 &
-  SERVER=$!
-  ADDRESS=""
-  for _ in $(seq 1 300); do
-    ADDRESS="$(sed -n 's/.*listening on \([0-9.]*:[0-9]*\).*/\1/p' "$WORK/deformd.log" | head -n 1)"
-    [ -n "$ADDRESS" ] && return 0
-    kill -0 "$SERVER" 2>/dev/null || { echo "animation-benchmark: deformd exited:" >&2; cat "$WORK/deformd.log" >&2; exit 1; }
-    sleep 0.1
-  done
+  deformd_start "$WORK/deformd.log" "$BIN/server/deformd/deformd" --listen 127.0.0.1:0 \
+    --log-level info || { cat "$WORK/deformd.log" >&2; exit 1; }
 }
 start_server
-if [ "${ADDRESS##*:}" = 50051 ]; then
-  kill -TERM "$SERVER"; wait "$SERVER" || true
+if [ "${DEFORMD_ADDRESS##*:}" = 50051 ]; then
+  deformd_stop
   start_server
 fi
-[ -n "$ADDRESS" ] || { echo "animation-benchmark: deformd did not report its address" >&2; exit 1; }
 
-"$BIN/bench/animation/deform-animation-bench" --target "$ADDRESS" "${SOURCE[@]}" \
+"$BIN/bench/animation/deform-animation-bench" --target "$DEFORMD_ADDRESS" "${SOURCE[@]}" \
   --poses "$POSES" "${PASS[@]}"

@@ -5,6 +5,7 @@
 #include <grpcpp/support/status.h>
 
 #include <exception>
+#include <initializer_list>
 #include <new>
 #include <string>
 
@@ -36,25 +37,34 @@ deform_status Guarded(const char* function, Body&& body) noexcept {
   }
 }
 
-// INVALID_ARGUMENT naming `what` (a parameter) when `pointer` is null.
-template <typename T>
-bool Missing(const T* pointer, const char* function, const char* what, deform_status* status) {
-  if (pointer != nullptr) return false;
-  *status = Fail(DEFORM_INVALID_ARGUMENT, std::string(function) + ": " + what + " is NULL");
-  return true;
+// A pointer parameter that must not be null, and its name.
+struct Required {
+  const void* pointer;
+  const char* name;
+};
+
+// Guarded(function, body), but first INVALID_ARGUMENT naming the first of `required` that is
+// null, if one is (`body` then does not run).
+template <typename Body>
+deform_status Guarded(const char* function, std::initializer_list<Required> required,
+                      Body&& body) noexcept {
+  return Guarded(function, [&] {
+    for (const Required& parameter : required) {
+      if (parameter.pointer == nullptr) {
+        return Fail(DEFORM_INVALID_ARGUMENT,
+                    std::string(function) + ": " + parameter.name + " is NULL");
+      }
+    }
+    return body();
+  });
 }
 
 // A getter's whole body: INVALID_ARGUMENT naming the parameter when `object` or `out` is null,
-// else *out = read(*object) and DEFORM_OK. `function` as for Guarded; the names as for Missing.
+// else *out = read(*object) and DEFORM_OK. `function` as for Guarded.
 template <typename Object, typename Out, typename Read>
 deform_status Get(const char* function, const Object* object, const char* object_name, Out* out,
                   const char* out_name, Read&& read) noexcept {
-  return Guarded(function, [&] {
-    deform_status status;
-    if (Missing(object, function, object_name, &status) ||
-        Missing(out, function, out_name, &status)) {
-      return status;
-    }
+  return Guarded(function, {{object, object_name}, {out, out_name}}, [&] {
     *out = read(*object);
     return Succeed();
   });

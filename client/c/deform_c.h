@@ -204,8 +204,9 @@ typedef enum deform_encoding {
 } deform_encoding;
 
 /* Opens a Deform stream on `mesh_id`. `max_error`: for DEFORM_ENCODING_PREDICTED, the largest
- * error per coordinate as a fraction of the mesh's bounding-box diagonal, (0, 0.01]; 0 = 5e-5;
- * ignored otherwise. Checks the mesh first: NOT_FOUND for an unknown id. Free with
+ * error per coordinate as a fraction of the mesh's bounding-box diagonal, (0, 0.01]; 0 = the
+ * default, 5e-5 (kDefaultPredictedMaxError, defined in server/core/codec/frame_codec.h); ignored
+ * otherwise. Checks the mesh first: NOT_FOUND for an unknown id. Free with
  * deform_stream_free. */
 DEFORM_C_API deform_status deform_stream_open(deform_client* client, const char* mesh_id,
                                               deform_encoding encoding, double max_error,

@@ -97,23 +97,17 @@ using deform::c_api::Fail;
 using deform::c_api::FromGrpc;
 using deform::c_api::Get;
 using deform::c_api::Guarded;
-using deform::c_api::Missing;
 using deform::c_api::Succeed;
 
 extern "C" {
 
 deform_status deform_connect(const deform_connect_options* options, deform_client** out) {
-  const char* const fn = __func__;
-  return Guarded(fn, [&] {
-    deform_status status;
-    if (Missing(options, fn, "options", &status) || Missing(out, fn, "out", &status)) {
-      return status;
-    }
+  return Guarded(__func__, {{options, "options"}, {out, "out"}}, [&] {
     if (options->target == nullptr || options->target[0] == '\0') {
       return Fail(DEFORM_INVALID_ARGUMENT, "deform_connect: options.target is not set");
     }
     deform::client::ClientOptions client_options;
-    status = deform::c_api::MakeClientOptions(*options, &client_options);
+    const deform_status status = deform::c_api::MakeClientOptions(*options, &client_options);
     if (status != DEFORM_OK) return status;
     auto handle = std::make_unique<deform_client>();
     handle->client =
@@ -133,12 +127,7 @@ void deform_client_free(deform_client* client) { delete client; }
 
 deform_status deform_load_phantom(deform_client* client, int vertices, const char* name,
                                   deform_mesh** out) {
-  const char* const fn = __func__;
-  return Guarded(fn, [&] {
-    deform_status status;
-    if (Missing(client, fn, "client", &status) || Missing(out, fn, "out", &status)) {
-      return status;
-    }
+  return Guarded(__func__, {{client, "client"}, {out, "out"}}, [&] {
     if (vertices < 0) return Fail(DEFORM_INVALID_ARGUMENT, "deform_load_phantom: vertices < 0");
     deform::v1::MeshSummary summary;
     const grpc::Status loaded = client->client->LoadPhantom(
@@ -151,13 +140,7 @@ deform_status deform_load_phantom(deform_client* client, int vertices, const cha
 deform_status deform_load_files(deform_client* client, const char* mesh_path,
                                 const char* skeleton_path, const char* weights_path,
                                 deform_mesh** out) {
-  const char* const fn = __func__;
-  return Guarded(fn, [&] {
-    deform_status status;
-    if (Missing(client, fn, "client", &status) || Missing(mesh_path, fn, "mesh_path", &status) ||
-        Missing(out, fn, "out", &status)) {
-      return status;
-    }
+  return Guarded(__func__, {{client, "client"}, {mesh_path, "mesh_path"}, {out, "out"}}, [&] {
     deform::v1::MeshSummary summary;
     const grpc::Status loaded = client->client->LoadMeshFiles(
         mesh_path, deform::c_api::Text(skeleton_path), deform::v1::MethodOptions(), &summary, {},
@@ -168,13 +151,7 @@ deform_status deform_load_files(deform_client* client, const char* mesh_path,
 }
 
 deform_status deform_mesh_open(deform_client* client, const char* mesh_id, deform_mesh** out) {
-  const char* const fn = __func__;
-  return Guarded(fn, [&] {
-    deform_status status;
-    if (Missing(client, fn, "client", &status) || Missing(mesh_id, fn, "mesh_id", &status) ||
-        Missing(out, fn, "out", &status)) {
-      return status;
-    }
+  return Guarded(__func__, {{client, "client"}, {mesh_id, "mesh_id"}, {out, "out"}}, [&] {
     deform::v1::GetMeshInfoResponse info;
     const grpc::Status found = client->client->GetMeshInfo(mesh_id, false, &info);
     if (!found.ok()) return FromGrpc(found, "deform_mesh_open");
@@ -206,10 +183,7 @@ deform_status deform_mesh_triangle_count(const deform_mesh* mesh, uint32_t* coun
 
 deform_status deform_mesh_rest_geometry(deform_mesh* mesh, float* positions, size_t capacity_floats,
                                         uint32_t* triangles, size_t capacity_indices) {
-  const char* const fn = __func__;
-  return Guarded(fn, [&] {
-    deform_status status;
-    if (Missing(mesh, fn, "mesh", &status)) return status;
+  return Guarded(__func__, {{mesh, "mesh"}}, [&] {
     const std::size_t floats = 3 * static_cast<std::size_t>(mesh->summary.vertex_count());
     const std::size_t indices = 3 * static_cast<std::size_t>(mesh->summary.triangle_count());
     if (positions != nullptr && capacity_floats < floats) {
@@ -225,7 +199,7 @@ deform_status deform_mesh_rest_geometry(deform_mesh* mesh, float* positions, siz
                       std::to_string(mesh->summary.triangle_count()) + " triangles)");
     }
     std::lock_guard<std::mutex> lock(mesh->geometry_mutex);
-    status = deform::c_api::LoadGeometryLocked(mesh);
+    const deform_status status = deform::c_api::LoadGeometryLocked(mesh);
     if (status != DEFORM_OK) return status;
     if (positions != nullptr) {
       std::memcpy(positions, mesh->rest_positions.data(), sizeof(float) * floats);
@@ -244,11 +218,8 @@ deform_status deform_mesh_joint_count(const deform_mesh* mesh, uint32_t* count) 
 
 deform_status deform_mesh_joint(const deform_mesh* mesh, uint32_t joint, deform_joint_info* info) {
   const char* const fn = __func__;
-  return Guarded(fn, [&] {
+  return Guarded(fn, {{mesh, "mesh"}, {info, "info"}}, [&] {
     deform_status status;
-    if (Missing(mesh, fn, "mesh", &status) || Missing(info, fn, "info", &status)) {
-      return status;
-    }
     const deform::v1::JointInfo* found = deform::c_api::FindJoint(mesh, joint, fn, &status);
     if (found == nullptr) return status;
     info->name = found->name().c_str();
@@ -265,11 +236,8 @@ deform_status deform_mesh_joint(const deform_mesh* mesh, uint32_t joint, deform_
 deform_status deform_mesh_joint_dof(const deform_mesh* mesh, uint32_t joint, uint32_t dof,
                                     deform_dof_info* info) {
   const char* const fn = __func__;
-  return Guarded(fn, [&] {
+  return Guarded(fn, {{mesh, "mesh"}, {info, "info"}}, [&] {
     deform_status status;
-    if (Missing(mesh, fn, "mesh", &status) || Missing(info, fn, "info", &status)) {
-      return status;
-    }
     const deform::v1::JointInfo* found = deform::c_api::FindJoint(mesh, joint, fn, &status);
     if (found == nullptr) return status;
     if (dof >= static_cast<uint32_t>(found->dofs_size())) {
@@ -290,10 +258,7 @@ deform_status deform_mesh_joint_dof(const deform_mesh* mesh, uint32_t joint, uin
 
 deform_status deform_list_meshes(deform_client* client, char* buffer, size_t capacity,
                                  size_t* needed, size_t* count) {
-  const char* const fn = __func__;
-  return Guarded(fn, [&] {
-    deform_status status;
-    if (Missing(client, fn, "client", &status)) return status;
+  return Guarded(__func__, {{client, "client"}}, [&] {
     if (buffer == nullptr && capacity > 0) {
       return Fail(DEFORM_INVALID_ARGUMENT, "deform_list_meshes: buffer is NULL, capacity > 0");
     }
@@ -315,12 +280,7 @@ deform_status deform_list_meshes(deform_client* client, char* buffer, size_t cap
 }
 
 deform_status deform_unload_mesh(deform_client* client, const char* mesh_id) {
-  const char* const fn = __func__;
-  return Guarded(fn, [&] {
-    deform_status status;
-    if (Missing(client, fn, "client", &status) || Missing(mesh_id, fn, "mesh_id", &status)) {
-      return status;
-    }
+  return Guarded(__func__, {{client, "client"}, {mesh_id, "mesh_id"}}, [&] {
     return FromGrpc(client->client->UnloadMesh(mesh_id), "deform_unload_mesh");
   });
 }

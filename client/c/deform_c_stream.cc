@@ -102,22 +102,32 @@ struct deform_stream {
 namespace deform::c_api {
 namespace {
 
-// Sends `pose` with the next sequence number (under the stream's send lock).
-deform_status SendPose(deform_stream* stream, v1::PoseUpdate* pose, std::uint64_t* sequence,
-                       const char* function) {
+// Runs `send` (true when the message was queued) under the stream's send lock: STREAM_ENDED when
+// the stream was closed, the stream's end (EndedStatus) when `send` fails.
+template <typename Send>
+deform_status SendLocked(deform_stream* stream, const char* function, Send&& send) {
   std::lock_guard<std::mutex> lock(stream->send_mutex);
   if (stream->closed) {
     return Fail(DEFORM_STREAM_ENDED, std::string(function) + ": the stream was closed");
   }
-  pose->set_sequence(stream->next_sequence);
-  pose->set_client_timestamp_ns(client::MonotonicNanos());
-  if (!stream->stream->SendPose(*pose)) {
+  if (!send()) {
     std::lock_guard<std::mutex> inbox_lock(stream->inbox->mutex);
     return EndedStatus(stream->inbox->final_status, function);
   }
-  if (sequence != nullptr) *sequence = stream->next_sequence;
-  ++stream->next_sequence;
   return Succeed();
+}
+
+// Sends `pose` with the next sequence number.
+deform_status SendPose(deform_stream* stream, v1::PoseUpdate* pose, std::uint64_t* sequence,
+                       const char* function) {
+  return SendLocked(stream, function, [&] {
+    pose->set_sequence(stream->next_sequence);
+    pose->set_client_timestamp_ns(client::MonotonicNanos());
+    if (!stream->stream->SendPose(*pose)) return false;
+    if (sequence != nullptr) *sequence = stream->next_sequence;
+    ++stream->next_sequence;
+    return true;
+  });
 }
 
 }  // namespace
@@ -127,20 +137,13 @@ using deform::c_api::Fail;
 using deform::c_api::FromGrpc;
 using deform::c_api::Get;
 using deform::c_api::Guarded;
-using deform::c_api::Missing;
 using deform::c_api::Succeed;
 
 extern "C" {
 
 deform_status deform_stream_open(deform_client* client, const char* mesh_id,
                                  deform_encoding encoding, double max_error, deform_stream** out) {
-  const char* const fn = __func__;
-  return Guarded(fn, [&] {
-    deform_status status;
-    if (Missing(client, fn, "client", &status) || Missing(mesh_id, fn, "mesh_id", &status) ||
-        Missing(out, fn, "out", &status)) {
-      return status;
-    }
+  return Guarded(__func__, {{client, "client"}, {mesh_id, "mesh_id"}, {out, "out"}}, [&] {
     // A C caller may pass any int; in C++ loading an enum outside its values is undefined, so
     // the value is checked as the int it was passed as (its bytes), before it is used as an enum.
     static_assert(sizeof(deform_encoding) == sizeof(int), "a C enum is passed as an int");
@@ -183,10 +186,7 @@ deform_status deform_stream_send_pose(deform_stream* stream, const deform_joint_
                                       size_t angle_count, const deform_joint_rotation* rotations,
                                       size_t rotation_count, const deform_root_transform* root,
                                       uint64_t* sequence) {
-  const char* const fn = __func__;
-  return Guarded(fn, [&] {
-    deform_status status;
-    if (Missing(stream, fn, "stream", &status)) return status;
+  return Guarded(__func__, {{stream, "stream"}}, [&] {
     if ((angles == nullptr && angle_count > 0) || (rotations == nullptr && rotation_count > 0)) {
       return Fail(DEFORM_INVALID_ARGUMENT,
                   "deform_stream_send_pose: an array is NULL but its count is not 0");
@@ -230,12 +230,7 @@ deform_status deform_stream_send_pose(deform_stream* stream, const deform_joint_
 
 deform_status deform_stream_send_pose_text(deform_stream* stream, const char* pose_text,
                                            uint64_t* sequence) {
-  const char* const fn = __func__;
-  return Guarded(fn, [&] {
-    deform_status status;
-    if (Missing(stream, fn, "stream", &status) || Missing(pose_text, fn, "pose", &status)) {
-      return status;
-    }
+  return Guarded(__func__, {{stream, "stream"}, {pose_text, "pose"}}, [&] {
     deform::v1::PoseUpdate pose;
     std::string error;
     if (!deform::client::ParsePoseAngles(pose_text, &pose, &error)) {
@@ -251,10 +246,7 @@ deform_status deform_stream_send_stiffness(deform_stream* stream,
                                            const deform_region_weight* regions, size_t region_count,
                                            const uint32_t* vertex_indices,
                                            const double* vertex_weights, size_t vertex_count) {
-  const char* const fn = __func__;
-  return Guarded(fn, [&] {
-    deform_status status;
-    if (Missing(stream, fn, "stream", &status)) return status;
+  return Guarded(__func__, {{stream, "stream"}}, [&] {
     if ((materials == nullptr && material_count > 0) || (regions == nullptr && region_count > 0) ||
         ((vertex_indices == nullptr || vertex_weights == nullptr) && vertex_count > 0)) {
       return Fail(DEFORM_INVALID_ARGUMENT,
@@ -285,28 +277,15 @@ deform_status deform_stream_send_stiffness(deform_stream* stream,
       update.add_vertex_indices(vertex_indices[k]);
       update.add_vertex_weights(vertex_weights[k]);
     }
-    std::lock_guard<std::mutex> lock(stream->send_mutex);
-    if (stream->closed) {
-      return Fail(DEFORM_STREAM_ENDED, "deform_stream_send_stiffness: the stream was closed");
-    }
-    if (!stream->stream->SendStiffness(update)) {
-      std::lock_guard<std::mutex> inbox_lock(stream->inbox->mutex);
-      return deform::c_api::EndedStatus(stream->inbox->final_status,
-                                        "deform_stream_send_stiffness");
-    }
-    return Succeed();
+    return deform::c_api::SendLocked(stream, "deform_stream_send_stiffness",
+                                     [&] { return stream->stream->SendStiffness(update); });
   });
 }
 
 deform_status deform_stream_next_frame(deform_stream* stream, float* positions,
                                        size_t capacity_floats, int timeout_ms,
                                        deform_frame_info* info) {
-  const char* const fn = __func__;
-  return Guarded(fn, [&] {
-    deform_status status;
-    if (Missing(stream, fn, "stream", &status) || Missing(positions, fn, "positions", &status)) {
-      return status;
-    }
+  return Guarded(__func__, {{stream, "stream"}, {positions, "positions"}}, [&] {
     deform::c_api::StreamInbox& inbox = *stream->inbox;
     std::unique_lock<std::mutex> lock(inbox.mutex);
     const auto ready = [&inbox] { return inbox.has_frame || inbox.ended; };
@@ -357,12 +336,7 @@ deform_status deform_stream_next_frame(deform_stream* stream, float* positions,
 
 deform_status deform_stream_next_notice(deform_stream* stream, deform_notice_info* info,
                                         char* message, size_t message_capacity) {
-  const char* const fn = __func__;
-  return Guarded(fn, [&] {
-    deform_status status;
-    if (Missing(stream, fn, "stream", &status) || Missing(info, fn, "info", &status)) {
-      return status;
-    }
+  return Guarded(__func__, {{stream, "stream"}, {info, "info"}}, [&] {
     if (message == nullptr && message_capacity > 0) {
       return Fail(DEFORM_INVALID_ARGUMENT,
                   "deform_stream_next_notice: message is NULL, message_capacity > 0");
@@ -385,10 +359,7 @@ deform_status deform_stream_next_notice(deform_stream* stream, deform_notice_inf
 }
 
 deform_status deform_stream_close(deform_stream* stream, int timeout_ms) {
-  const char* const fn = __func__;
-  return Guarded(fn, [&] {
-    deform_status status;
-    if (Missing(stream, fn, "stream", &status)) return status;
+  return Guarded(__func__, {{stream, "stream"}}, [&] {
     {
       std::lock_guard<std::mutex> lock(stream->send_mutex);
       stream->closed = true;

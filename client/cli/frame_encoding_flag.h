@@ -4,8 +4,11 @@
 
 #include <CLI/CLI.hpp>
 #include <map>
+#include <sstream>
 #include <string>
 
+#include "cli/enum_flag.h"
+#include "core/codec/frame_codec.h"
 #include "deform/v1/deform.pb.h"
 
 namespace deform::cli {
@@ -19,20 +22,22 @@ inline const std::map<std::string, deform::v1::FrameEncoding>& FrameEncodingName
 }
 
 inline std::string FrameEncodingName(deform::v1::FrameEncoding encoding) {
-  for (const auto& [name, value] : FrameEncodingNames()) {
-    if (value == encoding) return name;
-  }
-  return "float32";
+  return NameOf(FrameEncodingNames(), encoding, "float32");
+}
+
+// The flag's help; the predicted frames' error is the codec's default (core/codec/frame_codec.h).
+inline std::string FrameEncodingHelp() {
+  std::ostringstream help;
+  help << "How frames travel: float32 (12 bytes per vertex), quantized (16 bits in the frame's "
+          "box, meshoptimizer's vertex codec) or predicted (the residual against skinning both "
+          "sides compute, within "
+       << codec::kDefaultPredictedMaxError << " of the diagonal)";
+  return help.str();
 }
 
 inline CLI::Option* AddFrameEncodingFlag(CLI::App& app, deform::v1::FrameEncoding* encoding) {
-  return app
-      .add_option("--encoding", *encoding,
-                  "How frames travel: float32 (12 bytes per vertex), quantized (16 bits in the "
-                  "frame's box, meshoptimizer's vertex codec) or predicted (the residual against "
-                  "skinning both sides compute, within 5e-5 of the diagonal)")
-      ->transform(CLI::CheckedTransformer(FrameEncodingNames(), CLI::ignore_case))
-      ->default_str("float32");
+  return AddEnumFlag(app, "--encoding", encoding, FrameEncodingNames(), FrameEncodingHelp(),
+                     "float32");
 }
 
 // Bytes a frame's positions took on the wire: its encoded positions, or its float32 ones.

@@ -6,6 +6,7 @@
 #include <map>
 #include <string>
 
+#include "cli/enum_flag.h"
 #include "deform/v1/deform.pb.h"
 
 namespace deform::cli {
@@ -19,21 +20,17 @@ inline const std::map<std::string, deform::v1::RotationBlend>& RotationBlendName
 
 inline std::string RotationBlendName(deform::v1::RotationBlend blend) {
   if (blend == deform::v1::ROTATION_BLEND_UNSPECIFIED) return "quaternion";  // the default
-  for (const auto& [name, value] : RotationBlendNames()) {
-    if (value == blend) return name;
-  }
-  return "unknown";
+  return NameOf(RotationBlendNames(), blend, "unknown");
 }
 
 inline CLI::Option* AddRotationBlendFlag(CLI::App& app, deform::v1::RotationBlend* blend) {
-  return app
-      .add_option("--rotation-blend", *blend,
-                  "How the mesh loaded blends bone rotations near a joint: quaternion (the "
-                  "method's default) or linear (linear between samples of the bones' "
-                  "quaternion blend, four segments per weight: a precomputed response, no solve per frame, a few tenths "
-                  "of a percent more volume loss at a bent joint)")
-      ->transform(CLI::CheckedTransformer(RotationBlendNames(), CLI::ignore_case))
-      ->default_str("quaternion");
+  return AddEnumFlag(app, "--rotation-blend", blend, RotationBlendNames(),
+                     "How the mesh loaded blends bone rotations near a joint: quaternion (the "
+                     "method's default) or linear (linear between samples of the bones' "
+                     "quaternion blend, four segments per weight: a precomputed response, no "
+                     "solve per frame, a few tenths of a percent more volume loss at a bent "
+                     "joint)",
+                     "quaternion");
 }
 
 }  // namespace deform::cli

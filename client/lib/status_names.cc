@@ -1,46 +1,30 @@
 #include "status_names.h"
 
+#include "core/base/status.h"
+
 namespace deform::client {
+namespace {
+
+// grpc::StatusCode is numbered as the canonical codes, whose names the core's table holds
+// (tests/client/status_names_test.cc checks every number against Abseil's names).
+constexpr bool SameNumber(grpc::StatusCode grpc_code, StatusCode code) {
+  return static_cast<int>(grpc_code) == static_cast<int>(code);
+}
+static_assert(SameNumber(grpc::StatusCode::OK, StatusCode::kOk));
+static_assert(SameNumber(grpc::StatusCode::INVALID_ARGUMENT, StatusCode::kInvalidArgument));
+static_assert(SameNumber(grpc::StatusCode::NOT_FOUND, StatusCode::kNotFound));
+static_assert(SameNumber(grpc::StatusCode::RESOURCE_EXHAUSTED, StatusCode::kResourceExhausted));
+static_assert(SameNumber(grpc::StatusCode::FAILED_PRECONDITION, StatusCode::kFailedPrecondition));
+static_assert(SameNumber(grpc::StatusCode::OUT_OF_RANGE, StatusCode::kOutOfRange));
+static_assert(SameNumber(grpc::StatusCode::INTERNAL, StatusCode::kInternal));
+static_assert(SameNumber(grpc::StatusCode::UNAUTHENTICATED, StatusCode::kUnauthenticated));
+static_assert(static_cast<int>(grpc::StatusCode::UNAUTHENTICATED) == kCanonicalStatusCodes - 1);
+
+}  // namespace
 
 const char* StatusCodeName(grpc::StatusCode code) {
-  switch (code) {
-    case grpc::StatusCode::OK:
-      return "OK";
-    case grpc::StatusCode::CANCELLED:
-      return "CANCELLED";
-    case grpc::StatusCode::UNKNOWN:
-      return "UNKNOWN";
-    case grpc::StatusCode::INVALID_ARGUMENT:
-      return "INVALID_ARGUMENT";
-    case grpc::StatusCode::DEADLINE_EXCEEDED:
-      return "DEADLINE_EXCEEDED";
-    case grpc::StatusCode::NOT_FOUND:
-      return "NOT_FOUND";
-    case grpc::StatusCode::ALREADY_EXISTS:
-      return "ALREADY_EXISTS";
-    case grpc::StatusCode::PERMISSION_DENIED:
-      return "PERMISSION_DENIED";
-    case grpc::StatusCode::RESOURCE_EXHAUSTED:
-      return "RESOURCE_EXHAUSTED";
-    case grpc::StatusCode::FAILED_PRECONDITION:
-      return "FAILED_PRECONDITION";
-    case grpc::StatusCode::ABORTED:
-      return "ABORTED";
-    case grpc::StatusCode::OUT_OF_RANGE:
-      return "OUT_OF_RANGE";
-    case grpc::StatusCode::UNIMPLEMENTED:
-      return "UNIMPLEMENTED";
-    case grpc::StatusCode::INTERNAL:
-      return "INTERNAL";
-    case grpc::StatusCode::UNAVAILABLE:
-      return "UNAVAILABLE";
-    case grpc::StatusCode::DATA_LOSS:
-      return "DATA_LOSS";
-    case grpc::StatusCode::UNAUTHENTICATED:
-      return "UNAUTHENTICATED";
-    default:
-      return "UNKNOWN_CODE";
-  }
+  const char* name = CanonicalStatusCodeName(static_cast<int>(code));
+  return name != nullptr ? name : "UNKNOWN_CODE";
 }
 
 std::string StatusText(const grpc::Status& status) {

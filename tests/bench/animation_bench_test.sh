@@ -10,20 +10,13 @@
 #   malformed  an animation with a malformed line, and one with an unknown joint: exit code 2 and
 #              a stderr line naming the line number (checked before any server is contacted).
 set -euo pipefail
+# shellcheck source=scripts/deformd-process.sh
+source "$(dirname "$0")/../../scripts/deformd-process.sh"
 DEFORMD="$1"
 BENCH="$2"
 MODE="$3"
 WRITER="${4:-}"
-WORK="$(mktemp -d)"
-SERVER=""
-cleanup() {
-  if [ -n "$SERVER" ]; then
-    kill -TERM "$SERVER" 2>/dev/null || true
-    wait "$SERVER" 2>/dev/null || true
-  fi
-  rm -rf "$WORK"
-}
-trap cleanup EXIT
+deformd_make_work
 fail() { echo "FAIL: $*" >&2; exit 1; }
 
 expect_usage_error() {  # animation-file, line number expected in the message
@@ -56,16 +49,8 @@ case "$MODE" in
     ;;
   *) fail "unknown mode '$MODE'" ;;
 esac
-"$DEFORMD" --listen 127.0.0.1:0 --log-level info >"$WORK/deformd.log" 2>&1 &
-SERVER=$!
-ADDRESS=""
-for _ in $(seq 1 100); do
-  ADDRESS="$(sed -n 's/.*listening on \([0-9.]*:[0-9]*\).*/\1/p' "$WORK/deformd.log" | head -n 1)"
-  [ -n "$ADDRESS" ] && break
-  kill -0 "$SERVER" 2>/dev/null || fail "deformd exited: $(cat "$WORK/deformd.log")"
-  sleep 0.1
-done
-[ -n "$ADDRESS" ] || fail "deformd did not report its address"
+deformd_start "$WORK/deformd.log" "$DEFORMD" --listen 127.0.0.1:0 --log-level info ||
+  fail "deformd did not start: $(cat "$WORK/deformd.log")"
 
 {
   echo "# 10 frames: the knee 0 -> 120 -> 0 while the hip swings and the body moves forward"
@@ -76,8 +61,8 @@ done
 } >"$WORK/walk.txt"
 
 code=0
-"$BENCH" --target "$ADDRESS" "${SOURCE[@]}" --poses "$WORK/walk.txt" --json >"$WORK/report.json" \
-  2>"$WORK/err.txt" || code=$?
+"$BENCH" --target "$DEFORMD_ADDRESS" "${SOURCE[@]}" --poses "$WORK/walk.txt" --json \
+  >"$WORK/report.json" 2>"$WORK/err.txt" || code=$?
 cat "$WORK/err.txt" >&2
 [ "$code" -eq 0 ] || fail "exit code $code"
 python3 - "$WORK/report.json" "$MODE" <<'PY'

@@ -199,9 +199,9 @@ class DeformClient:
     def stream(self, mesh_id, encoding="float32", max_error=0.0):
         """Opens a Deform stream on `mesh_id` whose frames travel in `encoding` (float32,
         quantized or predicted; max_error: predicted frames' largest error as a fraction of the
-        bounding-box diagonal, 0 = the server's default 5e-5). Asks GetMeshInfo first for what
-        the decoder needs (which also raises NOT_FOUND for an unknown id). Returns a
-        DeformStream (stream.py)."""
+        bounding-box diagonal, 0 = the server's default 5e-5, kDefaultPredictedMaxError in
+        server/core/codec/frame_codec.h). Asks GetMeshInfo first for what the decoder needs
+        (which also raises NOT_FOUND for an unknown id). Returns a DeformStream (stream.py)."""
         encoding = codec.encoding_from_name(encoding)
         predicted = encoding == codec.PREDICTED
         info = self.info(mesh_id, geometry=predicted, prediction_weights=predicted)

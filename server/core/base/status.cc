@@ -1,27 +1,29 @@
 #include "core/base/status.h"
 
+#include <array>
+#include <cstddef>
+
 namespace deform {
 
+namespace {
+
+// Indexed by the canonical number (gRPC's doc/statuscodes.md).
+constexpr std::array<const char*, kCanonicalStatusCodes> kCanonicalNames = {
+    "OK",        "CANCELLED",      "UNKNOWN",           "INVALID_ARGUMENT",   "DEADLINE_EXCEEDED",
+    "NOT_FOUND", "ALREADY_EXISTS", "PERMISSION_DENIED", "RESOURCE_EXHAUSTED", "FAILED_PRECONDITION",
+    "ABORTED",   "OUT_OF_RANGE",   "UNIMPLEMENTED",     "INTERNAL",           "UNAVAILABLE",
+    "DATA_LOSS", "UNAUTHENTICATED"};
+
+}  // namespace
+
+const char* CanonicalStatusCodeName(int number) {
+  if (number < 0 || number >= kCanonicalStatusCodes) return nullptr;
+  return kCanonicalNames[static_cast<std::size_t>(number)];
+}
+
 const char* StatusCodeName(StatusCode code) {
-  switch (code) {
-    case StatusCode::kOk:
-      return "OK";
-    case StatusCode::kInvalidArgument:
-      return "INVALID_ARGUMENT";
-    case StatusCode::kNotFound:
-      return "NOT_FOUND";
-    case StatusCode::kOutOfRange:
-      return "OUT_OF_RANGE";
-    case StatusCode::kResourceExhausted:
-      return "RESOURCE_EXHAUSTED";
-    case StatusCode::kFailedPrecondition:
-      return "FAILED_PRECONDITION";
-    case StatusCode::kInternal:
-      return "INTERNAL";
-    case StatusCode::kUnauthenticated:
-      return "UNAUTHENTICATED";
-  }
-  return "UNKNOWN";
+  const char* name = CanonicalStatusCodeName(static_cast<int>(code));
+  return name != nullptr ? name : "UNKNOWN";
 }
 
 std::string Status::ToString() const {

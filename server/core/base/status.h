@@ -12,17 +12,29 @@
 
 namespace deform {
 
+// Each value is its canonical gRPC code's number (gRPC's doc/statuscodes.md), so a code converts
+// to a gRPC code by its number; the core uses only these eight.
 enum class StatusCode {
   kOk = 0,
-  kInvalidArgument,     // the input (mesh, skeleton, pose, request) is malformed
-  kNotFound,            // a named thing (file, joint, mesh id) does not exist
-  kOutOfRange,          // a value lies outside its allowed range
-  kResourceExhausted,   // a configured limit would be exceeded
-  kFailedPrecondition,  // the operation does not apply in the current state
-  kInternal,            // a numerical or programming failure (e.g. factorisation broke down)
-  kUnauthenticated,     // the caller presented no valid credentials (the service's token check)
+  kInvalidArgument = 3,     // the input (mesh, skeleton, pose, request) is malformed
+  kNotFound = 5,            // a named thing (file, joint, mesh id) does not exist
+  kResourceExhausted = 8,   // a configured limit would be exceeded
+  kFailedPrecondition = 9,  // the operation does not apply in the current state
+  kOutOfRange = 11,         // a value lies outside its allowed range
+  kInternal = 13,           // a numerical or programming failure (e.g. factorization broke down)
+  kUnauthenticated = 16,    // the caller presented no valid credentials (the service's token check)
 };
 
+// The canonical gRPC codes are numbered 0 (OK) to kCanonicalStatusCodes - 1 (UNAUTHENTICATED).
+inline constexpr int kCanonicalStatusCodes = 17;
+
+// The canonical name of the gRPC code numbered `number`, e.g. 3 -> "INVALID_ARGUMENT"; nullptr
+// outside [0, kCanonicalStatusCodes). The one table of these names: the core's messages, the
+// clients' error text and the service's metric labels all read it.
+const char* CanonicalStatusCodeName(int number);
+
+// The canonical name of `code`, e.g. "INVALID_ARGUMENT"; "UNKNOWN" for a number no canonical code
+// has.
 const char* StatusCodeName(StatusCode code);
 
 class [[nodiscard]] Status {

@@ -25,6 +25,12 @@ namespace deform::codec {
 
 enum class FrameEncoding { kFloat32 = 1, kQuantized = 2, kPredicted = 3 };
 
+// The largest per-coordinate error of kPredicted frames when a stream asks for none
+// (DeformStart.max_error = 0), as a fraction of the mesh's bounding-box diagonal: such a stream's
+// step is 2 x this x the diagonal. The one home of the default; the server, the benchmarks and the
+// clients' help text read it.
+inline constexpr double kDefaultPredictedMaxError = 5e-5;
+
 // What a coded frame states besides its bytes.
 struct EncodedFrameHeader {
   FrameEncoding encoding = FrameEncoding::kQuantized;

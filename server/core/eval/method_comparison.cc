@@ -7,17 +7,13 @@
 #include <string>
 #include <vector>
 
+#include "core/base/median.h"
 #include "core/eval/skinning.h"
 
 namespace deform {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double Median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  return values[values.size() / 2];
-}
 
 // Runs `frame` `repeat` times; each run's wall time in seconds.
 template <typename Frame>

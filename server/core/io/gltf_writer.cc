@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "core/io/base64.h"
 #include "internal/mesh_io_internal.h"
 
 namespace deform {
@@ -20,23 +21,6 @@ constexpr int kFloat = 5126;
 constexpr int kUnsignedByte = 5121;
 constexpr int kUnsignedShort = 5123;
 constexpr int kUnsignedInt = 5125;
-
-std::string Base64(const std::string& bytes) {
-  static constexpr char kAlphabet[] =
-      "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  out.reserve((bytes.size() + 2) / 3 * 4);
-  for (std::size_t i = 0; i < bytes.size(); i += 3) {
-    std::uint32_t group = static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[i])) << 16;
-    if (i + 1 < bytes.size()) group |= static_cast<unsigned char>(bytes[i + 1]) << 8;
-    if (i + 2 < bytes.size()) group |= static_cast<unsigned char>(bytes[i + 2]);
-    out.push_back(kAlphabet[(group >> 18) & 63]);
-    out.push_back(kAlphabet[(group >> 12) & 63]);
-    out.push_back(i + 1 < bytes.size() ? kAlphabet[(group >> 6) & 63] : '=');
-    out.push_back(i + 2 < bytes.size() ? kAlphabet[group & 63] : '=');
-  }
-  return out;
-}
 
 // One buffer built section by section; each section becomes a bufferView and an accessor.
 class BufferBuilder {
@@ -242,7 +226,7 @@ StatusOr<std::string> WriteGltf(const TriangleMesh& mesh, const Skeleton& skelet
   while (binary.size() % 4 != 0) binary.push_back('\0');
   doc["buffers"] = {{{"byteLength", binary.size()}}};
   if (container == GltfContainer::kGltf) {
-    doc["buffers"][0]["uri"] = "data:application/octet-stream;base64," + Base64(binary);
+    doc["buffers"][0]["uri"] = "data:application/octet-stream;base64," + Base64Encode(binary);
     return doc.dump(1);
   }
   return GlbBytes(doc.dump(), binary);

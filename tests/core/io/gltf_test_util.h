@@ -4,8 +4,8 @@
 //   Tube():        an open tube along +Y (rings of vertices from y = 0 to y = 2) on a chain of
 //                  three joints at y = 0, 1, 2, blending between the two bones around y = 1.
 //   GltfBuilder:   a glTF document assembled from raw accessors: every accessor gets its own
-//                  bufferView in one buffer; ToGltf() embeds it as a data URI, ToGlb() as the BIN
-//                  chunk.
+//                  bufferView in one buffer; ToGltf() embeds it as a data URI (the io layer's
+//                  Base64Encode, which base64_test.cc checks on its own), ToGlb() as the BIN chunk.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -21,6 +21,7 @@
 #include "core/geometry/mesh.h"
 #include "core/geometry/skeleton.h"
 #include "core/geometry/skin_weights.h"
+#include "core/io/base64.h"
 
 namespace deform::gltf_test {
 
@@ -108,7 +109,7 @@ class GltfBuilder {
 
   std::string ToGltf() {
     nlohmann::json doc = Finished();
-    doc["buffers"][0]["uri"] = "data:application/octet-stream;base64," + Base64(buffer_);
+    doc["buffers"][0]["uri"] = "data:application/octet-stream;base64," + Base64Encode(buffer_);
     return doc.dump();
   }
   std::string ToGlb() {
@@ -128,22 +129,6 @@ class GltfBuilder {
     put(static_cast<std::uint32_t>(binary.size()));
     put(0x004E4942);
     return out + binary;
-  }
-
-  static std::string Base64(const std::string& bytes) {
-    static constexpr char kAlphabet[] =
-        "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    std::string out;
-    for (std::size_t i = 0; i < bytes.size(); i += 3) {
-      std::uint32_t group = static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[i])) << 16;
-      if (i + 1 < bytes.size()) group |= static_cast<unsigned char>(bytes[i + 1]) << 8;
-      if (i + 2 < bytes.size()) group |= static_cast<unsigned char>(bytes[i + 2]);
-      out.push_back(kAlphabet[(group >> 18) & 63]);
-      out.push_back(kAlphabet[(group >> 12) & 63]);
-      out.push_back(i + 1 < bytes.size() ? kAlphabet[(group >> 6) & 63] : '=');
-      out.push_back(i + 2 < bytes.size() ? kAlphabet[group & 63] : '=');
-    }
-    return out;
   }
 
  private:

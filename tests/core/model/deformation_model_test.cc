@@ -158,12 +158,49 @@ TEST(DeformationModel, RefusesAFactorisationOrScratchOfAnotherModel) {
   EXPECT_EQ(scratch.positions(), foreign_scratch.positions());
 }
 
-// DeformBatch's arguments: a pointer to each element, as Element* (const or not).
-template <typename Element, typename Container>
-std::vector<Element*> PointersTo(Container& elements) {
-  std::vector<Element*> pointers;
-  for (auto& element : elements) pointers.push_back(&element);
-  return pointers;
+// A batch's frames: one pose per spec, each pose's frame solved alone by Deform(), a scratch per
+// frame, and the pointer arrays DeformBatch takes (into the vectors, which are never resized).
+struct BatchFrames {
+  BatchFrames(const DeformationModel& model, const std::vector<std::string>& specs) {
+    for (const std::string& spec : specs) {
+      poses.push_back(PoseFromSpec(model.skeleton(), spec));
+      expected.push_back(DeformOnce(model, poses.back()));
+      scratches.push_back(model.MakeScratch());
+    }
+    for (const Pose& pose : poses) pose_pointers.push_back(&pose);
+    for (DeformScratch& scratch : scratches) scratch_pointers.push_back(&scratch);
+  }
+  BatchFrames(const BatchFrames&) = delete;
+  BatchFrames& operator=(const BatchFrames&) = delete;
+
+  // Expects the first `count` scratches to hold the frames solved alone, to 1e-12 of the diagonal.
+  void ExpectSolvedAlone(const DeformationModel& model, int count,
+                         const std::string& context = "") const {
+    for (int f = 0; f < count; ++f) {
+      EXPECT_LE(MaxDistance(scratches[f].positions(), expected[f]),
+                1e-12 * model.bounding_box_diagonal())
+          << context << "frame " << f << " of " << count;
+    }
+  }
+
+  std::vector<Pose> poses;
+  std::vector<Positions> expected;
+  std::vector<DeformScratch> scratches;
+  std::vector<const Pose*> pose_pointers;
+  std::vector<DeformScratch*> scratch_pointers;
+};
+
+// `count` specs, each made by `spec` from its frame's index.
+template <typename Spec>
+std::vector<std::string> Specs(int count, Spec&& spec) {
+  std::vector<std::string> specs;
+  for (int f = 0; f < count; ++f) specs.push_back(spec(f));
+  return specs;
+}
+
+// The shared leg's batches: joint 1 bent by 15 degrees more in each of `count` frames.
+std::vector<std::string> LegBendSpecs(int count) {
+  return Specs(count, [](int f) { return "1:x:" + std::to_string(15 * f); });
 }
 
 // Frames solved in one batch (one pass over the factor for all their columns) equal the frames
@@ -173,41 +210,27 @@ TEST(DeformationModel, ABatchOfFramesEqualsTheFramesSolvedOneByOne) {
   auto model = BuildPhantomModel();
   const MaterialFactorization& factorization = *model->default_factorization();
   const int most = DeformationModel::kMaxBatchFrames;
-  std::vector<Pose> poses;
-  std::vector<Positions> expected;
-  for (int f = 0; f < most; ++f) {
-    poses.push_back(PoseFromSpec(model->skeleton(), "knee:flexion:" + std::to_string(8 * f)));
-    expected.push_back(DeformOnce(*model, poses.back()));
-  }
-  std::vector<DeformScratch> scratches;
-  for (int f = 0; f < most; ++f) scratches.push_back(model->MakeScratch());
-  const std::vector<const Pose*> pose_pointers = PointersTo<const Pose>(poses);
-  const std::vector<DeformScratch*> scratch_pointers = PointersTo<DeformScratch>(scratches);
+  BatchFrames frames(*model,
+                     Specs(most, [](int f) { return "knee:flexion:" + std::to_string(8 * f); }));
+  const Pose* const* pose_pointers = frames.pose_pointers.data();
+  DeformScratch* const* scratch_pointers = frames.scratch_pointers.data();
   DeformBatchScratch batch = model->MakeBatchScratch(most);
   EXPECT_EQ(batch.max_frames, most);
-  const double tolerance = 1e-12 * model->bounding_box_diagonal();
   for (int count = 1; count <= most; ++count) {
     const long before = test_support::AllocationCount();
-    ASSERT_TRUE(model->DeformBatch(factorization, pose_pointers.data(), scratch_pointers.data(),
-                                   count, &batch));
+    ASSERT_TRUE(model->DeformBatch(factorization, pose_pointers, scratch_pointers, count, &batch));
     EXPECT_EQ(test_support::AllocationCount() - before, 0) << "count " << count;
-    for (int f = 0; f < count; ++f) {
-      EXPECT_LE(MaxDistance(scratches[f].positions(), expected[f]), tolerance)
-          << "frame " << f << " of " << count;
-    }
+    frames.ExpectSolvedAlone(*model, count);
   }
   EXPECT_EQ(model->MakeBatchScratch(1000).max_frames, most);
   EXPECT_EQ(model->MakeBatchScratch(0).max_frames, 1);
 #ifdef NDEBUG
   DeformBatchScratch small = model->MakeBatchScratch(2);
-  EXPECT_FALSE(
-      model->DeformBatch(factorization, pose_pointers.data(), scratch_pointers.data(), 3, &small));
-  EXPECT_FALSE(
-      model->DeformBatch(factorization, pose_pointers.data(), scratch_pointers.data(), 0, &small));
+  EXPECT_FALSE(model->DeformBatch(factorization, pose_pointers, scratch_pointers, 3, &small));
+  EXPECT_FALSE(model->DeformBatch(factorization, pose_pointers, scratch_pointers, 0, &small));
   auto other = BuildPhantomModel();
   DeformBatchScratch foreign = other->MakeBatchScratch(2);
-  EXPECT_FALSE(model->DeformBatch(factorization, pose_pointers.data(), scratch_pointers.data(), 2,
-                                  &foreign));
+  EXPECT_FALSE(model->DeformBatch(factorization, pose_pointers, scratch_pointers, 2, &foreign));
 #endif
 }
 
@@ -215,22 +238,11 @@ TEST(DeformationModel, ABatchOnTheSharedLegEqualsTheFramesSolvedOneByOne) {
   DEFORM_SHARED_LEG_MODEL(model);
   const MaterialFactorization& factorization = *model->default_factorization();
   const int count = 8;
-  std::vector<Pose> poses;
-  std::vector<DeformScratch> scratches;
-  for (int f = 0; f < count; ++f) {
-    poses.push_back(PoseFromSpec(model->skeleton(), "1:x:" + std::to_string(15 * f)));
-    scratches.push_back(model->MakeScratch());
-  }
-  const std::vector<const Pose*> pose_pointers = PointersTo<const Pose>(poses);
-  const std::vector<DeformScratch*> scratch_pointers = PointersTo<DeformScratch>(scratches);
+  BatchFrames frames(*model, LegBendSpecs(count));
   DeformBatchScratch batch = model->MakeBatchScratch(count);
-  ASSERT_TRUE(model->DeformBatch(factorization, pose_pointers.data(), scratch_pointers.data(),
-                                 count, &batch));
-  for (int f = 0; f < count; ++f) {
-    EXPECT_LE(MaxDistance(scratches[f].positions(), DeformOnce(*model, poses[f])),
-              1e-12 * model->bounding_box_diagonal())
-        << "frame " << f;
-  }
+  ASSERT_TRUE(model->DeformBatch(factorization, frames.pose_pointers.data(),
+                                 frames.scratch_pointers.data(), count, &batch));
+  frames.ExpectSolvedAlone(*model, count);
 }
 
 // A frame solved on several threads (DeformParallel: the right-hand side by ranges, the solve by
@@ -290,18 +302,11 @@ TEST(DeformationModel, ABatchSolvedOnSeveralThreadsEqualsTheFramesSolvedOneByOne
   auto model = BuildPhantomModel();
   const MaterialFactorization& factorization = *model->default_factorization();
   const int most = DeformationModel::kMaxBatchFrames;
-  std::vector<Pose> poses;
-  std::vector<Positions> expected;
-  std::vector<DeformScratch> scratches;
-  for (int f = 0; f < most; ++f) {
-    poses.push_back(PoseFromSpec(model->skeleton(), "knee:flexion:" + std::to_string(7 * f) +
-                                                        ",knee:rotation:" + std::to_string(f)));
-    expected.push_back(DeformOnce(*model, poses.back()));
-    scratches.push_back(model->MakeScratch());
-  }
-  const std::vector<const Pose*> pose_pointers = PointersTo<const Pose>(poses);
-  const std::vector<DeformScratch*> scratch_pointers = PointersTo<DeformScratch>(scratches);
-  const double tolerance = 1e-12 * model->bounding_box_diagonal();
+  BatchFrames frames(*model, Specs(most, [](int f) {
+    return "knee:flexion:" + std::to_string(7 * f) + ",knee:rotation:" + std::to_string(f);
+  }));
+  const Pose* const* pose_pointers = frames.pose_pointers.data();
+  DeformScratch* const* scratch_pointers = frames.scratch_pointers.data();
   for (const int parts : {2, 3}) {
     const ParallelSolvePlan plan = factorization.factor().PlanParallel(parts);
     ASSERT_EQ(plan.parts, parts);
@@ -315,18 +320,14 @@ TEST(DeformationModel, ABatchSolvedOnSeveralThreadsEqualsTheFramesSolvedOneByOne
     for (ParallelRunner* runner :
          {static_cast<ParallelRunner*>(&team), static_cast<ParallelRunner*>(&serial)}) {
       for (int count = 1; count <= most; ++count) {
-        for (int f = 0; f < count; ++f) scratches[f].solution.setConstant(std::nan(""));
+        for (int f = 0; f < count; ++f) frames.scratches[f].solution.setConstant(std::nan(""));
         const long before = test_support::AllocationCount();
-        ASSERT_TRUE(model->DeformBatchParallel(factorization, pose_pointers.data(),
-                                               scratch_pointers.data(), count, &batch, plan,
-                                               runner));
+        ASSERT_TRUE(model->DeformBatchParallel(factorization, pose_pointers, scratch_pointers,
+                                               count, &batch, plan, runner));
         if (runner == &serial) {
           EXPECT_EQ(test_support::AllocationCount() - before, 0) << "count " << count;
         }
-        for (int f = 0; f < count; ++f) {
-          EXPECT_LE(MaxDistance(scratches[f].positions(), expected[f]), tolerance)
-              << parts << " parts, frame " << f << " of " << count;
-        }
+        frames.ExpectSolvedAlone(*model, count, std::to_string(parts) + " parts, ");
       }
     }
   }
@@ -334,9 +335,8 @@ TEST(DeformationModel, ABatchSolvedOnSeveralThreadsEqualsTheFramesSolvedOneByOne
   const ParallelSolvePlan plan = factorization.factor().PlanParallel(3);
   DeformBatchScratch serial_only = model->MakeBatchScratch(most);
   SerialRunner serial;
-  EXPECT_FALSE(model->DeformBatchParallel(factorization, pose_pointers.data(),
-                                          scratch_pointers.data(), most, &serial_only, plan,
-                                          &serial));
+  EXPECT_FALSE(model->DeformBatchParallel(factorization, pose_pointers, scratch_pointers, most,
+                                          &serial_only, plan, &serial));
 #endif
 }
 
@@ -346,23 +346,13 @@ TEST(DeformationModel, ABatchOfTheSharedLegOnTwoThreadsEqualsTheFramesSolvedOneB
   const ParallelSolvePlan plan = factorization.factor().PlanParallel(2);
   ASSERT_EQ(plan.parts, 2);
   const int count = 8;
-  std::vector<Pose> poses;
-  std::vector<DeformScratch> scratches;
-  for (int f = 0; f < count; ++f) {
-    poses.push_back(PoseFromSpec(model->skeleton(), "1:x:" + std::to_string(15 * f)));
-    scratches.push_back(model->MakeScratch());
-  }
-  const std::vector<const Pose*> pose_pointers = PointersTo<const Pose>(poses);
-  const std::vector<DeformScratch*> scratch_pointers = PointersTo<DeformScratch>(scratches);
+  BatchFrames frames(*model, LegBendSpecs(count));
   DeformBatchScratch batch = model->MakeBatchScratch(count, &plan);
   ThreadTeam team(2);
-  ASSERT_TRUE(model->DeformBatchParallel(factorization, pose_pointers.data(),
-                                         scratch_pointers.data(), count, &batch, plan, &team));
-  for (int f = 0; f < count; ++f) {
-    EXPECT_LE(MaxDistance(scratches[f].positions(), DeformOnce(*model, poses[f])),
-              1e-12 * model->bounding_box_diagonal())
-        << "frame " << f;
-  }
+  ASSERT_TRUE(model->DeformBatchParallel(factorization, frames.pose_pointers.data(),
+                                         frames.scratch_pointers.data(), count, &batch, plan,
+                                         &team));
+  frames.ExpectSolvedAlone(*model, count);
 }
 
 TEST(DeformationModel, ThreadsShareOneModelAndFactorisation) {

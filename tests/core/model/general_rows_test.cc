@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "tests/core/model/random_row_system.h"
+
 namespace deform {
 namespace {
 
@@ -29,17 +31,8 @@ struct Fixture {
   Fixture() {
     std::mt19937 random(11);
     std::uniform_real_distribution<double> value(-1, 1);
-    std::vector<Eigen::Triplet<double>> entries;
-    for (int i = 0; i < n + m; ++i) {
-      const int length = i < n ? 1 + i % 21 : 40;
-      for (int k = 0; k < length; ++k) entries.emplace_back(i, (i + 3 * k) % n, value(random));
-    }
-    system.num_vertices = n;
-    system.num_nodes = m;
-    system.laplacian_transpose.resize(n + m, n);
-    system.laplacian_transpose.setFromTriplets(entries.begin(), entries.end());
-    system.laplacian_transpose.makeCompressed();
-    system.rest_deltas = Positions::NullaryExpr(n, 3, [&] { return value(random); });
+    system = test_support::RandomRowSystem(
+        n, m, 3, [](int i) { return i < n ? 1 + i % 21 : 40; }, &random);
     weights.num_bones = 4;
     weights.offsets.push_back(0);
     for (int j = 0; j < n; ++j) {

@@ -8,6 +8,8 @@
 #include <random>
 #include <vector>
 
+#include "tests/core/model/random_row_system.h"
+
 namespace deform {
 namespace {
 
@@ -26,16 +28,8 @@ struct Fixture {
   Fixture() {
     std::mt19937 random(7);
     std::uniform_real_distribution<double> value(-1, 1);
-    std::vector<Eigen::Triplet<double>> entries;
-    for (int i = 0; i < n + m; ++i) {
-      for (int k = 0; k < 5; ++k) entries.emplace_back(i, (i + k) % n, value(random));
-    }
-    system.num_vertices = n;
-    system.num_nodes = m;
-    system.laplacian_transpose.resize(n + m, n);
-    system.laplacian_transpose.setFromTriplets(entries.begin(), entries.end());
-    system.laplacian_transpose.makeCompressed();
-    system.rest_deltas = Positions::NullaryExpr(n, 3, [&] { return value(random); });
+    system = test_support::RandomRowSystem(
+        n, m, 1, [](int) { return 5; }, &random);
     weights.num_bones = 3;
     weights.offsets.push_back(0);
     for (int j = 0; j < n; ++j) {

@@ -16,16 +16,9 @@ DEFORMD="$1"
 LOADTEST="$2"
 MODE="$3"
 SOURCE_DIR="$(cd "$(dirname "$0")/../../.." && pwd)"
-WORK="$(mktemp -d)"
-SERVER=""
-cleanup() {
-  if [ -n "$SERVER" ]; then
-    kill -TERM "$SERVER" 2>/dev/null || true
-    wait "$SERVER" 2>/dev/null || true
-  fi
-  rm -rf "$WORK"
-}
-trap cleanup EXIT
+# shellcheck source=scripts/deformd-process.sh
+source "$SOURCE_DIR/scripts/deformd-process.sh"
+deformd_make_work
 fail() {
   echo "FAIL: $*" >&2
   [ -f "$WORK/deformd.log" ] && tail -20 "$WORK/deformd.log" >&2
@@ -33,17 +26,11 @@ fail() {
 }
 
 start_server() {  # extra deformd flags...
-  "$DEFORMD" --listen 127.0.0.1:0 --metrics 127.0.0.1:0 --workers 2 "$@" \
-    >"$WORK/deformd.log" 2>&1 &
-  SERVER=$!
-  for _ in $(seq 1 200); do
-    if grep -q "listening on" "$WORK/deformd.log"; then break; fi
-    kill -0 "$SERVER" 2>/dev/null || fail "deformd exited at start-up"
-    sleep 0.05
-  done
-  GRPC=$(sed -n 's/.*listening on \([0-9.]*:[0-9]*\).*/\1/p' "$WORK/deformd.log" | head -1)
+  deformd_start "$WORK/deformd.log" "$DEFORMD" --listen 127.0.0.1:0 --metrics 127.0.0.1:0 \
+    --workers 2 "$@" || fail "deformd did not start"
+  GRPC="$DEFORMD_ADDRESS"
   METRICS=$(sed -n 's/.*metrics on \(https\{0,1\}:[^ ]*\).*/\1/p' "$WORK/deformd.log" | head -1)
-  [ -n "$GRPC" ] && [ -n "$METRICS" ] || fail "no listening or metrics line"
+  [ -n "$METRICS" ] || fail "no metrics line"
 }
 
 # The value of one series ("name{labels}" exactly as exposed), 0 when absent.
