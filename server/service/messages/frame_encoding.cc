@@ -55,7 +55,7 @@ StatusOr<std::unique_ptr<codec::FrameEncoder>> MakeFrameEncoder(const v1::Deform
       return Status::InvalidArgument("unknown frame encoding " +
                                      std::to_string(static_cast<int>(start.encoding())));
   }
-  double max_error = start.max_error() == 0 ? kDefaultPredictedMaxError : start.max_error();
+  double max_error = start.max_error() == 0 ? codec::kDefaultPredictedMaxError : start.max_error();
   if (!(max_error > 0 && max_error <= kLargestPredictedMaxError)) {
     return Status::InvalidArgument("max_error must be in (0, " +
                                    std::to_string(kLargestPredictedMaxError) +

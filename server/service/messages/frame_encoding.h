@@ -15,8 +15,8 @@
 
 namespace deform::service {
 
-// The default largest error of predicted frames, as a fraction of the bounding-box diagonal.
-constexpr double kDefaultPredictedMaxError = 5e-5;
+// The largest error a client may ask of predicted frames, as a fraction of the bounding-box
+// diagonal (the default: codec::kDefaultPredictedMaxError).
 constexpr double kLargestPredictedMaxError = 1e-2;
 
 // The mesh's prediction weights in the client's vertex order.

@@ -6,6 +6,8 @@
 #include <prometheus/registry.h>
 #include <prometheus/text_serializer.h>
 
+#include "core/base/status.h"
+
 namespace deform::service {
 namespace {
 
@@ -13,11 +15,6 @@ constexpr std::array<const char*, ServiceMetrics::kEncodings> kEncodingNames = {
     "float32", "float32", "quantized", "predicted"};
 constexpr std::array<const char*, ServiceMetrics::kNoticeKinds> kNoticeKindNames = {
     "unspecified", "pose_rejected", "stiffness_rejected", "stiffness_applied"};
-constexpr std::array<const char*, ServiceMetrics::kStatusCodes> kStatusCodeNames = {
-    "OK",        "CANCELLED",      "UNKNOWN",           "INVALID_ARGUMENT",   "DEADLINE_EXCEEDED",
-    "NOT_FOUND", "ALREADY_EXISTS", "PERMISSION_DENIED", "RESOURCE_EXHAUSTED", "FAILED_PRECONDITION",
-    "ABORTED",   "OUT_OF_RANGE",   "UNIMPLEMENTED",     "INTERNAL",           "UNAVAILABLE",
-    "DATA_LOSS", "UNAUTHENTICATED"};
 // The methods labelled by name; any other (health, reflection, unknown) is "other", so a client
 // cannot grow the number of series.
 constexpr std::array<const char*, ServiceMetrics::kMethods - 1> kMethodNames = {
@@ -87,7 +84,7 @@ ServiceMetrics::ServiceMetrics() : registry_(std::make_shared<prometheus::Regist
   for (int m = 0; m < kMethods; ++m) {
     const char* method = m < kMethods - 1 ? kMethodNames[m] : "other";
     for (int c = 0; c < kStatusCodes; ++c) {
-      rpcs_[m][c] = &rpcs.Add({{"method", method}, {"code", kStatusCodeNames[c]}});
+      rpcs_[m][c] = &rpcs.Add({{"method", method}, {"code", CanonicalStatusCodeName(c)}});
     }
   }
   auto& builds = BuildHistogram()
