@@ -8,7 +8,7 @@
 # -DDEFORM_THREAD_SAFETY_ANALYSIS=ON, which adds -Wthread-safety to our targets only (the
 # generated protobuf code gets none), where -Werror is on in every build. Only the object files
 # of the annotated targets are compiled (no linking, no tests, no core libraries), without
-# optimisation: the analysis runs in the front end. Installs what is missing
+# optimization: the analysis runs in the front end. Installs what is missing
 # (scripts/packages/build.txt and checks.txt: clang); ccache makes reruns fast.
 set -euo pipefail
 cd "$(dirname "$0")/.."
