@@ -28,6 +28,7 @@
 #include "bench/arithmetic_peak.h"
 #include "bench/bench_meshes.h"
 #include "bench/memory_bandwidth.h"
+#include "core/base/build_info.h"
 #include "core/base/median.h"
 #include "core/io/model_input.h"
 #include "core/io/phantom.h"
@@ -541,7 +542,9 @@ void RegisterBenchmarks(const BenchMesh& mesh) {
 
 int main(int argc, char** argv) {
   using namespace deform::bench;
+  if (deform::PrintVersionIfAsked(argc, argv, "deform_bench")) return 0;
   benchmark::Initialize(&argc, argv);
+  benchmark::AddCustomContext("build", deform::VersionLine("deform_bench"));
   benchmark::AddCustomContext("dram_read_GBps_at_start",
                               std::to_string(MeasureReadBandwidth(std::size_t{1} << 30) / 1e9));
   benchmark::AddCustomContext("solve_kernel", deform::SolveKernelName(deform::BestSolveKernel()));

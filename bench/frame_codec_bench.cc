@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "bench/bench_meshes.h"
+#include "core/base/build_info.h"
 #include "core/codec/frame_codec.h"
 
 namespace deform::bench {
@@ -30,8 +31,8 @@ struct Trajectory {
   int num_vertices = 0;
   int num_bones = 0;
   double diagonal = 0;
-  std::vector<std::vector<double>> frames;      // solved, 3 n each
-  std::vector<std::vector<float>> transforms;   // 12 per bone each
+  std::vector<std::vector<double>> frames;     // solved, 3 n each
+  std::vector<std::vector<float>> transforms;  // 12 per bone each
   std::vector<float> rest;
   codec::PredictionWeights weights;
 };
@@ -52,8 +53,7 @@ std::shared_ptr<const Trajectory> TrajectoryFor(const BenchMesh& mesh) {
   DeformScratch scratch = model->MakeScratch();
   for (int f = 0; f < kTrajectoryFrames; ++f) {
     const double degrees = 120.0 * f / (kTrajectoryFrames - 1);
-    const Pose pose =
-        PoseFromSpecOrRest(*model, mesh.flexion_prefix + std::to_string(degrees));
+    const Pose pose = PoseFromSpecOrRest(*model, mesh.flexion_prefix + std::to_string(degrees));
     model->Deform(*model->default_factorization(), pose, &scratch);
     trajectory->frames.emplace_back(scratch.solution.data(), scratch.solution.data() + 3 * n);
     std::vector<float> transforms(12 * trajectory->num_bones);
@@ -94,15 +94,15 @@ CodedTrajectory CodeAll(const Trajectory& t, bool predicted) {
   for (int f = 0; f < kTrajectoryFrames; ++f) {
     std::vector<unsigned char> bytes(encoder->max_encoded_bytes());
     codec::EncodedFrameHeader header;
-    bytes.resize(encoder->Encode(t.frames[f].data(), {}, t.transforms[f].data(), &header,
-                                 bytes.data()));
+    bytes.resize(
+        encoder->Encode(t.frames[f].data(), {}, t.transforms[f].data(), &header, bytes.data()));
     total_bytes += bytes.size();
     if (header.encoding == codec::FrameEncoding::kPredicted) total_bytes += 48.0 * t.num_bones;
     (void)decoder.Decode(header, bytes.data(), bytes.size(), t.transforms[f].data(),
                          t.transforms[f].size(), decoded.data());
     for (int k = 0; k < 3 * t.num_vertices; ++k) {
-      coded.max_error_diag = std::max(
-          coded.max_error_diag, std::abs(decoded[k] - t.frames[f][k]) / t.diagonal);
+      coded.max_error_diag =
+          std::max(coded.max_error_diag, std::abs(decoded[k] - t.frames[f][k]) / t.diagonal);
     }
     coded.bytes.push_back(std::move(bytes));
     coded.headers.push_back(header);
@@ -124,8 +124,8 @@ void BM_Encode(benchmark::State& state, const BenchMesh& mesh, bool predicted) {
   codec::EncodedFrameHeader header;
   int f = 0;
   for (auto _ : state) {
-    benchmark::DoNotOptimize(encoder->Encode(t->frames[f].data(), {}, t->transforms[f].data(),
-                                             &header, bytes.data()));
+    benchmark::DoNotOptimize(
+        encoder->Encode(t->frames[f].data(), {}, t->transforms[f].data(), &header, bytes.data()));
     f = (f + 1) % kTrajectoryFrames;
   }
   ReportCounters(state, CodeAll(*t, predicted));
@@ -153,7 +153,9 @@ void BM_Decode(benchmark::State& state, const BenchMesh& mesh, bool predicted) {
 
 int main(int argc, char** argv) {
   using namespace deform::bench;
+  if (deform::PrintVersionIfAsked(argc, argv, "deform_codec_bench")) return 0;
   benchmark::Initialize(&argc, argv);
+  benchmark::AddCustomContext("build", deform::VersionLine("deform_codec_bench"));
   for (const BenchMesh& mesh : AvailableMeshes()) {
     for (const bool predicted : {false, true}) {
       const std::string encoding = predicted ? "predicted" : "quantized";

@@ -9,6 +9,7 @@
 #               viewer's files; no benchmarks), then ctest, 2 at a time: every test of the suite, the
 #               tests on the large shared meshes as they are (durations: docs/testing.md). The
 #               benchmarks' ctest tests (bench/animation) are not built here (Release suite only).
+#               A skipped test fails the suite as in the Release run (scripts/run-ctest.sh).
 #               Leaks: scripts/sanitizers/lsan.supp lists OpenMesh's one-time registry only.
 #   TSan:       build-tsan ($DEFORM_TSAN_BUILD_DIR), the service's test programs (TSAN_PROGRAMS), run on
 #               the suites in
@@ -60,7 +61,7 @@ if [ "$only" = all ] || [ "$only" = asan ]; then
   cmake --build "$ASAN_DIR" --parallel "$(nproc)"
   echo "check-sanitizers: ASan+UBSan build done after $(($(date +%s) - start)) s"
   (export_sanitizer_options &&
-    ctest --test-dir "$ASAN_DIR" --output-on-failure --parallel "$(nproc)" --timeout 1200)
+    scripts/run-ctest.sh "$ASAN_DIR" --output-on-failure --parallel "$(nproc)" --timeout 1200)
   echo "check-sanitizers: ASan+UBSan suite passed after $(($(date +%s) - start)) s"
 fi
 

@@ -5,11 +5,12 @@
 # its lock, a *Locked helper is called without it, or any other Clang warning appears there.
 #
 # Builds in its own directory (build-tsa, or $DEFORM_TSA_BUILD_DIR) with clang++ and
-# -DDEFORM_THREAD_SAFETY_ANALYSIS=ON, which adds -Wthread-safety -Werror to our targets only (the
-# generated protobuf code gets none). Only the object files of the annotated targets are compiled
-# (no linking, no tests, no core libraries), without optimisation: the analysis runs in the front
-# end. Installs what is missing (scripts/packages/build.txt and checks.txt: clang). ccache makes
-# reruns fast (durations: docs/testing.md).
+# -DDEFORM_THREAD_SAFETY_ANALYSIS=ON, which adds -Wthread-safety to our targets only (the
+# generated protobuf code gets none), where -Werror is on in every build. Only the object files
+# of the annotated targets are compiled (no linking, no tests, no core libraries), without
+# optimization: the analysis runs in the front end. Installs what is missing
+# (scripts/packages/build.txt and checks.txt: clang); ccache makes reruns fast (durations:
+# docs/testing.md).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 # shellcheck source=scripts/ccache-env.sh

@@ -3,6 +3,7 @@
 #include <iostream>
 
 #include "cli/rotation_blend_flag.h"
+#include "core/base/build_info.h"
 #include "lib/status_names.h"
 
 namespace deform::cli {
@@ -17,8 +18,9 @@ void AddSecurityFlags(CLI::App& app, SecurityArgs* args) {
       ->envname("DEFORM_TLS_CERT");
   app.add_option("--tls-key", args->key_file, "PEM private key of --tls-cert")
       ->envname("DEFORM_TLS_KEY");
-  app.add_option("--tls-server-name", args->server_name,
-                 "Name the server's certificate carries, when not the target's host (implies --tls)")
+  app.add_option(
+         "--tls-server-name", args->server_name,
+         "Name the server's certificate carries, when not the target's host (implies --tls)")
       ->envname("DEFORM_TLS_SERVER_NAME");
   app.add_option("--token", args->token,
                  "Bearer token sent with every call (deformd --token-file); prefer DEFORM_TOKEN, "
@@ -83,6 +85,7 @@ MeshSourceOptions AddMeshSourceFlags(CLI::App& app, MeshSource* source) {
 }
 
 std::optional<int> ParseCommandLine(CLI::App& app, int argc, char** argv, const char* program) {
+  app.set_version_flag("--version", VersionLine(program));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

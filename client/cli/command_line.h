@@ -15,12 +15,12 @@ namespace deform::cli {
 
 // How to talk to a secured server: TLS files and the bearer token.
 struct SecurityArgs {
-  bool tls = false;          // --tls: TLS with the system's trusted roots
-  std::string ca_file;       // --tls-ca: the server's CA (implies TLS)
-  std::string cert_file;     // --tls-cert / --tls-key: client certificate for mutual TLS
+  bool tls = false;       // --tls: TLS with the system's trusted roots
+  std::string ca_file;    // --tls-ca: the server's CA (implies TLS)
+  std::string cert_file;  // --tls-cert / --tls-key: client certificate for mutual TLS
   std::string key_file;
-  std::string server_name;   // --tls-server-name: the name the server's certificate carries
-  std::string token;         // --token: bearer token
+  std::string server_name;  // --tls-server-name: the name the server's certificate carries
+  std::string token;        // --token: bearer token
 };
 
 // --tls, --tls-ca, --tls-cert, --tls-key, --tls-server-name, --token; each also read from the
@@ -56,8 +56,9 @@ struct MeshSourceOptions {
 // (app's parse_complete_callback: a usage error).
 MeshSourceOptions AddMeshSourceFlags(CLI::App& app, MeshSource* source);
 
-// Parses the command line. Returns the exit code the program should end with (0 after --help or
-// --version, 2 after a usage error, reported on stderr as "program: message"), or nullopt to go on.
+// Adds --version (VersionLine(program), core/base/build_info.h) and parses the command line.
+// Returns the exit code the program should end with (0 after --help or --version, 2 after a usage
+// error, reported on stderr as "program: message"), or nullopt to go on.
 std::optional<int> ParseCommandLine(CLI::App& app, int argc, char** argv, const char* program);
 
 // Writes "program: STATUS_NAME: message" to stderr and returns 1 (the runtime-error exit code).

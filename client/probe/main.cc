@@ -16,6 +16,7 @@
 #include <string>
 
 #include "cli/command_line.h"
+#include "core/base/build_info.h"
 #include "health.grpc.pb.h"
 #include "lib/deform_client.h"
 
@@ -31,6 +32,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 600000));
   deform::cli::SecurityArgs security;
   deform::cli::AddSecurityFlags(app, &security);
+  app.set_version_flag("--version", deform::VersionLine("deform-health-probe"));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "core/base/build_info.h"
 #include "core/eval/method_comparison.h"
 #include "core/io/mesh_io.h"
 #include "core/io/model_input.h"
@@ -223,6 +224,7 @@ int main(int argc, char** argv) {
   PhantomArgs phantom_args;
   const CLI::App* deform_command = AddDeformCommand(&app, &deform_args);
   AddPhantomCommand(&app, &phantom_args);
+  app.set_version_flag("--version", deform::VersionLine("deformctl"));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

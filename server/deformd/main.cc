@@ -9,6 +9,7 @@
 //           [--token-file FILE] [--tenant-max-meshes N] [--tenant-max-streams N]
 //           [--tenant-max-memory-mb N] [--preload-tenant NAME] [--store DIR] [--metrics ADDR]
 //           [--http ADDR [--http-root DIR] [--http-max-connections N]]
+//   deformd --version   prints "deformd VERSION (commit COMMIT)" (core/base/build_info.h)
 //
 // --metrics ADDR serves GET /metrics in Prometheus' format on its own port: plain HTTP, on a
 // loopback address unless --plaintext, and with a token file for operators' tokens only
@@ -48,6 +49,7 @@
 #include <thread>
 #include <vector>
 
+#include "core/base/build_info.h"
 #include "core/io/model_input.h"
 #include "service/rpc/deform_server.h"
 #include "service/access/identity.h"
@@ -304,6 +306,7 @@ int main(int argc, char** argv) {
                  "Open HTTP and WebSocket connections at once")
       ->capture_default_str()
       ->check(CLI::Range(1, 65536));
+  app.set_version_flag("--version", deform::VersionLine("deformd"));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

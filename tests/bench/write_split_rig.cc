@@ -6,11 +6,13 @@
 #include <iostream>
 #include <vector>
 
+#include "core/base/build_info.h"
 #include "core/io/gltf_writer.h"
 #include "core/io/phantom.h"
 #include "core/model/deformation_model.h"
 
 int main(int argc, char** argv) {
+  if (deform::PrintVersionIfAsked(argc, argv, "write_split_rig")) return 0;
   if (argc != 2) {
     std::cerr << "usage: write_split_rig OUT.glb\n";
     return 2;

@@ -6,6 +6,7 @@
 #include <prometheus/registry.h>
 #include <prometheus/text_serializer.h>
 
+#include "core/base/build_info.h"
 #include "core/base/status.h"
 
 namespace deform::service {
@@ -114,6 +115,12 @@ ServiceMetrics::ServiceMetrics() : registry_(std::make_shared<prometheus::Regist
   memory_budget_ = gauge("deformd_memory_budget_bytes", "The memory budget (--max-memory-mb)");
   notice_backlog_ =
       gauge("deformd_notice_backlog_bytes", "Serialised bytes of notices waiting unwritten");
+  BuildGauge()
+      .Name("deformd_build_info")
+      .Help("The build's version and commit, as --version prints them (value 1)")
+      .Register(*registry_)
+      .Add({{"version", std::string(BuildVersion())}, {"commit", std::string(BuildCommit())}})
+      .Set(1);
 }
 
 ServiceMetrics::~ServiceMetrics() = default;

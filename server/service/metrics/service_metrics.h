@@ -19,6 +19,8 @@
 //    deformd_memory_budget_reserved_bytes, deformd_memory_budget_streams_bytes,
 //    deformd_memory_budget_bytes,
 //    deformd_notice_backlog_bytes.
+//  - deformd_build_info{version,commit}: always 1; the build's version and commit as labels
+//    (core/base/build_info.h), as --version prints them.
 //
 // A client's errors as deform-loadtest counts them are the Deform RPCs that ended with a code
 // other than OK plus the notices pose_rejected and stiffness_rejected.

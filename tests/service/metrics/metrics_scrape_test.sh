@@ -1,6 +1,9 @@
 #!/usr/bin/env bash
-# deformd's Prometheus metrics end to end (ctest): metrics_scrape_test.sh DEFORMD LOADTEST MODE
-#   loadtest  starts a real deformd with --metrics on ports the kernel picks, runs deform-loadtest
+# deformd's Prometheus metrics end to end (ctest):
+#   metrics_scrape_test.sh DEFORMD LOADTEST MODE VERSION
+#   loadtest  starts a real deformd with --metrics on ports the kernel picks; its first scrape
+#             carries deformd_build_info{commit,version} 1 with VERSION (CMake's) and the commit
+#             this checkout is at (tests/expected_commit.sh). Then it runs deform-loadtest
 #             (--json, no warm-up, so it counts every frame) and scrapes /metrics while it runs
 #             (frames are counted live) and after: deformd_frames_sent_total is the loadtest's
 #             frames_received, and its bytes are counted. Then a loadtest whose every pose names an
@@ -15,7 +18,10 @@ set -euo pipefail
 DEFORMD="$1"
 LOADTEST="$2"
 MODE="$3"
+VERSION="${4:-}"
 SOURCE_DIR="$(cd "$(dirname "$0")/../../.." && pwd)"
+# shellcheck source=tests/expected_commit.sh
+source "$SOURCE_DIR/tests/expected_commit.sh"
 # shellcheck source=scripts/deformd-process.sh
 source "$SOURCE_DIR/scripts/deformd-process.sh"
 deformd_make_work
@@ -46,6 +52,10 @@ case "$MODE" in
 loadtest)
   start_server
   curl -sf "$METRICS" >"$WORK/before.txt" || fail "scrape before the load test"
+  [ -n "$VERSION" ] || fail "no VERSION given"
+  build_info="deformd_build_info{commit=\"$(expected_commit "$SOURCE_DIR")\",version=\"$VERSION\"}"
+  [ "$(series "$WORK/before.txt" "$build_info")" -eq 1 ] ||
+    fail "no '$build_info 1' in the scrape: $(grep '^deformd_build_info' "$WORK/before.txt")"
   [ "$(series "$WORK/before.txt" 'deformd_frames_sent_total{encoding="float32"}')" -eq 0 ] ||
     fail "frames counted before any stream"
   "$LOADTEST" --target "$GRPC" --streams 4 --rate 60 --duration 3 --warmup 0 --json \
