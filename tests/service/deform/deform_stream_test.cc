@@ -69,24 +69,34 @@ double DistanceFromCore(const std::vector<float>& positions, const CoreResult& c
   return worst;
 }
 
-// Opens `count` streams on `mesh_id` through `client`, each with its own recorder.
-void OpenStreams(client::DeformClient* client, const std::string& mesh_id, int count,
-                 bool keep_positions, std::vector<std::unique_ptr<StreamRecorder>>* recorders,
-                 std::vector<std::unique_ptr<client::DeformStream>>* streams) {
-  for (int s = 0; s < count; ++s) {
-    recorders->push_back(std::make_unique<StreamRecorder>(keep_positions));
-    streams->push_back(client->OpenStream(mesh_id, recorders->back()->Callbacks()));
+// The Deform stream's tests: every body runs over both transports (the stream handler is one
+// for both), except the few that speak gRPC's own API (DeformStreamGrpcTest).
+class DeformStreamTest : public ServiceTest, public ::testing::WithParamInterface<Transport> {
+ protected:
+  void SetUp() override { transport_ = GetParam(); }
+
+  // Opens `count` streams on `mesh_id`, each with its own recorder.
+  void OpenStreams(const std::string& mesh_id, int count, bool keep_positions,
+                   std::vector<std::unique_ptr<StreamRecorder>>* recorders,
+                   std::vector<std::unique_ptr<client::DeformStream>>* streams) {
+    for (int s = 0; s < count; ++s) {
+      recorders->push_back(std::make_unique<StreamRecorder>(keep_positions));
+      streams->push_back(OpenStream(mesh_id, recorders->back()->Callbacks()));
+    }
   }
-}
+};
+class DeformStreamGrpcTest : public ServiceTest {};
 
-class DeformStreamTest : public ServiceTest {};
+INSTANTIATE_TEST_SUITE_P(Transports, DeformStreamTest,
+                         ::testing::Values(Transport::kGrpc, Transport::kWebSocket),
+                         TransportName);
 
-TEST_F(DeformStreamTest, FrameEqualsTheCoreResultForTheSamePose) {
+TEST_P(DeformStreamTest, FrameEqualsTheCoreResultForTheSamePose) {
   StartServer();
   constexpr int kVertices = 2000;
   const std::string mesh_id = LoadPhantom(kVertices);
   StreamRecorder recorder(/*keep_positions=*/true);
-  auto stream = client_->OpenStream(mesh_id, recorder.Callbacks());
+  auto stream = OpenStream(mesh_id, recorder.Callbacks());
 
   const std::vector<std::string> specs = {"knee:flexion:60,hip:flexion:20", "knee:flexion:200",
                                           "knee:x:-30,ankle:y:10", "rest"};
@@ -125,7 +135,7 @@ TEST_F(DeformStreamTest, FrameEqualsTheCoreResultForTheSamePose) {
 
 // The linear rotation blend reaches the core: the frame is the core's linear-blend result (from its
 // precomputed response), not the quaternion blend's.
-TEST_F(DeformStreamTest, LinearBlendFrameEqualsTheCoreResult) {
+TEST_P(DeformStreamTest, LinearBlendFrameEqualsTheCoreResult) {
   StartServer();
   constexpr int kVertices = 1500;
   v1::MethodOptions options;
@@ -135,7 +145,7 @@ TEST_F(DeformStreamTest, LinearBlendFrameEqualsTheCoreResult) {
   EXPECT_EQ(summary.rotation_blend(), v1::ROTATION_BLEND_LINEAR);
   EXPECT_GT(summary.linear_response_bytes(), 0u);
   StreamRecorder recorder(/*keep_positions=*/true);
-  auto stream = client_->OpenStream(mesh_id, recorder.Callbacks());
+  auto stream = OpenStream(mesh_id, recorder.Callbacks());
   const std::string spec = "knee:flexion:90,knee:rotation:10";
   v1::PoseUpdate pose;
   std::string error;
@@ -165,11 +175,11 @@ TEST_F(DeformStreamTest, LinearBlendFrameEqualsTheCoreResult) {
   ExpectBackgroundStreamAlive();
 }
 
-TEST_F(DeformStreamTest, StiffnessUpdateSwitchesVersionsWithoutAGap) {
+TEST_P(DeformStreamTest, StiffnessUpdateSwitchesVersionsWithoutAGap) {
   StartServer();
   const std::string mesh_id = LoadPhantom(3000);
   StreamRecorder recorder(/*keep_positions=*/true);
-  auto stream = client_->OpenStream(mesh_id, recorder.Callbacks());
+  auto stream = OpenStream(mesh_id, recorder.Callbacks());
   // A fixed pose, so that only the stiffness changes the frames.
   std::atomic<bool> stop{false};
   std::thread pacer([&] {
@@ -225,11 +235,11 @@ TEST_F(DeformStreamTest, StiffnessUpdateSwitchesVersionsWithoutAGap) {
   ExpectBackgroundStreamAlive();
 }
 
-TEST_F(DeformStreamTest, NanAngleIsRejectedAndTheStreamGoesOn) {
+TEST_P(DeformStreamTest, NanAngleIsRejectedAndTheStreamGoesOn) {
   StartServer();
   const std::string mesh_id = LoadPhantom(500);
   StreamRecorder recorder;
-  auto stream = client_->OpenStream(mesh_id, recorder.Callbacks());
+  auto stream = OpenStream(mesh_id, recorder.Callbacks());
   ASSERT_TRUE(stream->SendPose(KneePose(1, 30)));
   ASSERT_TRUE(recorder.WaitForFrameWithSequence(1));
   ASSERT_TRUE(stream->SendPose(KneePose(2, std::numeric_limits<double>::quiet_NaN())));
@@ -262,11 +272,11 @@ TEST_F(DeformStreamTest, NanAngleIsRejectedAndTheStreamGoesOn) {
   ExpectBackgroundStreamAlive();
 }
 
-TEST_F(DeformStreamTest, UnknownJointIsRejectedInPosesAndStiffness) {
+TEST_P(DeformStreamTest, UnknownJointIsRejectedInPosesAndStiffness) {
   StartServer();
   const std::string mesh_id = LoadPhantom(500);
   StreamRecorder recorder;
-  auto stream = client_->OpenStream(mesh_id, recorder.Callbacks());
+  auto stream = OpenStream(mesh_id, recorder.Callbacks());
   v1::PoseUpdate pose = KneePose(1, 10);
   pose.mutable_angles(0)->set_joint("elbow");
   ASSERT_TRUE(stream->SendPose(pose));
@@ -292,7 +302,7 @@ TEST_F(DeformStreamTest, UnknownJointIsRejectedInPosesAndStiffness) {
   ExpectBackgroundStreamAlive();
 }
 
-TEST_F(DeformStreamTest, FirstMessageMustBeStart) {
+TEST_F(DeformStreamGrpcTest, FirstMessageMustBeStart) {
   StartServer();
   grpc::ClientContext context;
   auto stream = client_->stub()->Deform(&context);
@@ -311,7 +321,7 @@ TEST_F(DeformStreamTest, FirstMessageMustBeStart) {
 
 // Every pose the server received is either answered by a frame or counted in the next frame's
 // skipped_poses, and the newest pose is always answered.
-TEST_F(DeformStreamTest, LatestPoseWinsAndSkippedPosesAccountForEveryPose) {
+TEST_F(DeformStreamGrpcTest, LatestPoseWinsAndSkippedPosesAccountForEveryPose) {
   StartServer();
   const std::string mesh_id = LoadPhantom(3000);
   grpc::ClientContext context;
@@ -352,11 +362,11 @@ TEST_F(DeformStreamTest, LatestPoseWinsAndSkippedPosesAccountForEveryPose) {
   ExpectBackgroundStreamAlive();
 }
 
-TEST_F(DeformStreamTest, CancelledClientLeavesTheServerHealthy) {
+TEST_P(DeformStreamTest, CancelledClientLeavesTheServerHealthy) {
   StartServer();
   const std::string mesh_id = LoadPhantom(500);
   StreamRecorder recorder;
-  auto stream = client_->OpenStream(mesh_id, recorder.Callbacks());
+  auto stream = OpenStream(mesh_id, recorder.Callbacks());
   {
     PosePacer pacer(stream.get(), std::chrono::milliseconds(2));
     ASSERT_TRUE(recorder.WaitForFrames(5));
@@ -368,7 +378,7 @@ TEST_F(DeformStreamTest, CancelledClientLeavesTheServerHealthy) {
 
   // The server forgets the stream and serves new ones.
   StreamRecorder fresh;
-  auto again = client_->OpenStream(mesh_id, fresh.Callbacks());
+  auto again = OpenStream(mesh_id, fresh.Callbacks());
   ASSERT_TRUE(again->SendPose(KneePose(1, 10)));
   ASSERT_TRUE(fresh.WaitForFrameWithSequence(1));
   again->Close();
@@ -384,11 +394,11 @@ TEST_F(DeformStreamTest, CancelledClientLeavesTheServerHealthy) {
   ExpectBackgroundStreamAlive();
 }
 
-TEST_F(DeformStreamTest, UnloadedMeshKeepsItsStreamsButRefusesNewOnes) {
+TEST_P(DeformStreamTest, UnloadedMeshKeepsItsStreamsButRefusesNewOnes) {
   StartServer();
   const std::string mesh_id = LoadPhantom(500);
   StreamRecorder recorder;
-  auto stream = client_->OpenStream(mesh_id, recorder.Callbacks());
+  auto stream = OpenStream(mesh_id, recorder.Callbacks());
   ASSERT_TRUE(stream->SendPose(KneePose(1, 10)));
   ASSERT_TRUE(recorder.WaitForFrameWithSequence(1));
   EXPECT_FALSE(recorder.last_frame().mesh_unloaded());
@@ -399,7 +409,7 @@ TEST_F(DeformStreamTest, UnloadedMeshKeepsItsStreamsButRefusesNewOnes) {
   EXPECT_TRUE(recorder.last_frame().mesh_unloaded());
 
   StreamRecorder refused;
-  auto late = client_->OpenStream(mesh_id, refused.Callbacks());
+  auto late = OpenStream(mesh_id, refused.Callbacks());
   EXPECT_EQ(late->Wait().error_code(), grpc::StatusCode::NOT_FOUND);
   v1::GetMeshInfoResponse info;
   EXPECT_EQ(client_->GetMeshInfo(mesh_id, false, &info).error_code(), grpc::StatusCode::NOT_FOUND);
@@ -411,13 +421,13 @@ TEST_F(DeformStreamTest, UnloadedMeshKeepsItsStreamsButRefusesNewOnes) {
   ExpectBackgroundStreamAlive();
 }
 
-TEST_F(DeformStreamTest, AnUnloadedMeshKeptAliveByAStreamStillCountsAgainstTheBudget) {
+TEST_P(DeformStreamTest, AnUnloadedMeshKeptAliveByAStreamStillCountsAgainstTheBudget) {
   service::ServerOptions options = TestServerOptions();
   options.limits.max_memory_bytes = std::size_t{16} << 20;  // one 5000-vertex phantom, not two
   StartServer(options);
   const std::string mesh_id = LoadPhantom(5000);
   StreamRecorder recorder;
-  auto stream = client_->OpenStream(mesh_id, recorder.Callbacks());
+  auto stream = OpenStream(mesh_id, recorder.Callbacks());
   ASSERT_TRUE(stream->SendPose(KneePose(1, 10)));
   ASSERT_TRUE(recorder.WaitForFrameWithSequence(1));
   ASSERT_TRUE(client_->UnloadMesh(mesh_id).ok());
@@ -441,11 +451,11 @@ TEST_F(DeformStreamTest, AnUnloadedMeshKeptAliveByAStreamStillCountsAgainstTheBu
   ExpectBackgroundStreamAlive();
 }
 
-TEST_F(DeformStreamTest, HalfCloseAnswersTheLastPoseThenEndsOk) {
+TEST_P(DeformStreamTest, HalfCloseAnswersTheLastPoseThenEndsOk) {
   StartServer();
   const std::string mesh_id = LoadPhantom(500);
   StreamRecorder recorder;
-  auto stream = client_->OpenStream(mesh_id, recorder.Callbacks());
+  auto stream = OpenStream(mesh_id, recorder.Callbacks());
   for (std::uint64_t sequence = 1; sequence <= 50; ++sequence) {
     ASSERT_TRUE(stream->SendPose(KneePose(sequence, static_cast<double>(sequence))));
   }
@@ -457,13 +467,13 @@ TEST_F(DeformStreamTest, HalfCloseAnswersTheLastPoseThenEndsOk) {
   EXPECT_TRUE(recorder.status()->ok());
 }
 
-TEST_F(DeformStreamTest, ManyStreamsOnOneMeshAllReceiveFrames) {
+TEST_P(DeformStreamTest, ManyStreamsOnOneMeshAllReceiveFrames) {
   StartServer();
   const std::string mesh_id = LoadPhantom(1000);
   constexpr int kStreams = 16;
   std::vector<std::unique_ptr<StreamRecorder>> recorders;
   std::vector<std::unique_ptr<client::DeformStream>> streams;
-  OpenStreams(client_.get(), mesh_id, kStreams, /*keep_positions=*/false, &recorders, &streams);
+  OpenStreams(mesh_id, kStreams, /*keep_positions=*/false, &recorders, &streams);
   for (std::uint64_t sequence = 1; sequence <= 20; ++sequence) {
     for (auto& stream : streams) ASSERT_TRUE(stream->SendPose(KneePose(sequence, 3.0 * sequence)));
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
@@ -479,7 +489,7 @@ TEST_F(DeformStreamTest, ManyStreamsOnOneMeshAllReceiveFrames) {
 // Streams on one mesh whose poses queue together are solved in one pass over the factor
 // (FrameTimings.batch_frames > 1), and each stream's frame is still its own pose's core result.
 // One worker, so poses sent while it solves queue behind it and form the batch.
-TEST_F(DeformStreamTest, StreamsSolvedInOneBatchEachGetTheirOwnPosesFrame) {
+TEST_P(DeformStreamTest, StreamsSolvedInOneBatchEachGetTheirOwnPosesFrame) {
   service::ServerOptions options = TestServerOptions();
   options.workers = 1;
   options.batch_frames = 8;
@@ -489,7 +499,7 @@ TEST_F(DeformStreamTest, StreamsSolvedInOneBatchEachGetTheirOwnPosesFrame) {
   const std::string mesh_id = LoadPhantom(kVertices);
   std::vector<std::unique_ptr<StreamRecorder>> recorders;
   std::vector<std::unique_ptr<client::DeformStream>> streams;
-  OpenStreams(client_.get(), mesh_id, kStreams, /*keep_positions=*/true, &recorders, &streams);
+  OpenStreams(mesh_id, kStreams, /*keep_positions=*/true, &recorders, &streams);
   std::vector<CoreResult> expected;  // per stream: the knee at 15 * (s + 1) degrees
   for (int s = 0; s < kStreams; ++s) {
     expected.push_back(CoreDeform(kVertices, "knee:flexion:" + std::to_string(15 * (s + 1))));
@@ -521,7 +531,7 @@ TEST_F(DeformStreamTest, StreamsSolvedInOneBatchEachGetTheirOwnPosesFrame) {
 // that queue together are solved as one batch split over both workers (batch_frames > 1 and
 // solve_parts 2: the pool runs one such batch at a time, the other worker helping), and each
 // stream's frame is still its own pose's core result.
-TEST_F(DeformStreamTest, ABatchSplitOverTheWorkersGivesEachStreamItsOwnPosesFrame) {
+TEST_P(DeformStreamTest, ABatchSplitOverTheWorkersGivesEachStreamItsOwnPosesFrame) {
   service::ServerOptions options = TestServerOptions();
   options.workers = 2;
   options.batch_frames = 8;
@@ -532,7 +542,7 @@ TEST_F(DeformStreamTest, ABatchSplitOverTheWorkersGivesEachStreamItsOwnPosesFram
   const std::string mesh_id = LoadPhantom(kVertices);
   std::vector<std::unique_ptr<StreamRecorder>> recorders;
   std::vector<std::unique_ptr<client::DeformStream>> streams;
-  OpenStreams(client_.get(), mesh_id, kStreams, /*keep_positions=*/true, &recorders, &streams);
+  OpenStreams(mesh_id, kStreams, /*keep_positions=*/true, &recorders, &streams);
   std::vector<CoreResult> expected;  // per stream: the knee at 15 * (s + 1) degrees
   for (int s = 0; s < kStreams; ++s) {
     expected.push_back(CoreDeform(kVertices, "knee:flexion:" + std::to_string(15 * (s + 1))));
@@ -563,7 +573,7 @@ TEST_F(DeformStreamTest, ABatchSplitOverTheWorkersGivesEachStreamItsOwnPosesFram
 }
 
 // With --batch-frames 1 every frame is solved alone.
-TEST_F(DeformStreamTest, ABatchLimitOfOneSolvesEveryFrameAlone) {
+TEST_P(DeformStreamTest, ABatchLimitOfOneSolvesEveryFrameAlone) {
   service::ServerOptions options = TestServerOptions();
   options.workers = 1;
   options.batch_frames = 1;
@@ -572,7 +582,7 @@ TEST_F(DeformStreamTest, ABatchLimitOfOneSolvesEveryFrameAlone) {
   constexpr int kStreams = 4;
   std::vector<std::unique_ptr<StreamRecorder>> recorders;
   std::vector<std::unique_ptr<client::DeformStream>> streams;
-  OpenStreams(client_.get(), mesh_id, kStreams, /*keep_positions=*/false, &recorders, &streams);
+  OpenStreams(mesh_id, kStreams, /*keep_positions=*/false, &recorders, &streams);
   for (std::uint64_t round = 1; round <= 10; ++round) {
     for (auto& stream : streams) ASSERT_TRUE(stream->SendPose(KneePose(round, 5.0 * round)));
   }
@@ -605,7 +615,7 @@ class LoneFrameSplitTest : public DeformStreamTest {
     constexpr int kVertices = 4000;
     const std::string mesh_id = LoadPhantom(kVertices);
     StreamRecorder recorder(/*keep_positions=*/true);
-    auto stream = client_->OpenStream(mesh_id, recorder.Callbacks());
+    auto stream = OpenStream(mesh_id, recorder.Callbacks());
     std::uint64_t sequence = 0;
     bool split = false;
     for (int i = 0; i < (until_split ? 30 : 3) && !(until_split && split); ++i) {
@@ -632,26 +642,30 @@ class LoneFrameSplitTest : public DeformStreamTest {
 };
 
 // Fewer streams open than workers (two of three): a lone frame is split over the workers.
-TEST_F(LoneFrameSplitTest, FramesSplitOverTheWorkersWhileFewerStreamsThanWorkersAreOpen) {
+INSTANTIATE_TEST_SUITE_P(Transports, LoneFrameSplitTest,
+                         ::testing::Values(Transport::kGrpc, Transport::kWebSocket),
+                         TransportName);
+
+TEST_P(LoneFrameSplitTest, FramesSplitOverTheWorkersWhileFewerStreamsThanWorkersAreOpen) {
   ExpectThreeFramesSolvedIn(/*workers=*/3, /*parts=*/3);
 }
 
 // As many streams open as workers (two of two), but the other stream sends nothing, so the other
 // worker is idle when a frame starts (unless the scheduler has not yet let it wait): a lone frame
 // is split over it too.
-TEST_F(LoneFrameSplitTest, FramesSplitOverAnIdleWorkerAlsoWhileAsManyStreamsAsWorkersAreOpen) {
+TEST_P(LoneFrameSplitTest, FramesSplitOverAnIdleWorkerAlsoWhileAsManyStreamsAsWorkersAreOpen) {
   ExpectThreeFramesSolvedIn(/*workers=*/2, /*parts=*/2, /*until_split=*/true);
 }
 
 // One worker: nothing to split over, every frame solved whole.
-TEST_F(LoneFrameSplitTest, FramesAreSolvedWholeOnASingleWorker) {
+TEST_P(LoneFrameSplitTest, FramesAreSolvedWholeOnASingleWorker) {
   ExpectThreeFramesSolvedIn(/*workers=*/1, /*parts=*/1);
 }
 
 // With the float32 threshold lowered to every mesh, the phantom's factor is stored in float32 (the
 // summary says so, with the probe's error), and its frames, batched, split over the workers or
 // alone, stay within 1e-6 of the diagonal of the core's double frames.
-TEST_F(DeformStreamTest, AFloat32FactorsFramesStayWithinTheTransportRoundingOfTheCore) {
+TEST_P(DeformStreamTest, AFloat32FactorsFramesStayWithinTheTransportRoundingOfTheCore) {
   service::ServerOptions options = TestServerOptions();
   options.workers = 2;
   options.parallel_solve_min_factor_bytes = 0;
@@ -665,7 +679,7 @@ TEST_F(DeformStreamTest, AFloat32FactorsFramesStayWithinTheTransportRoundingOfTh
   EXPECT_LE(summary.float32_probe_error(), MaterialFactorization::kFloat32ProbeTolerance);
   std::vector<std::unique_ptr<StreamRecorder>> recorders;
   std::vector<std::unique_ptr<client::DeformStream>> streams;
-  OpenStreams(client_.get(), mesh_id, 3, /*keep_positions=*/true, &recorders, &streams);
+  OpenStreams(mesh_id, 3, /*keep_positions=*/true, &recorders, &streams);
   std::uint64_t sequence = 0;
   for (const int degrees : {30, 75, 120}) {
     ++sequence;
@@ -688,7 +702,7 @@ TEST_F(DeformStreamTest, AFloat32FactorsFramesStayWithinTheTransportRoundingOfTh
 }
 
 // By default (64 MiB) a small mesh keeps its factor in double and no probe runs.
-TEST_F(DeformStreamTest, ASmallMeshKeepsADoubleFactorByDefault) {
+TEST_P(DeformStreamTest, ASmallMeshKeepsADoubleFactorByDefault) {
   StartServer();
   v1::MeshSummary summary;
   LoadPhantom(2000, {}, &summary);

@@ -11,8 +11,16 @@
 #include "deform_client.h"
 #include "tests/service/support/stream_recorder.h"
 #include "tests/service/support/test_server.h"
+#include "tests/service/support/websocket_deform_stream.h"
 
 namespace deform::test_support {
+
+// The transports a stream handler's tests run over (one body each: TEST_P over both).
+enum class Transport { kGrpc, kWebSocket };
+
+inline std::string TransportName(const ::testing::TestParamInfo<Transport>& info) {
+  return info.param == Transport::kGrpc ? "Grpc" : "WebSocket";
+}
 
 class ServiceTest : public ::testing::Test {
  protected:
@@ -20,7 +28,7 @@ class ServiceTest : public ::testing::Test {
   // streamed from its own client and thread.
   void StartServer(service::ServerOptions options = TestServerOptions(),
                    int background_vertices = 300) {
-    server_ = std::make_unique<TestServer>(options);
+    server_ = std::make_unique<TestServer>(options, "", transport_ == Transport::kWebSocket);
     client_ = server_->NewClient();
     ASSERT_TRUE(client_->WaitForReady(60'000));
     background_client_ = server_->NewClient();
@@ -61,6 +69,17 @@ class ServiceTest : public ::testing::Test {
         << "the background stream ended: " << background_recorder_.status()->error_message();
   }
 
+  // A Deform stream of the test's on `mesh_id`, over the test's transport (the background stream
+  // always runs over gRPC).
+  std::unique_ptr<client::DeformStream> OpenStream(const std::string& mesh_id,
+                                                   client::DeformClient::StreamCallbacks callbacks) {
+    if (transport_ == Transport::kWebSocket) {
+      return std::make_unique<WebSocketDeformStream>(server_->web_port(), mesh_id,
+                                                     std::move(callbacks));
+    }
+    return client_->OpenStream(mesh_id, std::move(callbacks));
+  }
+
   // Loads a phantom through the test's client; its id.
   std::string LoadPhantom(int vertices, const v1::MethodOptions& options = {},
                           v1::MeshSummary* summary_out = nullptr) {
@@ -79,6 +98,7 @@ class ServiceTest : public ::testing::Test {
   std::unique_ptr<client::DeformStream> background_stream_;
   std::unique_ptr<PosePacer> background_pacer_;
   bool expect_background_ok_at_end_ = true;
+  Transport transport_ = Transport::kGrpc;
 };
 
 }  // namespace deform::test_support
