@@ -16,7 +16,7 @@ constexpr int kChains = 12;
 constexpr std::int64_t kSteps = 1 << 22;
 
 // `steps` steps of every chain, in whichever instruction set the caller is compiled for (always
-// inlined into it). Returns a sum of the chains, so that none is optimised away.
+// inlined into it). Returns a sum of the chains, so that none is optimized away.
 template <typename Vec>
 __attribute__((always_inline)) inline double RunChains(std::int64_t steps) {
   Vec acc[kChains];

@@ -14,8 +14,8 @@ struct BenchMesh {
   std::string name;
   std::string mesh_path;  // empty: the phantom
   std::string skeleton_path;
-  std::string pose_spec;         // the benchmarks' pose
-  std::string flexion_prefix;    // the flexion at DEG degrees is flexion_prefix + DEG
+  std::string pose_spec;       // the benchmarks' pose
+  std::string flexion_prefix;  // the flexion at DEG degrees is flexion_prefix + DEG
 };
 
 // The meshes present (a line on stderr for each shared mesh absent).

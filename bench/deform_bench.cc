@@ -1,4 +1,4 @@
-// Per-frame solve, factorisation and precomputation of the deformation model on the shared meshes
+// Per-frame solve, factorization and precomputation of the deformation model on the shared meshes
 // (1.6k and 26k leg, 133k arm; skipped where ../shared/data is absent) and the built-in phantom.
 //
 // Every solve benchmark reports, besides Google Benchmark's mean time:
@@ -77,7 +77,7 @@ void ReportAgainstBound(benchmark::State& state, std::size_t bytes,
 }
 
 // What the frame benchmarks work on: a mesh's model, its benchmark pose, the model's default
-// factorisation and a scratch.
+// factorization and a scratch.
 struct FrameSetup {
   std::shared_ptr<const DeformationModel> model;
   Pose pose;
@@ -451,7 +451,7 @@ void BM_EigenBaselineSolve(benchmark::State& state, BenchMesh mesh) {
       state, l.nonZeros() * (sizeof(double) + sizeof(int)) + (l.cols() + 1) * sizeof(int), seconds);
 }
 
-// A numeric refactorisation (as after a stiffness change), reusing the symbolic analysis.
+// A numeric refactorization (as after a stiffness change), reusing the symbolic analysis.
 void BM_Factorize(benchmark::State& state, BenchMesh mesh) {
   auto model = ModelFor(mesh);
   if (!model) return state.SkipWithError("mesh could not be loaded");
@@ -467,7 +467,7 @@ void BM_Factorize(benchmark::State& state, BenchMesh mesh) {
   state.counters["factor_MB"] = model->default_factorization()->factor().bytes() / 1e6;
 }
 
-// Everything Build() does: validation, weights, regions, symbolic analysis, first factorisation.
+// Everything Build() does: validation, weights, regions, symbolic analysis, first factorization.
 void BM_Precompute(benchmark::State& state, BenchMesh mesh) {
   auto input = LoadModelInput(mesh.mesh_path, mesh.skeleton_path, kDefaultPhantomVertices);
   if (!input.ok()) return state.SkipWithError(input.status().ToString().c_str());
@@ -479,7 +479,7 @@ void BM_Precompute(benchmark::State& state, BenchMesh mesh) {
     if (model.ok()) precompute.push_back((*model)->precompute_seconds());
   }  // the model is freed outside the timed span
   state.counters["median_ms"] = Median(seconds) * 1e3;
-  state.counters["precompute_ms"] = Median(precompute) * 1e3;  // before the first factorisation
+  state.counters["precompute_ms"] = Median(precompute) * 1e3;  // before the first factorization
 }
 
 // Registers benchmark `name`/<mesh> of `function`(state, mesh, extra...), timed in milliseconds.

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The whole test suite under AddressSanitizer + UndefinedBehaviorSanitizer, then the service tests
-# whose threads meet through our own synchronisation under ThreadSanitizer. Exits non-zero on any
+# whose threads meet through our own synchronization under ThreadSanitizer. Exits non-zero on any
 # failing test or sanitizer report. Run by .ci/run after scripts/run-fuzz.sh.
 #
 #   ASan+UBSan: build-asan ($DEFORM_ASAN_BUILD_DIR, shared with scripts/run-fuzz.sh:

@@ -50,7 +50,7 @@ grep -q "requires holding mutex" "$canary_log" || {
 mkdir -p "$BUILD_DIR"
 LAUNCHER=()
 if command -v ccache >/dev/null 2>&1; then LAUNCHER=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
-# CMAKE_BUILD_TYPE=None: no optimisation and no debug information, the fastest compile.
+# CMAKE_BUILD_TYPE=None: no optimization and no debug information, the fastest compile.
 cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=None -DCMAKE_CXX_COMPILER=clang++ \
   "${LAUNCHER[@]}" -DDEFORM_THREAD_SAFETY_ANALYSIS=ON -DDEFORM_BUILD_TESTS=OFF \
   -DDEFORM_BUILD_BENCHMARKS=OFF >"$BUILD_DIR/configure.log" 2>&1 || {

@@ -96,7 +96,7 @@ DEFORM_C_API const char* deform_status_name(int status);
 
 typedef struct deform_client deform_client;
 
-/* Connection options. Zero-initialise the struct and set what you need; NULL or "" means unset.
+/* Connection options. Zero-initialize the struct and set what you need; NULL or "" means unset.
  * TLS is on when `tls` is non-zero or any of the CA / certificate / key fields is set. */
 typedef struct deform_connect_options {
   const char* target;    /* required: "host:port", e.g. "127.0.0.1:50051" */
@@ -222,7 +222,7 @@ typedef struct deform_joint_angle {
   double degrees;
 } deform_joint_angle;
 
-/* A joint's whole local rotation as a quaternion (normalised by the server); applied before the
+/* A joint's whole local rotation as a quaternion (normalized by the server); applied before the
  * angles of the same joint. */
 typedef struct deform_joint_rotation {
   const char* joint;
@@ -266,7 +266,7 @@ typedef struct deform_region_weight {
 
 /* Replaces the stream's stiffness (not cumulative: the model's defaults, then these). Any array
  * may be NULL when its count is 0; `vertex_indices` and `vertex_weights` both have vertex_count
- * entries. Never waits; updates are applied in order, each with a refactorisation on the server
+ * entries. Never waits; updates are applied in order, each with a refactorization on the server
  * (a notice says when it is applied or why it was rejected). */
 DEFORM_C_API deform_status deform_stream_send_stiffness(
     deform_stream* stream, const deform_joint_material* materials, size_t material_count,
@@ -315,7 +315,7 @@ typedef struct deform_notice_info {
   int kind; /* a deform_notice_kind */
   uint64_t sequence;
   uint64_t stiffness_version;
-  double factor_ms; /* STIFFNESS_APPLIED: the refactorisation's time */
+  double factor_ms; /* STIFFNESS_APPLIED: the refactorization's time */
 } deform_notice_info;
 
 /* Takes the oldest notice not yet taken (the stream keeps the last 64) into *info; its message,

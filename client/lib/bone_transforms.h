@@ -26,7 +26,7 @@ struct BoneTransform {
 };
 
 // From a 4x4 column-major matrix (glTF's and OpenGL's layout) holding a rotation and a
-// translation; the rotation part is orthonormalised.
+// translation; the rotation part is orthonormalized.
 BoneTransform BoneTransformFromMatrix(const std::array<double, 16>& column_major);
 
 struct PoseConversion {

@@ -142,7 +142,7 @@ class DeformClient {
   ClientOptions options_;
 };
 
-// One bidirectional Deform stream. Writes are serialised: while one is in flight, a newer pose
+// One bidirectional Deform stream. Writes are serialized: while one is in flight, a newer pose
 // replaces any pose still waiting (latest wins), and stiffness updates queue in order.
 class DeformStream {
  public:

@@ -157,7 +157,7 @@ class DeformStreamImpl final
 
   grpc::ClientContext context_;
   DeformClient::StreamCallbacks callbacks_;
-  deform::v1::DeformResponse response_;  // read side: one read outstanding at a time
+  deform::v1::DeformResponse response_;           // read side: one read outstanding at a time
   std::unique_ptr<codec::FrameDecoder> decoder_;  // read side only
 
   std::mutex mutex_;

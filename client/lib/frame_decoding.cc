@@ -22,15 +22,16 @@ std::unique_ptr<codec::FrameDecoder> MakeFrameDecoder(const deform::v1::GetMeshI
   weights.bones.resize(slots);
   weights.weights.resize(slots);
   for (std::size_t s = 0; s < slots; ++s) {
-    weights.bones[s] = static_cast<std::uint16_t>(
-        static_cast<unsigned char>(proto.bones()[2 * s]) |
-        (static_cast<unsigned char>(proto.bones()[2 * s + 1]) << 8));
+    weights.bones[s] =
+        static_cast<std::uint16_t>(static_cast<unsigned char>(proto.bones()[2 * s]) |
+                                   (static_cast<unsigned char>(proto.bones()[2 * s + 1]) << 8));
   }
   std::memcpy(weights.weights.data(), proto.weights().data(), 4 * slots);  // little-endian hosts
   std::vector<float> rest(3 * static_cast<std::size_t>(n));
   std::memcpy(rest.data(), info.rest_positions().data(), 12 * static_cast<std::size_t>(n));
-  if (!decoder->SetPrediction(std::move(rest), std::move(weights),
-                              static_cast<int>(proto.num_bones())).ok()) {
+  if (!decoder
+           ->SetPrediction(std::move(rest), std::move(weights), static_cast<int>(proto.num_bones()))
+           .ok()) {
     return nullptr;
   }
   return decoder;
@@ -55,7 +56,7 @@ grpc::Status DecodeFrame(const deform::v1::EncodedPositions& encoded, codec::Fra
       return grpc::Status(grpc::StatusCode::INTERNAL, "a frame in an unknown encoding");
   }
   if (header.encoding == codec::FrameEncoding::kQuantized && encoded.origin_size() != 3) {
-    return grpc::Status(grpc::StatusCode::INTERNAL, "a quantised frame without its box origin");
+    return grpc::Status(grpc::StatusCode::INTERNAL, "a quantized frame without its box origin");
   }
   for (int a = 0; a < encoded.origin_size() && a < 3; ++a) header.origin[a] = encoded.origin(a);
   header.step = encoded.step();

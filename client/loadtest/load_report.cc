@@ -205,7 +205,7 @@ std::string ReportText(const LoadReport& report) {
       "threads\n",
       report.batch_frames_mean, 100.0 * report.split_fraction);
   if (plan.stiffness_every_s > 0) {
-    add("stiffness on %s every %.2f s: %llu sent, %llu applied (median refactorisation %.3f ms)\n",
+    add("stiffness on %s every %.2f s: %llu sent, %llu applied (median refactorization %.3f ms)\n",
         report.run.stiffness_joint.c_str(), plan.stiffness_every_s,
         static_cast<unsigned long long>(report.stiffness_sent),
         static_cast<unsigned long long>(report.stiffness_applied), report.stiffness_factor_ms_p50);

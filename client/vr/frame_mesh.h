@@ -9,8 +9,9 @@
 namespace deform::vr {
 
 // Builds a mesh from `positions` (float32 little-endian xyz per vertex, as DeformFrame.positions)
-// and `triangles` (uint32 little-endian, 3 per triangle, as GetMeshInfoResponse.triangles). INVALID_ARGUMENT
-// when a buffer's size is not a whole number of records or a triangle names a missing vertex.
+// and `triangles` (uint32 little-endian, 3 per triangle, as GetMeshInfoResponse.triangles).
+// INVALID_ARGUMENT when a buffer's size is not a whole number of records or a triangle names a
+// missing vertex.
 StatusOr<TriangleMesh> MeshFromBuffers(const std::string& positions, const std::string& triangles);
 
 }  // namespace deform::vr

@@ -16,8 +16,8 @@
 // (service/metrics_endpoint.h).
 //
 // --http ADDR also serves the browser viewer and the API over HTTP and WebSockets
-// (service/rpc/web_server.h) from the same service context; its files come from --http-root, by default the
-// `web` directory beside the executable (the build copies client/web there), else
+// (service/rpc/web_server.h) from the same service context; its files come from --http-root, by
+// default the `web` directory beside the executable (the build copies client/web there), else
 // ../share/deformd/web.
 //
 // --store DIR keeps loaded meshes on disk and builds them again, under their ids and owners, when
@@ -51,9 +51,9 @@
 
 #include "core/base/build_info.h"
 #include "core/io/model_input.h"
-#include "service/rpc/deform_server.h"
 #include "service/access/identity.h"
 #include "service/base/service_options.h"
+#include "service/rpc/deform_server.h"
 #include "service/rpc/web_server.h"
 
 namespace {

@@ -1,5 +1,5 @@
 // libFuzzer target: a LoadMesh header as the server checks it before reserving anything. The
-// bytes are a serialised deform.v1.LoadMeshHeader; CheckLoadHeader (string limits, source, sizes
+// bytes are a serialized deform.v1.LoadMeshHeader; CheckLoadHeader (string limits, source, sizes
 // without overflow) and ModelOptionsFromProto (against the knee phantom's skeleton) must give a
 // Status, never a crash or a sanitizer report.
 #include <cstddef>

@@ -1,4 +1,4 @@
-// libFuzzer target: a Deform stream's pose as the server converts it. The bytes are a serialised
+// libFuzzer target: a Deform stream's pose as the server converts it. The bytes are a serialized
 // deform.v1.PoseUpdate (as received); PoseInputFromProto checks and resolves it against the knee
 // phantom's skeleton and PoseFromInput makes the core pose. Rejections are Statuses; an accepted
 // pose must have finite unit rotations and a finite root.

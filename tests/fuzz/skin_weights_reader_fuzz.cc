@@ -1,5 +1,5 @@
 // libFuzzer target: ReadSkinWeights in one format (DEFORM_FUZZ_WEIGHTS_FORMAT: kDmat, ASCII and
-// binary, or kCsv) on arbitrary bytes, then normalised against a mesh and skeleton of the sizes it
+// binary, or kCsv) on arbitrary bytes, then normalized against a mesh and skeleton of the sizes it
 // names (bounded): a Status or weights, never a crash or a sanitizer report.
 #include <cstddef>
 #include <cstdint>

@@ -1,6 +1,6 @@
 // libFuzzer target: a Deform stream's stiffness update as the server converts it. The bytes are a
-// serialised deform.v1.StiffnessUpdate; StiffnessFromProto checks it against the knee phantom's
-// model (joints, regions, vertex indices, weights). An accepted update is refactorised when small
+// serialized deform.v1.StiffnessUpdate; StiffnessFromProto checks it against the knee phantom's
+// model (joints, regions, vertex indices, weights). An accepted update is refactorized when small
 // enough to keep the run fast; rejections are Statuses.
 #include <cstddef>
 #include <cstdint>

@@ -69,7 +69,7 @@ function startDeformd(extra) {
   });
 }
 
-// A raw HTTP request (no path normalisation); resolves with {status, headers, body} or, for an
+// A raw HTTP request (no path normalization); resolves with {status, headers, body} or, for an
 // upgrade, {upgraded: true, headers}.
 function rawRequest(port, method, target, headers = {}, body = null) {
   return new Promise((resolve, reject) => {

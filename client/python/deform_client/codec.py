@@ -136,7 +136,7 @@ class FrameDecoder:
             raise ValueError("encoded frame's step must be positive and finite")
         if encoded.encoding == QUANTIZED:
             if len(encoded.origin) != 3:
-                raise ValueError("a quantised frame without its box origin")
+                raise ValueError("a quantized frame without its box origin")
             records = decode_records(encoded.data, self.vertex_count)
             origin = np.array(encoded.origin, dtype=np.float64)
             values = origin + records[:, :3].astype(np.float64) * step

@@ -107,8 +107,8 @@ Status FrameDecoder::SetPrediction(std::vector<float> rest, PredictionWeights we
   if (weights.num_vertices() != num_vertices_ ||
       rest.size() != 3 * static_cast<std::size_t>(num_vertices_)) {
     return Status::InvalidArgument("prediction weights or rest positions for " +
-                                   std::to_string(weights.num_vertices()) + " vertices; frames have " +
-                                   std::to_string(num_vertices_));
+                                   std::to_string(weights.num_vertices()) +
+                                   " vertices; frames have " + std::to_string(num_vertices_));
   }
   if (!CheckPredictionWeights(weights, num_bones)) {
     return Status::InvalidArgument("prediction weights name a bone out of range or are negative");
@@ -121,8 +121,8 @@ Status FrameDecoder::SetPrediction(std::vector<float> rest, PredictionWeights we
 }
 
 Status FrameDecoder::Decode(const EncodedFrameHeader& header, const unsigned char* data,
-                            std::size_t size, const float* transforms,
-                            std::size_t transform_floats, float* positions) {
+                            std::size_t size, const float* transforms, std::size_t transform_floats,
+                            float* positions) {
   if (!std::isfinite(header.step) || header.step <= 0) {
     return Status::InvalidArgument("encoded frame's step must be positive and finite");
   }
@@ -153,8 +153,8 @@ Status FrameDecoder::Decode(const EncodedFrameHeader& header, const unsigned cha
   PredictPositions(rest_.data(), weights_, transforms, predicted_.data());
   for (int c = 0; c < num_vertices_; ++c) {
     for (int a = 0; a < 3; ++a) {
-      positions[3 * c + a] = static_cast<float>(predicted_[3 * c + a] +
-                                                UnZigZag(records_[4 * c + a]) * header.step);
+      positions[3 * c + a] =
+          static_cast<float>(predicted_[3 * c + a] + UnZigZag(records_[4 * c + a]) * header.step);
     }
   }
   return Status::Ok();

@@ -1,8 +1,8 @@
-// Compact frames: positions quantised in a box, or predicted by linear blend skinning with a
-// quantised residual, each coded by meshoptimizer's vertex codec (whose decoder also ships on npm,
+// Compact frames: positions quantized in a box, or predicted by linear blend skinning with a
+// quantized residual, each coded by meshoptimizer's vertex codec (whose decoder also ships on npm,
 // so browsers decode the same bytes).
 //
-// Both encodings quantise every coordinate with one step: the decoded coordinate differs from the
+// Both encodings quantize every coordinate with one step: the decoded coordinate differs from the
 // solved one by at most step / 2 (the header's max_error), plus the float32 rounding of the decoded
 // value. The bytes are meshopt_encodeVertexBuffer of 8-byte records, one per vertex in the frame's
 // vertex order: four little-endian uint16 (x, y, z, 0).
@@ -35,7 +35,7 @@ inline constexpr double kDefaultPredictedMaxError = 5e-5;
 struct EncodedFrameHeader {
   FrameEncoding encoding = FrameEncoding::kQuantized;
   double origin[3] = {0, 0, 0};  // kQuantized: the box's minimum corner
-  double step = 0;               // the quantisation step, model units
+  double step = 0;               // the quantization step, model units
   double max_error = 0;          // step / 2: the largest per-coordinate error, model units
 };
 
@@ -46,18 +46,18 @@ class FrameEncoder {
   // kQuantized frames of `num_vertices` vertices.
   explicit FrameEncoder(int num_vertices);
   // kPredicted frames: `rest` (3 n float32) and `weights` in the frame's vertex order, `num_bones`
-  // transforms per frame, residual quantised with `step` (model units, > 0).
+  // transforms per frame, residual quantized with `step` (model units, > 0).
   FrameEncoder(std::vector<float> rest, PredictionWeights weights, int num_bones, double step);
 
   // Bytes Encode may write at most.
   std::size_t max_encoded_bytes() const { return max_encoded_bytes_; }
   bool predicted() const { return !rest_.empty(); }
 
-  // Codes the frame whose vertex c is solution[3 order[c] .. 3 order[c] + 2] (order empty: c itself)
-  // into out[0, max_encoded_bytes()), filling `header`; returns the bytes written. `transforms`: 12
-  // floats per bone (skinning_prediction.h), read for kPredicted only.
-  std::size_t Encode(const double* solution, const std::vector<int>& order,
-                     const float* transforms, EncodedFrameHeader* header, unsigned char* out);
+  // Codes the frame whose vertex c is solution[3 order[c] .. 3 order[c] + 2] (order empty: c
+  // itself) into out[0, max_encoded_bytes()), filling `header`; returns the bytes written.
+  // `transforms`: 12 floats per bone (skinning_prediction.h), read for kPredicted only.
+  std::size_t Encode(const double* solution, const std::vector<int>& order, const float* transforms,
+                     EncodedFrameHeader* header, unsigned char* out);
 
  private:
   std::size_t EncodeQuantized(const double* solution, const std::vector<int>& order,

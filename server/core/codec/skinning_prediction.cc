@@ -30,8 +30,10 @@ void PredictPositions(const float* rest, const PredictionWeights& weights, const
 }
 
 PredictionWeights TopFourWeights(const std::vector<int>& offsets, const std::vector<int>& bones,
-                                 const std::vector<double>& weights, const std::vector<int>& order) {
-  const int n = order.empty() ? static_cast<int>(offsets.size()) - 1 : static_cast<int>(order.size());
+                                 const std::vector<double>& weights,
+                                 const std::vector<int>& order) {
+  const int n =
+      order.empty() ? static_cast<int>(offsets.size()) - 1 : static_cast<int>(order.size());
   constexpr int kSlots = kPredictionBonesPerVertex;
   PredictionWeights result;
   result.bones.assign(static_cast<std::size_t>(kSlots) * n, 0);

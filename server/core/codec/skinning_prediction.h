@@ -37,7 +37,7 @@ struct PredictionWeights {
 // The prediction weights of a skinning given per vertex as lists (vertex i's bones and weights at
 // [offsets[i], offsets[i + 1]), largest weight first, as the model's BoneWeights holds them), in
 // the vertex order `order` (frame vertex c is vertex order[c]; empty: the same order): the four
-// largest of each vertex, renormalised to sum to 1.
+// largest of each vertex, renormalized to sum to 1.
 PredictionWeights TopFourWeights(const std::vector<int>& offsets, const std::vector<int>& bones,
                                  const std::vector<double>& weights, const std::vector<int>& order);
 

@@ -28,7 +28,7 @@ struct MethodRun {
   Positions posed;  // #V by 3
   QualityReport quality;
   double precompute_seconds = 0;   // model precomputation (weights, regions, symbolic analysis)
-  double factor_seconds = 0;       // numeric factorisation (0 for skinning)
+  double factor_seconds = 0;       // numeric factorization (0 for skinning)
   std::size_t factor_bytes = 0;    // bytes of the stored factor (0 for skinning)
   std::size_t response_bytes = 0;  // bytes of the linear response (paper-linear only)
   // Medians over `repeat` frames. For paper and laplacian, solve_seconds is the two triangular

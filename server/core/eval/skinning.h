@@ -13,7 +13,7 @@ namespace deform {
 void LinearBlendSkinning(const Positions& rest, const BoneWeights& weights,
                          const std::vector<RigidTransform>& bone_transforms, Positions* posed);
 
-// Dual quaternion skinning (Kavan et al. 2008) with the same weights: the normalised blend of the
+// Dual quaternion skinning (Kavan et al. 2008) with the same weights: the normalized blend of the
 // bones' unit dual quaternions, signs aligned to each vertex's heaviest bone.
 void DualQuaternionSkinning(const Positions& rest, const BoneWeights& weights,
                             const std::vector<RigidTransform>& bone_transforms, Positions* posed);

@@ -10,7 +10,7 @@
 namespace deform {
 namespace {
 
-// A joint's degrees of freedom: usable, distinct names, non-zero finite axes (normalised here)
+// A joint's degrees of freedom: usable, distinct names, non-zero finite axes (normalized here)
 // and valid ranges.
 Status CheckDegreesOfFreedom(Joint* joint) {
   std::unordered_set<std::string> names;

@@ -38,7 +38,7 @@ class Skeleton {
  public:
   // Validates and builds: joint names unique and non-empty, finite positions, bones reference
   // existing joints, no bone of zero length, each joint is the tail of at most one bone, no cycles,
-  // dof axes non-zero (normalised here) and min <= max. Parent bones are derived here.
+  // dof axes non-zero (normalized here) and min <= max. Parent bones are derived here.
   static StatusOr<Skeleton> Create(std::vector<Joint> joints,
                                    std::vector<std::pair<int, int>> bones);
   // As above, with explicit parents for rigs whose bones do not meet (a game-engine thigh hangs

@@ -23,7 +23,7 @@ struct SkinWeights {
 
 // Checks `weights` against a mesh of `num_vertices` and a skeleton of `num_bones`, and returns
 // them cleaned: entries sorted by bone per vertex, repeated bones summed, weights below
-// kSkinWeightDropBelow of the vertex's total dropped, rows renormalised to sum to 1.
+// kSkinWeightDropBelow of the vertex's total dropped, rows renormalized to sum to 1.
 // INVALID_ARGUMENT naming the first problem: a vertex count or bone count that differs, a bone
 // index out of range, a negative or non-finite weight, a vertex whose weights sum to zero (it
 // would follow no bone), malformed offsets.

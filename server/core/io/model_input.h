@@ -16,7 +16,7 @@ namespace deform {
 struct ModelInput {
   TriangleMesh mesh;
   Skeleton skeleton;
-  // Skinning weights over `skeleton`'s bones for every vertex of `mesh`, normalised
+  // Skinning weights over `skeleton`'s bones for every vertex of `mesh`, normalized
   // (NormalizeSkinWeights); from a weights file or a glTF rig, absent otherwise.
   std::optional<SkinWeights> weights;
   // For a glTF rig: per vertex in the file's own order, its vertex of `mesh` (see RigImport).

@@ -49,7 +49,7 @@ void AccumulateJointVertices(const FileMesh& file, std::vector<SkinJoint>* joint
   }
 }
 
-// The file vertices' joint influences as normalised weights on the rig's bones: a joint's weight
+// The file vertices' joint influences as normalized weights on the rig's bones: a joint's weight
 // goes to the bone starting at its skeleton joint, the nearest one where several start there.
 StatusOr<SkinWeights> BoneWeights(const FileMesh& file, const RigSkeleton& rig) {
   const SkinWeights& influences = file.joint_weights;

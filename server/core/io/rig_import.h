@@ -10,7 +10,7 @@
 //   - The skinned mesh: the one node with both "mesh" and "skin" (none: INVALID_ARGUMENT "no
 //     skin: ..."; several: INVALID_ARGUMENT). Every primitive must be triangles (mode 4, indexed
 //     or not) with POSITION (float VEC3) and JOINTS_n/WEIGHTS_n pairs (n = 0, 1, ...; JOINTS
-//     unsigned byte/short, WEIGHTS float or normalised unsigned byte/short). Primitives are
+//     unsigned byte/short, WEIGHTS float or normalized unsigned byte/short). Primitives are
 //     concatenated in file order. Morph targets, normals, UVs and materials are ignored.
 //   - Positions are kept as the file holds them, in the bind space the inverse bind matrices refer
 //     to: glTF ignores a skinned mesh node's own transform (the joints place the mesh), so it is
@@ -26,7 +26,7 @@
 //     lone joint without parent: toward its vertices' weighted centroid, twice as far, or along
 //     their principal direction when they centre on the joint).
 //   - Weights: a glTF joint's weight goes to the bone that starts at its skeleton joint; where
-//     several start there, to the one nearest the vertex; normalised (NormalizeSkinWeights).
+//     several start there, to the one nearest the vertex; normalized (NormalizeSkinWeights).
 //   - Welding: vertices that glTF splits at seams (exactly equal position, weights equal within
 //     1e-6) become one vertex of the mesh; vertices no triangle uses are dropped from it, and each
 //     follows the used vertex before it in the file (the first used one, for those before it):
@@ -47,15 +47,15 @@ namespace deform {
 struct RigImport {
   TriangleMesh mesh;    // the welded mesh the solve uses (validated with ValidateMesh)
   Skeleton skeleton;    // the skin's joints (plus any "<name>_end" joints) and their bones
-  SkinWeights weights;  // on the welded vertices, bone indices in skeleton bone order; normalised
+  SkinWeights weights;  // on the welded vertices, bone indices in skeleton bone order; normalized
   // For each vertex in the file's own order (all primitives of the skinned mesh concatenated, as
   // an engine holds them): its vertex in `mesh` (always one: a vertex no triangle uses follows
   // the used vertex before it, see Welding above). Frames computed on `mesh` return to the file's
   // order through this.
   std::vector<int> file_vertex_to_mesh;
   std::vector<int> unused_file_vertices;  // file vertices no triangle uses, ascending
-  std::string units = "metre";   // glTF's units (the spec says metres)
-  std::string up_axis = "+Y";    // glTF's up axis
+  std::string units = "metre";            // glTF's units (the spec says metres)
+  std::string up_axis = "+Y";             // glTF's up axis
 };
 
 // Parses a whole .gltf (JSON, buffers as data URIs) or .glb (told by its "glTF" magic) held in

@@ -48,7 +48,7 @@ const char* SkinWeightsFormatName(SkinWeightsFormat format);
 
 // Parses a whole weights file held in memory. Rows (vertices) are limited by
 // limits.max_vertices, bones by kMaxSkinBones. Weights are finite and non-negative (see
-// kNegativeWeightRoundOff); zeros are dropped. Not normalised.
+// kNegativeWeightRoundOff); zeros are dropped. Not normalized.
 StatusOr<SkinWeights> ReadSkinWeights(std::string_view bytes, SkinWeightsFormat format,
                                       const MeshLimits& limits = {});
 // Reads a file; the format comes from the extension (.dmat, .csv). NOT_FOUND if it cannot be

@@ -79,7 +79,7 @@ NearestBone FirstVisibleBone(const Skeleton& skeleton, const TriangleBvh& bvh,
 }
 
 // Area-weighted vertex normals, pointing out of the enclosed volume (flipped when the triangles
-// wind inward: a negative signed volume). Not normalised; zero for an isolated vertex.
+// wind inward: a negative signed volume). Not normalized; zero for an isolated vertex.
 Positions OutwardVertexNormals(const TriangleMesh& mesh) {
   Positions normals = Positions::Zero(mesh.num_vertices(), 3);
   double six_volume = 0;

@@ -33,7 +33,7 @@ Status SolveFreeVertices(const VertexAdjacency& adjacency, const std::vector<int
   Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::AMDOrdering<int>> llt(
       laplacian);
   if (llt.info() != Eigen::Success) {
-    return Status::Internal("harmonic weight system could not be factorised");
+    return Status::Internal("harmonic weight system could not be factorized");
   }
   const Eigen::MatrixXd solution = llt.solve(rhs);
   for (int i = 0; i < n; ++i) {
@@ -70,7 +70,7 @@ Status SolveOneBone(const VertexAdjacency& adjacency, const std::vector<int>& fi
       laplacian);
   if (llt.info() != Eigen::Success) {
     return Status::Internal("harmonic weight system of bone " + std::to_string(bone) +
-                            " could not be factorised");
+                            " could not be factorized");
   }
   const Eigen::VectorXd solution = llt.solve(rhs);
   for (int i = 0; i < n; ++i) {
@@ -80,7 +80,7 @@ Status SolveOneBone(const VertexAdjacency& adjacency, const std::vector<int>& fi
 }
 
 // The compressed per-vertex lists of `weights` from its dense field: weights below kDropBelow
-// dropped, the rest renormalised, largest first.
+// dropped, the rest renormalized, largest first.
 void CompressWeights(BoneWeights* weights) {
   const int n = static_cast<int>(weights->dense.rows());
   weights->offsets.assign(n + 1, 0);

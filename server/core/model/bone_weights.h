@@ -15,7 +15,7 @@ struct BoneWeights {
   int num_bones = 0;
   Eigen::MatrixXd dense;  // #V by K, the harmonic field as solved (in [0, 1], rows sum to 1)
   // Compressed per vertex for blending: weights below kDropBelow are dropped and the rest
-  // renormalised. Vertex i's entries are [offsets[i], offsets[i + 1]), largest weight first.
+  // renormalized. Vertex i's entries are [offsets[i], offsets[i + 1]), largest weight first.
   std::vector<int> offsets;
   std::vector<int> bones;
   std::vector<double> weights;
@@ -47,7 +47,7 @@ StatusOr<BoneWeights> HarmonicBoneWeights(const VertexAdjacency& adjacency,
 Status CheckEveryComponentAnchored(const VertexAdjacency& adjacency,
                                    const std::vector<int>& fixed_bone);
 
-// The rotation field of given skinning weights (normalised for this mesh: NormalizeSkinWeights),
+// The rotation field of given skinning weights (normalized for this mesh: NormalizeSkinWeights),
 // in the same form as the harmonic field.
 BoneWeights BoneWeightsFromSkinWeights(const SkinWeights& weights);
 

@@ -85,7 +85,7 @@ StatusOr<std::shared_ptr<const DeformationModel>> DeformationModel::Build(
   DEFORM_ASSIGN_OR_RETURN(model->default_factorization_,
                           model->FactorizeCancellable(Stiffness{}, hooks.cancel));
   model->build_phases_.push_back(
-      {"the numeric factorisation", model->default_factorization_->factor_seconds()});
+      {"the numeric factorization", model->default_factorization_->factor_seconds()});
   spdlog::debug("model built: {} vertices, {} joint nodes, {} anchors, factor {} non-zeros",
                 model->mesh_.num_vertices(), model->system_.num_nodes,
                 model->system_.anchors.size(), model->default_factorization_->factor().nonzeros());
@@ -199,7 +199,7 @@ StatusOr<std::shared_ptr<const MaterialFactorization>> DeformationModel::Factori
       result->factor_,
       CholeskyFactor::Factorize(
           symbolic_, deform::NormalMatrix(system_, result->row_weights_squared_), cancel));
-  DEFORM_RETURN_IF_ERROR(CheckCancelled(cancel, "the numeric factorisation"));
+  DEFORM_RETURN_IF_ERROR(CheckCancelled(cancel, "the numeric factorization"));
   if (options_.rotation_blend == RotationBlend::kLinear) {
     result->linear_response_ = BuildLinearPoseResponse(
         system_, skeleton_, linear_blend_plan_, result->row_weights_squared_, result->factor_);
@@ -328,7 +328,7 @@ DeformScratch DeformationModel::MakeScratchWithWork(std::size_t solve_work_doubl
 bool DeformationModel::RefusesForeign(const MaterialFactorization& factorization,
                                       const DeformScratch& scratch) const {
   const bool owned = Owns(factorization, scratch);
-  assert(owned && "a factorisation or scratch of another model");
+  assert(owned && "a factorization or scratch of another model");
   return !owned;
 }
 
@@ -695,7 +695,7 @@ void DeformationModel::AddNodeTargets(const Pose& pose, DeformScratch* scratch) 
   }
 }
 
-// A factorisation made by this model always has a factor: Solve3 cannot refuse it.
+// A factorization made by this model always has a factor: Solve3 cannot refuse it.
 void DeformationModel::SolveOwnedInPlace(const MaterialFactorization& factorization,
                                          DeformScratch* scratch) const {
   const Status solved = factorization.factor().Solve3(

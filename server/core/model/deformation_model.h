@@ -3,15 +3,15 @@
 // Life cycle (precompute once, solve per frame):
 //   1. DeformationModel::Build(mesh, skeleton, options): validation, harmonic bone weights, joint
 //      regions and joint centre nodes, differential coordinates, anchors, the fill-reducing
-//      ordering and symbolic analysis of the normal equations, and a first numeric factorisation
+//      ordering and symbolic analysis of the normal equations, and a first numeric factorization
 //      for the default stiffness. Expensive: it grows with the mesh (docs/performance.md, "Time
 //      to first frame"); call it off any thread that must stay responsive.
-//   2. model->Factorize(stiffness): a new numeric factorisation for other material weights; the
+//   2. model->Factorize(stiffness): a new numeric factorization for other material weights; the
 //      symbolic analysis is reused. Returns a new immutable object; solves running on an older
-//      factorisation are not disturbed.
+//      factorization are not disturbed.
 //   3. model->Deform(factorization, pose, &scratch): per frame. const, allocation-free, writes into
 //      the caller's scratch. Any number of threads may call it at once on one model and one
-//      factorisation, each with its own scratch.
+//      factorization, each with its own scratch.
 //
 // Notation (in the comments of the model's headers): n mesh vertices, m joint centre nodes, K
 // bones. The pieces: options (model_options.h), the least-squares system (laplacian_system.h), the
@@ -48,7 +48,7 @@
 
 namespace deform {
 
-// Numeric factorisation of the normal equations for one stiffness. Immutable; shared read-only by
+// Numeric factorization of the normal equations for one stiffness. Immutable; shared read-only by
 // every stream that deforms with it.
 class MaterialFactorization {
  public:
@@ -58,7 +58,7 @@ class MaterialFactorization {
   // factor's non-zeros: two triangular passes); otherwise, and with kQuaternion, null and frames
   // solve.
   const LinearPoseResponse* linear_response() const { return linear_response_.get(); }
-  // Seconds of the numeric factorisation, including the linear response when there is one.
+  // Seconds of the numeric factorization, including the linear response when there is one.
   double factor_seconds() const { return factor_seconds_; }
   // The float32 probe (ModelOptions::float32_factor_min_bytes): the largest vertex difference
   // between the rest pose solved with the double factor and with its float32 rounding, relative
@@ -142,13 +142,13 @@ struct BuildHooks {
   // build and is returned (the service checks its memory budget and reports progress here).
   std::function<Status()> validated;
   // Once the weights, regions and symbolic analysis are done, before the first numeric
-  // factorisation (for progress reports).
+  // factorization (for progress reports).
   std::function<void()> precomputed;
   // Polled between the build's phases (validation, binding, joint regions, harmonic weights, the
-  // Laplacian system, symbolic analysis, numeric factorisation, linear response): once it is
+  // Laplacian system, symbolic analysis, numeric factorization, linear response): once it is
   // cancelled, Build frees what it made and returns FAILED_PRECONDITION "cancelled during
   // <phase>" at the end of the phase in progress. A phase itself is not interrupted (the longest
-  // are the symbolic analysis and the numeric factorisation: docs/performance.md, "Time to first
+  // are the symbolic analysis and the numeric factorization: docs/performance.md, "Time to first
   // frame"). Null:
   // never cancelled. Must outlive the Build call.
   const CancelToken* cancel = nullptr;
@@ -156,7 +156,7 @@ struct BuildHooks {
 
 class DeformationModel {
  public:
-  // Builds the model: the expensive precomputation and the default factorisation.
+  // Builds the model: the expensive precomputation and the default factorization.
   //
   // Validates its inputs, whoever made them, so callers need not check first: the mesh with
   // ValidateMesh() against options.limits (INVALID_ARGUMENT naming the first problem,
@@ -171,7 +171,7 @@ class DeformationModel {
   // than a diagonal from the surface, or none within the mesh's bounding box).
   //
   // Binding (which bones each vertex follows): with `weights` (a rig's own skinning weights, one
-  // row per vertex, bones in skeleton order; checked and normalised here), they are the rotation
+  // row per vertex, bones in skeleton order; checked and normalized here), they are the rotation
   // field; a vertex whose largest weight is at least 1 - options.rigid_weight_tolerance is in that
   // bone's rigid zone, the others form the joint regions (weight_binding.h), and anchors follow
   // the vertex's own weights, i.e. the rig's linear blend skinning. Without, options.binding (by
@@ -187,11 +187,11 @@ class DeformationModel {
                                                                  const SkinWeights* weights,
                                                                  const BuildHooks& hooks = {});
 
-  // A new factorisation for `stiffness`, reusing the symbolic analysis. INVALID_ARGUMENT for
+  // A new factorization for `stiffness`, reusing the symbolic analysis. INVALID_ARGUMENT for
   // non-finite or non-positive weights, unknown joints or vertex indices out of range.
   StatusOr<std::shared_ptr<const MaterialFactorization>> Factorize(
       const Stiffness& stiffness) const;
-  // The factorisation built by Build() for options.default_material.
+  // The factorization built by Build() for options.default_material.
   const std::shared_ptr<const MaterialFactorization>& default_factorization() const {
     return default_factorization_;
   }
@@ -222,7 +222,7 @@ class DeformationModel {
   // solved in one pass over the factor, so the factor's bytes are read once for the batch. Each
   // frame equals Deform()'s to round-off (1e-12 of the diagonal, tested). With a linear response
   // there is no solve to share and each frame is evaluated alone. No allocation. Refuses (false,
-  // nothing written) a count outside [1, batch->max_frames], another model's factorisation, scratch
+  // nothing written) a count outside [1, batch->max_frames], another model's factorization, scratch
   // or batch scratch, as Deform() does. `timings`, when given, are the whole batch's: every
   // right-hand side (and packing them side by side), then the one solve (and unpacking it).
   bool DeformBatch(const MaterialFactorization& factorization, const Pose* const* poses,
@@ -230,7 +230,7 @@ class DeformationModel {
                    DeformTimings* timings = nullptr) const;
   // Deform() on several threads: the rotation blend and A^T b split by vertex and row ranges, and
   // the solve by subtrees (CholeskyFactor::Solve3Parallel), each step's parts run through
-  // `runner`. `plan` from factor().PlanParallel of any of this model's factorisations (they share
+  // `runner`. `plan` from factor().PlanParallel of any of this model's factorizations (they share
   // the analysis); `work` holds factor().WorkSizeParallel(plan) doubles. The frame equals
   // Deform()'s to round-off (1e-12 of the diagonal, tested). With a linear response or a plan
   // without parts it is Deform(). Allocation-free; refuses another model's arguments as Deform().
@@ -262,7 +262,7 @@ class DeformationModel {
   bool Owns(const MaterialFactorization& factorization, const DeformScratch& scratch) const {
     return factorization.model_id_ == id_ && scratch.model_id_ == id_;
   }
-  // The normal matrix A^T A ((n + m) square) that `factorization` factorises.
+  // The normal matrix A^T A ((n + m) square) that `factorization` factorizes.
   Eigen::SparseMatrix<double> NormalMatrix(const MaterialFactorization& factorization) const;
 
   const TriangleMesh& mesh() const { return mesh_; }
@@ -282,17 +282,17 @@ class DeformationModel {
   const std::vector<int>& bound_bones() const { return bound_bones_; }
   const BindingReport& binding_report() const { return binding_report_; }
   bool weights_given() const { return given_weights_.has_value(); }
-  // The skinning weights Build was given (normalised), for building a variant with the same
+  // The skinning weights Build was given (normalized), for building a variant with the same
   // binding; empty when the model bound automatically.
   const std::optional<SkinWeights>& given_weights() const { return given_weights_; }
   int num_joint_nodes() const { return system_.num_nodes; }
   double bounding_box_diagonal() const { return diagonal_; }
-  // Seconds spent in Build() before the first numeric factorisation.
+  // Seconds spent in Build() before the first numeric factorization.
   double precompute_seconds() const { return precompute_seconds_; }
   // The build's phases in order, each with its wall-clock seconds: the stretches between the
   // points where a build can be cancelled (BuildHooks::cancel), so each is the longest a cancel
   // waits. Names as in the "cancelled during ..." errors; the last is "the numeric
-  // factorisation" (with the linear response, if any).
+  // factorization" (with the linear response, if any).
   struct BuildPhase {
     const char* name;
     double seconds;
@@ -302,7 +302,7 @@ class DeformationModel {
   // The memory a model holds, estimated; the one formula behind every memory budget, calibrated
   // against the growth of a server's resident memory when it loads the model (the shared arm's
   // measurement: docs/performance.md, "Memory").
-  // EstimatedBytes(), once built: the default factorisation's factor, linear response and rigid
+  // EstimatedBytes(), once built: the default factorization's factor, linear response and rigid
   // rows' sums as they are, the rigid rows' bones, plus kBytesPerVertex per vertex (rest and
   // differential coordinates, Laplacian rows in both orientations, bone weights, region data, the
   // normal matrix's pattern the symbolic analysis keeps) and kBytesPerTriangle per triangle.
@@ -315,8 +315,8 @@ class DeformationModel {
   static constexpr std::size_t kFactorBytesPerVertexLog2 = 80;
   static std::size_t EstimateBytesBeforeBuild(int num_vertices, int num_triangles);
   std::size_t EstimatedBytes() const;
-  // The bytes one more factorisation for other stiffness (Factorize) holds: the default
-  // factorisation's factor, linear response and rigid rows' sums (same sparsity, same sizes), the
+  // The bytes one more factorization for other stiffness (Factorize) holds: the default
+  // factorization's factor, linear response and rigid rows' sums (same sparsity, same sizes), the
   // factor as it is built (in double, also where it is then stored in float32).
   std::size_t FactorizationBytes() const;
   // The bytes MakeScratch() allocates: one stream's solve buffers.
@@ -340,7 +340,7 @@ class DeformationModel {
   void RoundFactorToFloat32IfWithinTolerance(MaterialFactorization* result) const;
   // MakeScratch with `solve_work_doubles` of solve work (before default_factorization_ exists).
   DeformScratch MakeScratchWithWork(std::size_t solve_work_doubles) const;
-  // Factorize, stopping between the numeric factorisation and the linear response when `cancel`
+  // Factorize, stopping between the numeric factorization and the linear response when `cancel`
   // (may be null) is cancelled.
   StatusOr<std::shared_ptr<const MaterialFactorization>> FactorizeCancellable(
       const Stiffness& stiffness, const CancelToken* cancel) const;

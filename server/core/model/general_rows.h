@@ -2,7 +2,7 @@
 //
 // A frame's A^T b holds L'^T r, r_j = w_j^2 T_j delta_j, T_j vertex j's quaternion blend (QLERP:
 // its bones' unit quaternions weighted, their signs aligned to its first bone's, the blend
-// normalised). The rigid rows (rigid_rows.h) are one 3x3 product each. The general rows read the
+// normalized). The rigid rows (rigid_rows.h) are one 3x3 product each. The general rows read the
 // rotated deltas of their vertices, which this plan computes kLanes slots at a time and a row's
 // entry reads in one load:
 //
@@ -24,7 +24,7 @@
 //
 // The same values as blending and rotating vertex by vertex and summing row by row
 // (SparseRowTimes3, laplacian_system.h) to round-off: sums in another order, 1e-14 of their norm
-// (tested against the normalised blend's full product).
+// (tested against the normalized blend's full product).
 #pragma once
 
 #include <Eigen/Core>
@@ -142,7 +142,7 @@ class GeneralRowsPlan {
   static constexpr int kMaxFramesSideBySide = 8;
   // The signed quaternions a frame needs (4 doubles each): one per bone of each group.
   int quaternion_count() const { return static_cast<int>(quaternion_bones_.size()); }
-  // w_j^2 of each slot's vertex j (0 in the padding), for a factorisation's row weights (n).
+  // w_j^2 of each slot's vertex j (0 in the padding), for a factorization's row weights (n).
   std::vector<double> SlotWeights(const Eigen::VectorXd& row_weights_squared) const;
   // quaternions[4 q, 4 q + 4) = x y z w of each group's bones' rotations, each sign aligned to
   // the group's first bone's. No allocation.

@@ -1,5 +1,5 @@
 // The least-squares system of METHOD.md for one mesh, without its material weights and pose: the
-// rows that DeformationModel factorises and solves (deformation_model.h's notation: n vertices,
+// rows that DeformationModel factorizes and solves (deformation_model.h's notation: n vertices,
 // m joint centre nodes, K bones; x holds the n vertices' positions, then the m nodes'):
 //
 //   vertex rows  w_i ((L' x)_i - T_i delta_i)    delta = L' x_rest, T_i the vertex's rotation blend

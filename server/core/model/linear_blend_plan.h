@@ -3,7 +3,7 @@
 //
 // Every vertex's blend T_i is a fixed linear combination of "slot" rotations: slot k < K is bone
 // k's rotation R_k, slot K + j is knot j. A knot is the quaternion blend of a few bones at fixed
-// shares, normalise(sum_k g_k q_k) with the g_k non-negative integers summing to S (the
+// shares, normalize(sum_k g_k q_k) with the g_k non-negative integers summing to S (the
 // `segments`), the signs of the q_k aligned to the knot's first bone: a point of the simplex grid
 // of resolution S over the bones' weights. A vertex with weights w on its m bones (taken in
 // ascending bone order) lies in one cell of the Freudenthal (Kuhn) triangulation of that grid, in

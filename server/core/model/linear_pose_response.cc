@@ -5,7 +5,6 @@
 #include <memory>
 #include <utility>
 
-
 namespace deform {
 namespace {
 
@@ -20,7 +19,7 @@ constexpr int kBlock = 256;
 #define DEFORM_ALWAYS_INLINE inline
 #endif
 
-// x, y, z[0, count) += (cx, cy, cz) * column[0, count). Vectorised by the compiler.
+// x, y, z[0, count) += (cx, cy, cz) * column[0, count). Vectorized by the compiler.
 DEFORM_ALWAYS_INLINE void AddScaledColumn(const double* __restrict column, int count, double cx,
                                           double cy, double cz, double* __restrict x,
                                           double* __restrict y, double* __restrict z) {

@@ -7,7 +7,7 @@
 //
 // U_kb = A^-1 (the right-hand side with R_k = the unit matrix's column b, every other transform
 // zero), V_k = A^-1 (the right-hand side of t_k = 1). Four vectors of length n per bone, computed
-// once per factorisation with 2 K three-column solves; a frame then costs 12 K multiply-adds per
+// once per factorization with 2 K three-column solves; a frame then costs 12 K multiply-adds per
 // vertex and reads 32 K bytes per vertex. It is exact for the linear blend (a test compares it
 // with the solve) and differs from the quaternion blend in the blend regions (measured in
 // METHOD-comparison tests and the quality table).
@@ -28,8 +28,8 @@
 
 #include "core/geometry/pose.h"
 #include "core/geometry/skeleton.h"
-#include "core/model/linear_blend_plan.h"
 #include "core/model/laplacian_system.h"
+#include "core/model/linear_blend_plan.h"
 #include "core/solver/cholesky_factor.h"
 
 namespace deform {

@@ -12,9 +12,9 @@ namespace deform {
 
 // How a blend-region vertex's rotation T_i mixes the rotations of its bones.
 enum class RotationBlend {
-  // Normalised weighted quaternion sum (QLERP; METHOD.md's slerp for two bones, generalised).
+  // Normalized weighted quaternion sum (QLERP; METHOD.md's slerp for two bones, generalized).
   kQuaternion,
-  // T_i = sum_k h_ik R_k, not re-normalised. METHOD.md's fast path: the solution is linear in the
+  // T_i = sum_k h_ik R_k, not re-normalized. METHOD.md's fast path: the solution is linear in the
   // bone transforms, so a frame can come from a precomputed response without a solve
   // (LinearPoseResponse). Cheaper per frame; differs from kQuaternion in the blend regions.
   kLinear,
@@ -82,7 +82,7 @@ struct ModelOptions {
   // vectors per knot. Default: 4; at most kMaxLinearBlendSegments.
   int linear_blend_segments = 4;
   static constexpr int kMaxLinearBlendSegments = 64;
-  // Store a factorisation's values in float32 (half the bytes each solve reads; the solve still
+  // Store a factorization's values in float32 (half the bytes each solve reads; the solve still
   // computes in double) when its double factor holds at least this many bytes and the probe of
   // MaterialFactorization::float32_probe_error() keeps its frames within a quarter of 1e-6 of the
   // diagonal of the double factor's; otherwise the factor stays double. Negative: never (the

@@ -4,7 +4,7 @@
 // r_j = w_j^2 T_j delta_j (T_j vertex j's rotation blend). Where every vertex j of a row i of L'^T
 // is wholly one bone's (a single bone-weight entry, so T_j = R_b for the same bone b), the row is
 //   (L'^T r)_i = R_b sum_j L'^T_ij w_j^2 delta_j = R_b c_i,
-// with c_i fixed for a stiffness (the weights w_j are the factorisation's). Rows away from the
+// with c_i fixed for a stiffness (the weights w_j are the factorization's). Rows away from the
 // joint regions are such rigid rows (most of a limb's rows, fewer where the regions are wide:
 // docs/performance.md, "Right-hand side"), so a frame computes them as one 3x3 product each, and
 // rotates only the deltas that the other rows (general rows) read. The result equals the full
@@ -36,7 +36,7 @@ struct RigidRows {
 };
 
 // c_i = sum_j L'^T_ij w_j^2 delta_j of every rigid row, zero in the general rows ((n + m) by 3,
-// row-major), for the vertex rows' squared weights `row_weights_squared` (n) of a factorisation.
+// row-major), for the vertex rows' squared weights `row_weights_squared` (n) of a factorization.
 std::vector<double> RigidRowSums(const LaplacianSystem& system, const RigidRows& rigid,
                                  const Eigen::VectorXd& row_weights_squared);
 

@@ -32,7 +32,7 @@ constexpr double kMaxMaterialWeight = 1e4;
 
 // The rule for every material weight: finite and in (0, kMaxMaterialWeight]. INVALID_ARGUMENT
 // "<what> must be finite and in (0, 10000.000000], got <weight>" otherwise. MaterialRowWeights
-// checks every weight with it; the service calls it to refuse a request before factorising.
+// checks every weight with it; the service calls it to refuse a request before factorizing.
 Status CheckMaterialWeight(double weight, const std::string& what);
 // CheckMaterialWeight on the three weights, described as "<what> rigid weight" and so on.
 Status CheckJointMaterial(const JointMaterial& material, const std::string& what);

@@ -21,7 +21,7 @@ struct WeightBinding {
   std::vector<int> main_bone;     // per vertex: its largest weight's bone
 };
 
-// `weights` must be normalised for this mesh and skeleton (NormalizeSkinWeights). A vertex is
+// `weights` must be normalized for this mesh and skeleton (NormalizeSkinWeights). A vertex is
 // rigid when one bone carries at least 1 - rigid_tolerance of its weight. A blending
 // vertex's region: of the inner joints on the skeleton path between its two largest weights' bones
 // (the joint they share when they meet), the one nearest to the vertex.

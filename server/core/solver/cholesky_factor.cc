@@ -25,7 +25,7 @@ Status CheckFrameCount(int frames) {
 StatusOr<CholeskyFactor> CholeskyFactor::Factorize(std::shared_ptr<const SymbolicCholesky> symbolic,
                                                    const ColMajorMatrix& a,
                                                    const CancelToken* cancel) {
-  if (!symbolic) return Status::InvalidArgument("no symbolic analysis to factorise with");
+  if (!symbolic) return Status::InvalidArgument("no symbolic analysis to factorize with");
   DEFORM_RETURN_IF_ERROR(CheckAnalysedPattern(*symbolic, a));
   DEFORM_ASSIGN_OR_RETURN(const ColumnFactor l,
                           UpLookingCholesky(*symbolic, PermutedUpperValues(*symbolic, a), cancel));
@@ -55,7 +55,7 @@ std::vector<double> CholeskyFactor::PermutedUpperValues(const SymbolicCholesky& 
   return c_values;
 }
 
-// Up-looking factorisation (CSparse's cs_chol): row k of L from the rows above it.
+// Up-looking factorization (CSparse's cs_chol): row k of L from the rows above it.
 StatusOr<CholeskyFactor::ColumnFactor> CholeskyFactor::UpLookingCholesky(
     const SymbolicCholesky& s, const std::vector<double>& c_values, const CancelToken* cancel) {
   const int n = s.n_;
@@ -66,7 +66,7 @@ StatusOr<CholeskyFactor::ColumnFactor> CholeskyFactor::UpLookingCholesky(
   std::vector<int> stack(n), mark(n, -1);
   for (int k = 0; k < n; ++k) {
     if (k % kCancelCheckRows == 0) {
-      DEFORM_RETURN_IF_ERROR(CheckCancelled(cancel, "the numeric factorisation"));
+      DEFORM_RETURN_IF_ERROR(CheckCancelled(cancel, "the numeric factorization"));
     }
     const int top = solver_internal::RowPattern(k, s.c_column_pointers_, s.c_row_indices_,
                                                 s.elimination_tree_, &stack, &mark);

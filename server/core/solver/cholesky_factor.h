@@ -24,8 +24,8 @@ class CholeskyFactor {
   // `a` must have exactly the pattern that `symbolic` was analysed with. INTERNAL if `a` is not
   // positive definite (names the pivot); INVALID_ARGUMENT for another pattern or a null `symbolic`.
   // `cancel` (optional) is checked every kCancelCheckRows rows: once it is cancelled the
-  // factorisation stops there with FAILED_PRECONDITION "cancelled during the numeric
-  // factorisation" and frees what it built: a cancel waits for at most kCancelCheckRows rows, not
+  // factorization stops there with FAILED_PRECONDITION "cancelled during the numeric
+  // factorization" and frees what it built: a cancel waits for at most kCancelCheckRows rows, not
   // for the whole factorization of a large mesh (docs/performance.md, "Time to first frame").
   static StatusOr<CholeskyFactor> Factorize(
       std::shared_ptr<const SymbolicCholesky> symbolic,

@@ -52,7 +52,7 @@ bool SolveKernelAvailable(SolveKernel kernel) {
 bool ForwardStreamIsNonTemporal() {
 #if defined(__x86_64__) || defined(__i386__)
   static const bool amd = [] {
-    __builtin_cpu_init();  // may run during static initialisation (supernodal_solve_impl.h)
+    __builtin_cpu_init();  // may run during static initialization (supernodal_solve_impl.h)
     return __builtin_cpu_is("amd") != 0;
   }();
   return amd;

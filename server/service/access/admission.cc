@@ -183,15 +183,15 @@ void Admission::ReleaseUnloadedMesh(const std::string& tenant, std::size_t bytes
 Status Admission::AcquireStream(const std::string& tenant) {
   MutexLock lock(&mutex_);
   if (limits_.max_streams > 0 && streams_ >= limits_.max_streams) {
-    return Status::ResourceExhausted("server stream limit reached (--max-streams): " +
-                                     std::to_string(streams_) + " streams open, of at most " +
-                                     std::to_string(limits_.max_streams));
+    return Status::ResourceExhausted(
+        "server stream limit reached (--max-streams): " + std::to_string(streams_) +
+        " streams open, of at most " + std::to_string(limits_.max_streams));
   }
   Usage& usage = tenants_[tenant];
   if (limits_.tenant_max_streams > 0 && usage.streams >= limits_.tenant_max_streams) {
-    return Status::ResourceExhausted("tenant stream limit reached (--tenant-max-streams): " +
-                                     std::to_string(usage.streams) + " streams open, of at most " +
-                                     std::to_string(limits_.tenant_max_streams) + " per tenant");
+    return Status::ResourceExhausted(
+        "tenant stream limit reached (--tenant-max-streams): " + std::to_string(usage.streams) +
+        " streams open, of at most " + std::to_string(limits_.tenant_max_streams) + " per tenant");
   }
   ++usage.streams;
   ++streams_;

@@ -79,11 +79,13 @@ StatusOr<TokenTable> TokenTable::Parse(std::string_view text) {
     }
     const std::string hash = Lower(fields[0]);
     if (hash.size() != 64 || !IsLowerHex(hash)) {
-      return Status::InvalidArgument(where + ": the first field is not a SHA-256 in hex (64 "
+      return Status::InvalidArgument(where +
+                                     ": the first field is not a SHA-256 in hex (64 "
                                      "hex digits)");
     }
     if (!IsValidTenantName(fields[1])) {
-      return Status::InvalidArgument(where + ": the tenant must be 1 to 64 characters of "
+      return Status::InvalidArgument(where +
+                                     ": the tenant must be 1 to 64 characters of "
                                      "A-Z a-z 0-9 . _ -");
     }
     Identity identity;

@@ -55,8 +55,8 @@ void UploadWatchdog::Run() {
   for (const auto limit : {idle_timeout_, time_limit_}) {
     if (limit.count() > 0) shortest = std::min(shortest, limit);
   }
-  const auto period = std::clamp(shortest / 10, std::chrono::milliseconds(10),
-                                 std::chrono::milliseconds(1000));
+  const auto period =
+      std::clamp(shortest / 10, std::chrono::milliseconds(10), std::chrono::milliseconds(1000));
   MutexLock lock(&mutex_);
   while (!stopping_) {
     wake_.WaitFor(&mutex_, period);

@@ -82,7 +82,8 @@ Status CheckLoadHeaderStrings(const v1::LoadMeshHeader& header) {
 
 Status CheckUploadSize(std::uint64_t mesh_bytes, std::uint64_t skeleton_bytes,
                        std::uint64_t weights_bytes, std::uint64_t limit) {
-  const std::uint64_t total = SaturatingAdd(SaturatingAdd(mesh_bytes, skeleton_bytes), weights_bytes);
+  const std::uint64_t total =
+      SaturatingAdd(SaturatingAdd(mesh_bytes, skeleton_bytes), weights_bytes);
   if (total <= limit) return Status::Ok();
   const bool saturated = total == std::numeric_limits<std::uint64_t>::max() &&
                          (skeleton_bytes != 0 || weights_bytes != 0);

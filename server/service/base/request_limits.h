@@ -31,7 +31,7 @@ inline constexpr std::size_t kMaxEchoBytes = 64;
 inline constexpr std::size_t kMaxStatusMessageBytes = 1024;
 // Largest joint angle accepted, in degrees (100 turns); beyond it a pose is rejected.
 inline constexpr double kMaxAngleDegrees = 36000;
-// A quaternion's norm must be within this of 1; it is normalised within it, rejected beyond.
+// A quaternion's norm must be within this of 1; it is normalized within it, rejected beyond.
 inline constexpr double kQuaternionNormTolerance = 0.1;
 
 // OK, or INVALID_ARGUMENT "<field> is N bytes long, over the limit of L bytes".

@@ -5,7 +5,7 @@
 // gRPC's callback API takes a raw reactor pointer from the service method, calls the reactor's
 // reactions until OnDone(), its last one, and requires the reactor to stay alive until OnDone()
 // has been called; it never touches the reactor after that. Worker tasks the reactor posted
-// (solves, refactorisations, mesh builds) may still run after OnDone(). So the reactor is owned by
+// (solves, refactorizations, mesh builds) may still run after OnDone(). So the reactor is owned by
 // shared_ptrs and nothing else:
 //  - the transport's reference, which the object keeps to itself from Create() until the
 //    transport's last callback calls ReleaseTransportReference();

@@ -16,15 +16,15 @@
 #include <unordered_set>
 
 #include "core/base/cancel_token.h"
-#include "service/base/annotated_mutex.h"
 #include "service/access/admission.h"
 #include "service/access/identity.h"
-#include "service/registry/mesh_registry.h"
-#include "service/registry/mesh_store.h"
-#include "service/metrics/service_metrics.h"
+#include "service/access/upload_watchdog.h"
+#include "service/base/annotated_mutex.h"
 #include "service/base/service_options.h"
 #include "service/base/thread_annotations.h"
-#include "service/access/upload_watchdog.h"
+#include "service/metrics/service_metrics.h"
+#include "service/registry/mesh_registry.h"
+#include "service/registry/mesh_store.h"
 #include "service/workers/worker_pool.h"
 
 namespace deform::service {

@@ -32,7 +32,7 @@ namespace deform::service {
 
 class DeformOutbox {
  public:
-  // Unwritten notices, and their serialised bytes, beyond which rejections are dropped.
+  // Unwritten notices, and their serialized bytes, beyond which rejections are dropped.
   static constexpr std::size_t kMaxNoticeBacklog = 1024;
   static constexpr std::size_t kMaxNoticeBacklogBytes = std::size_t{256} << 10;
   // A notice's message is cut to this many bytes.
@@ -67,10 +67,9 @@ class DeformOutbox {
   }
   // Whether the backlog drained to half its bounds (when a stream that stopped reading resumes).
   bool notice_backlog_drained() const {
-    return notices_.size() <= kMaxNoticeBacklog / 2 &&
-           backlog_bytes_ <= kMaxNoticeBacklogBytes / 2;
+    return notices_.size() <= kMaxNoticeBacklog / 2 && backlog_bytes_ <= kMaxNoticeBacklogBytes / 2;
   }
-  // Serialised bytes of the unwritten notices.
+  // Serialized bytes of the unwritten notices.
   std::size_t notice_backlog_bytes() const { return backlog_bytes_; }
   // Rejections dropped so far.
   std::uint64_t notices_dropped() const { return notices_dropped_; }

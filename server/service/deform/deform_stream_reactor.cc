@@ -12,23 +12,23 @@
 #include <utility>
 
 #include "core/model/deformation_model.h"
-#include "service/base/annotated_mutex.h"
 #include "service/access/audit_log.h"
-#include "service/deform/deform_outbox.h"
-#include "service/messages/frame_encoding.h"
-#include "service/deform/frame_solver.h"
+#include "service/base/annotated_mutex.h"
 #include "service/base/log_text.h"
-#include "service/deform/pending_pose_slot.h"
-#include "service/workers/worker_pool_parallel_runner.h"
-#include "service/deform/pose_input.h"
-#include "service/messages/proto_conversion.h"
 #include "service/base/request_limits.h"
 #include "service/base/self_owning_handler.h"
-#include "service/transport/status_mapping.h"
-#include "service/deform/stiffness_switch.h"
-#include "service/transport/stream_write_pump.h"
 #include "service/base/thread_annotations.h"
+#include "service/deform/deform_outbox.h"
+#include "service/deform/frame_solver.h"
+#include "service/deform/pending_pose_slot.h"
+#include "service/deform/pose_input.h"
+#include "service/deform/stiffness_switch.h"
+#include "service/messages/frame_encoding.h"
+#include "service/messages/proto_conversion.h"
+#include "service/transport/status_mapping.h"
+#include "service/transport/stream_write_pump.h"
 #include "service/workers/worker_pool.h"
+#include "service/workers/worker_pool_parallel_runner.h"
 
 namespace deform::service {
 namespace {
@@ -52,7 +52,7 @@ void CountWritten(const v1::DeformResponse& message, ServiceMetrics* metrics) {
 
 // The reactor coordinates the stream's parts; each part states its own contract:
 //  PendingPoseSlot (latest wins, skipped poses, the solve task's state), StiffnessSwitch (the
-//  factorisation in use and the refactorisations), DeformOutbox (notices and frame slots, in
+//  factorization in use and the refactorizations), DeformOutbox (notices and frame slots, in
 //  order), StreamWritePump (one write in flight, the finish), FrameSolver (the solve itself).
 // The first four are guarded by mutex_; the solver and the pose it solves belong to the solve
 // task, the request buffers to the reader (one read outstanding at a time).
@@ -90,42 +90,41 @@ class DeformStreamReactor final : public StreamHandler,
   void ReadNextLocked() DEFORM_REQUIRES(mutex_);
   // The notices of a stiffness update that will not be applied: refused (`why`, also logged), or
   // replaced by a newer version `by` (`when`: at which step).
-  void RejectStiffnessLocked(std::uint64_t version, const std::string& why)
-      DEFORM_REQUIRES(mutex_);
+  void RejectStiffnessLocked(std::uint64_t version, const std::string& why) DEFORM_REQUIRES(mutex_);
   void SupersedeStiffnessLocked(std::uint64_t superseded, std::uint64_t by, const char* when)
       DEFORM_REQUIRES(mutex_);
 
   // FrameTask: the stream's solve on a worker, alone or batched with other streams' on the same
-  // factorisation (the pool gathers streams whose BatchKey, their factorisation, is the same).
+  // factorization (the pool gathers streams whose BatchKey, their factorization, is the same).
   void RunUrgent() DEFORM_EXCLUDES(mutex_) override;
   void RunUrgentBatch(FrameTask* const* others, int count) DEFORM_EXCLUDES(mutex_) override;
   const void* BatchKey() const override { return batch_key_.load(std::memory_order_relaxed); }
   // A mesh with a parallel plan: its batches (and lone frames) split over the idle workers.
   bool SplitsItsBatches() const override { return splits_batches_.load(std::memory_order_relaxed); }
   // A run's steps for one stream: BeginSolveRun takes the pending pose into solving_ with its
-  // factorisation, stamp and frame (false: nothing to solve); RejectSolvingPose answers a pose the
+  // factorization, stamp and frame (false: nothing to solve); RejectSolvingPose answers a pose the
   // solver refused with a notice; EndSolveRun publishes the frame (`produced`), switches in a
-  // finished refactorisation and ends the run, posting the task again when a pose is pending.
+  // finished refactorization and ends the run, posting the task again when a pose is pending.
   // Every BeginSolveRun is followed by one EndSolveRun.
   bool BeginSolveRun() DEFORM_EXCLUDES(mutex_);
   void RejectSolvingPose(const Status& status) DEFORM_EXCLUDES(mutex_);
   void EndSolveRun(bool produced) DEFORM_EXCLUDES(mutex_);
-  // The batch key of the stream's current factorisation: itself, or null (never batched) when it
+  // The batch key of the stream's current factorization: itself, or null (never batched) when it
   // evaluates a linear response, which shares nothing.
   void UpdateBatchKeyLocked() DEFORM_REQUIRES(mutex_);
   // Drainable.
   void Drain() DEFORM_EXCLUDES(mutex_) override;
 
-  // Posts the background refactorisation of `update`, once the memory budgets hold its
-  // factorisation (else KIND_STIFFNESS_REJECTED naming the budget).
+  // Posts the background refactorization of `update`, once the memory budgets hold its
+  // factorization (else KIND_STIFFNESS_REJECTED naming the budget).
   void StartRefactorLocked(StiffnessSwitch::Update update) DEFORM_REQUIRES(mutex_);
-  // Makes memory_ hold the buffers and one factorisation's bytes for each factorisation of the
+  // Makes memory_ hold the buffers and one factorization's bytes for each factorization of the
   // stream's own that may be alive: the current one unless it is the model's default, the next
   // one waiting to be switched in, and `running` being built.
   Status HoldFactorizationsLocked(int running, const std::string& what) DEFORM_REQUIRES(mutex_);
-  // On a worker: the refactorisation, then its result handed to the stream.
+  // On a worker: the refactorization, then its result handed to the stream.
   void Refactor(const StiffnessSwitch::Update& update) DEFORM_EXCLUDES(mutex_);
-  // Switches the finished factorisation in, with its KIND_STIFFNESS_APPLIED notice. Only between
+  // Switches the finished factorization in, with its KIND_STIFFNESS_APPLIED notice. Only between
   // two solves.
   void ApplyNextFactorizationLocked() DEFORM_REQUIRES(mutex_);
 
@@ -154,15 +153,15 @@ class DeformStreamReactor final : public StreamHandler,
   std::uint64_t last_stiffness_version_ = 0;
 
   // Solve-task-owned (between PendingPoseSlot::BeginRun and EndRun).
-  std::optional<FrameSolver> solver_;          // emplaced by HandleStart
-  std::atomic<bool> splits_batches_{false};    // SplitsItsBatches: set once, before any solve
+  std::optional<FrameSolver> solver_;        // emplaced by HandleStart
+  std::atomic<bool> splits_batches_{false};  // SplitsItsBatches: set once, before any solve
   std::optional<WorkerPoolParallelRunner> parallel_runner_;  // for a mesh with a parallel plan
   PoseInput solving_;
   std::shared_ptr<const MaterialFactorization> solve_factorization_;
   FrameStamp solve_stamp_;
   v1::DeformFrame* solve_frame_ = nullptr;
 
-  // The current factorisation as the worker pool's batch key (BatchKey), written under mutex_.
+  // The current factorization as the worker pool's batch key (BatchKey), written under mutex_.
   std::atomic<const void*> batch_key_{nullptr};
 
   Mutex mutex_;
@@ -175,7 +174,7 @@ class DeformStreamReactor final : public StreamHandler,
   const v1::DeformResponse* in_flight_ DEFORM_GUARDED_BY(mutex_) = nullptr;
   std::uint64_t frames_written_ DEFORM_GUARDED_BY(mutex_) = 0;
   // The stream's memory beyond its mesh in the budgets: its buffers (buffer_bytes_, set by
-  // HandleStart before they are allocated) and its own factorisations (HoldFactorizationsLocked).
+  // HandleStart before they are allocated) and its own factorizations (HoldFactorizationsLocked).
   Admission::MemoryHold memory_ DEFORM_GUARDED_BY(mutex_);
   std::size_t buffer_bytes_ DEFORM_GUARDED_BY(mutex_) = 0;
   std::uint64_t poses_rejected_ DEFORM_GUARDED_BY(mutex_) = 0;
@@ -379,7 +378,7 @@ Status DeformStreamReactor::HoldFactorizationsLocked(int running, const std::str
 
 void DeformStreamReactor::StartRefactorLocked(StiffnessSwitch::Update update) {
   const Status held = HoldFactorizationsLocked(
-      1, "the factorisation of stiffness version " + std::to_string(update.version));
+      1, "the factorization of stiffness version " + std::to_string(update.version));
   if (!held.ok()) {
     RejectStiffnessLocked(update.version, held.message());
     return;
@@ -401,7 +400,7 @@ void DeformStreamReactor::Refactor(const StiffnessSwitch::Update& update) {
                  Status::FailedPrecondition("stream ending"))
            : model_->Factorize(update.stiffness);
   if (!skip) {
-    context_->metrics().RefactorisationFinished(
+    context_->metrics().RefactorizationFinished(
         std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
   }
   const std::uint64_t version = update.version;
@@ -433,11 +432,11 @@ void DeformStreamReactor::ApplyNextFactorizationLocked() {
   const std::uint64_t version = stiffness_.ApplyNext();
   UpdateBatchKeyLocked();
   const double factor_ms = stiffness_.current()->factor_seconds() * 1e3;
-  spdlog::info("{} stiffness version {} applied (factorisation {:.2f} ms)", log_context_, version,
+  spdlog::info("{} stiffness version {} applied (factorization {:.2f} ms)", log_context_, version,
                factor_ms);
   outbox_.AddNotice(v1::Notice::KIND_STIFFNESS_APPLIED, 0, version,
                     "stiffness version " + std::to_string(version) + " applied", factor_ms);
-  // The previous factorisation of the stream's own (if any) is released with this switch.
+  // The previous factorization of the stream's own (if any) is released with this switch.
   (void)HoldFactorizationsLocked(stiffness_.refactor_running() ? 1 : 0, "");  // shrinks only
 }
 
@@ -465,7 +464,7 @@ void DeformStreamReactor::RunUrgentBatch(FrameTask* const* others, int count) {
       solving[to_solve++] = member;
     }
   }
-  // Grouped by factorisation (a member's may have changed since the pool read its key); each group
+  // Grouped by factorization (a member's may have changed since the pool read its key); each group
   // in one pass, its frames then finished and published one by one.
   std::array<FrameSolver*, WorkerPool::kMaxBatch> solvers;
   std::array<DeformStreamReactor*, WorkerPool::kMaxBatch> group;
@@ -499,7 +498,7 @@ bool DeformStreamReactor::BeginSolveRun() {
   if (pump_.failing()) return false;
   const std::optional<std::uint64_t> skipped = poses_.Take(&solving_);
   if (!skipped.has_value()) return false;
-  // The factorisation cannot change until EndRun(): ApplyNext waits for the end of the run.
+  // The factorization cannot change until EndRun(): ApplyNext waits for the end of the run.
   solve_factorization_ = stiffness_.current();
   solve_stamp_.stiffness_version = stiffness_.current_version();
   solve_stamp_.skipped_poses = *skipped;
@@ -578,7 +577,8 @@ void DeformStreamReactor::OnDone() {
 
 }  // namespace
 
-StreamHandler* NewDeformStream(ServiceContext* context, Identity caller, DeformTransport* transport) {
+StreamHandler* NewDeformStream(ServiceContext* context, Identity caller,
+                               DeformTransport* transport) {
   return DeformStreamReactor::Create(context, std::move(caller), transport);
 }
 

@@ -6,7 +6,7 @@
 // poses, mesh_unloaded), the clamped angles and the timings (queue time from the pose's arrival).
 //
 // A solve is Prepare (the pose), the deformation (alone, or batched with other streams' solvers on
-// the same factorisation: DeformPrepared), then Finish (the frame); Solve does all three alone.
+// the same factorization: DeformPrepared), then Finish (the frame); Solve does all three alone.
 //
 // Thread safety: one solve at a time (the stream's solve task owns the solver); no lock is taken
 // or needed. The model must outlive the solver.
@@ -22,8 +22,8 @@
 #include "core/geometry/pose.h"
 #include "core/model/deformation_model.h"
 #include "deform/v1/deform.pb.h"
-#include "service/workers/batch_scratch_pool.h"
 #include "service/deform/pose_input.h"
+#include "service/workers/batch_scratch_pool.h"
 
 namespace deform::service {
 
@@ -48,13 +48,13 @@ class FrameSolver {
   // `runner`. A batch led by this solver is always split (as DeformBatchParallel splits it, with
   // a batch scratch made for the plan): the pool runs one batch of such a mesh at a time, so the
   // other workers are free unless other meshes' work holds them, and one that frees up during
-  // the batch joins it (WorkerPoolParallelRunner). A lone frame is split (as DeformParallel splits it) while
-  // fewer streams than the plan has parts (one per worker) are open on the service
+  // the batch joins it (WorkerPoolParallelRunner). A lone frame is split (as DeformParallel splits
+  // it) while fewer streams than the plan has parts (one per worker) are open on the service
   // (`open_streams`, MeshRegistry::open_streams()) or, with more, while the runner has an idle
   // worker (ParallelRunner::IdleHelpers): a split solve costs the workers more time in all than a
   // whole one (docs/performance.md, "Parallel solve"), which pays on a worker that is idle but not
-  // on one that has other frames to solve. All three must outlive the solver. Allocates the parallel solve's work:
-  // ParallelWorkBytes.
+  // on one that has other frames to solve. All three must outlive the solver. Allocates the
+  // parallel solve's work: ParallelWorkBytes.
   void EnableParallel(const ParallelSolvePlan* plan, ParallelRunner* runner,
                       const std::atomic<int>* open_streams);
   static std::size_t ParallelWorkBytes(const DeformationModel& model,

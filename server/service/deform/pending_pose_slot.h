@@ -39,7 +39,7 @@ class PendingPoseSlot {
   bool EndRun(bool may_continue);
 
   bool has_pending() const { return has_pending_; }
-  // Between BeginRun() and EndRun(): a solve may be using the stream's factorisation.
+  // Between BeginRun() and EndRun(): a solve may be using the stream's factorization.
   bool running() const { return task_ == Task::kRunning; }
   // No task queued or running.
   bool idle() const { return task_ == Task::kIdle; }

@@ -1,10 +1,10 @@
 #include "service/deform/pose_input.h"
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <cstdio>
 #include <string>
-
-#include <fmt/format.h>
 
 #include "service/base/request_limits.h"
 
@@ -15,7 +15,7 @@ namespace {
 // every digit of a limb's shape).
 constexpr double kMaxRootTranslation = 1e9;
 
-// The unit quaternion of (w, x, y, z): normalised when its norm is within
+// The unit quaternion of (w, x, y, z): normalized when its norm is within
 // kQuaternionNormTolerance of 1. INVALID_ARGUMENT for NaN, infinite or all-zero input and for
 // norms further from 1 (1e155 components are a client's bug, not a rotation). The norm is computed
 // on the scaled vector, so huge finite components are not squared into infinity.
@@ -70,9 +70,10 @@ Status PoseInputFromProto(const v1::PoseUpdate& update, const Skeleton& skeleton
   for (const v1::JointRotation& rotation : update.rotations()) {
     auto joint = skeleton.FindJoint(rotation.joint());
     if (!joint.ok()) return Status::InvalidArgument("rotation: " + joint.status().message());
-    DEFORM_ASSIGN_OR_RETURN(const Eigen::Quaterniond q,
-                            UnitQuaternion(rotation.w(), rotation.x(), rotation.y(), rotation.z(),
-                                           "rotation of joint '" + EchoForClient(rotation.joint()) + "'"));
+    DEFORM_ASSIGN_OR_RETURN(
+        const Eigen::Quaterniond q,
+        UnitQuaternion(rotation.w(), rotation.x(), rotation.y(), rotation.z(),
+                       "rotation of joint '" + EchoForClient(rotation.joint()) + "'"));
     input->rotations.emplace_back(*joint, q);
   }
   for (const v1::JointAngle& angle : update.angles()) {

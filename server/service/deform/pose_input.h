@@ -31,7 +31,7 @@ struct PoseInput {
 // left to the caller). INVALID_ARGUMENT naming the problem for a joint or axis string over its
 // length limit (request_limits.h), an unknown joint or axis, an angle or quaternion component that
 // is NaN or infinite, an angle beyond kMaxAngleDegrees, a quaternion whose norm is not within
-// kQuaternionNormTolerance of 1 (within it, it is normalised; huge components are scaled, never
+// kQuaternionNormTolerance of 1 (within it, it is normalized; huge components are scaled, never
 // squared into infinity), or a root translation that is not finite or beyond 1e9 model units.
 Status PoseInputFromProto(const v1::PoseUpdate& update, const Skeleton& skeleton, PoseInput* input);
 

@@ -11,7 +11,7 @@ void StiffnessSwitch::Reset(std::shared_ptr<const MaterialFactorization> initial
 }
 
 void StiffnessSwitch::RefactorStarted() {
-  assert(!running_ && "one refactorisation at a time");
+  assert(!running_ && "one refactorization at a time");
   running_ = true;
 }
 
@@ -40,7 +40,7 @@ std::optional<std::uint64_t> StiffnessSwitch::SetNext(
 }
 
 std::uint64_t StiffnessSwitch::ApplyNext() {
-  assert(next_ != nullptr && "ApplyNext without a finished factorisation");
+  assert(next_ != nullptr && "ApplyNext without a finished factorization");
   current_ = std::move(next_);
   next_ = nullptr;
   current_version_ = next_version_;

@@ -11,19 +11,19 @@
 
 #include "core/io/phantom.h"
 #include "core/model/deformation_model.h"
-#include "service/base/annotated_mutex.h"
 #include "service/access/audit_log.h"
+#include "service/base/annotated_mutex.h"
+#include "service/base/log_text.h"
+#include "service/base/self_owning_handler.h"
+#include "service/base/thread_annotations.h"
 #include "service/load/load_header.h"
 #include "service/load/load_request.h"
-#include "service/base/log_text.h"
-#include "service/registry/mesh_id.h"
 #include "service/load/mesh_loader.h"
-#include "service/registry/mesh_store.h"
 #include "service/messages/proto_conversion.h"
-#include "service/base/self_owning_handler.h"
+#include "service/registry/mesh_id.h"
+#include "service/registry/mesh_store.h"
 #include "service/transport/status_mapping.h"
 #include "service/transport/stream_write_pump.h"
-#include "service/base/thread_annotations.h"
 
 namespace deform::service {
 namespace {
@@ -166,8 +166,8 @@ Status LoadMeshReactor::HandleHeader() {
   // Admission: the memory the load will need, as far as the header tells, is taken from the
   // budget before anything is allocated (BuildAndRegister replaces it by the model's estimate
   // once the upload is parsed).
-  const Status admitted = context_->admission().ReserveMemory(&reservation_, AdmissionBytes(header_),
-                                                        AdmissionSubject(header_));
+  const Status admitted = context_->admission().ReserveMemory(
+      &reservation_, AdmissionBytes(header_), AdmissionSubject(header_));
   if (!admitted.ok()) reservation_.Release();
   return admitted;
 }
@@ -282,14 +282,13 @@ StatusOr<std::shared_ptr<const MeshEntry>> LoadMeshReactor::ParseAndBuild() {
       case LoadStage::kWeights:
         AddProgressLocked(v1::LoadMeshResponse::STAGE_WEIGHTS, elapsed_ms);
         break;
-      case LoadStage::kFactorised:
+      case LoadStage::kFactorized:
         AddProgressLocked(v1::LoadMeshResponse::STAGE_FACTORISED, elapsed_ms);
         break;
     }
     pump_.Pump();
   };
-  auto entry =
-      BuildAndRegister(context_, std::move(reservation_), std::move(job), progress);
+  auto entry = BuildAndRegister(context_, std::move(reservation_), std::move(job), progress);
   if (!pending_id.empty()) {
     if (entry.ok()) {
       context_->store()->Commit(pending_id);
@@ -364,7 +363,8 @@ void LoadMeshReactor::OnDone() {
 
 }  // namespace
 
-StreamHandler* NewLoadMeshStream(ServiceContext* context, Identity caller, LoadMeshTransport* transport) {
+StreamHandler* NewLoadMeshStream(ServiceContext* context, Identity caller,
+                                 LoadMeshTransport* transport) {
   return LoadMeshReactor::Create(context, std::move(caller), transport);
 }
 

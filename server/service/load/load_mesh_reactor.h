@@ -12,8 +12,8 @@
 // bytes.
 //
 // The mesh belongs to the caller's tenant (its slot and memory count against the tenant's
-// limits too). With a store (ServiceContext::store), the header and the upload's bytes are written to
-// it before parsing and kept once the mesh is registered (mesh_store.h); an audit line records
+// limits too). With a store (ServiceContext::store), the header and the upload's bytes are written
+// to it before parsing and kept once the mesh is registered (mesh_store.h); an audit line records
 // the outcome.
 //
 // Threads: gRPC's threads run the reactions and own the upload's buffers until the build is
@@ -30,8 +30,9 @@ namespace deform::service {
 
 using LoadMeshTransport = StreamTransport<v1::LoadMeshRequest, v1::LoadMeshResponse>;
 
-// A new handler for one LoadMesh call over `transport`; it starts reading at once. `context` and the
-// transport must outlive it (the transport until its OnDone()).
-StreamHandler* NewLoadMeshStream(ServiceContext* context, Identity caller, LoadMeshTransport* transport);
+// A new handler for one LoadMesh call over `transport`; it starts reading at once. `context` and
+// the transport must outlive it (the transport until its OnDone()).
+StreamHandler* NewLoadMeshStream(ServiceContext* context, Identity caller,
+                                 LoadMeshTransport* transport);
 
 }  // namespace deform::service

@@ -10,8 +10,8 @@
 #include "core/io/mesh_io.h"
 #include "core/io/skin_weights_io.h"
 #include "deform/v1/deform.pb.h"
-#include "service/load/mesh_loader.h"
 #include "service/base/service_options.h"
+#include "service/load/mesh_loader.h"
 
 namespace deform::service {
 

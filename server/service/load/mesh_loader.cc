@@ -50,12 +50,12 @@ StatusOr<std::shared_ptr<const MeshEntry>> Build(ServiceContext* context, Admiss
       std::shared_ptr<const DeformationModel> model,
       DeformationModel::Build(std::move(job.mesh), std::move(job.skeleton), job.options,
                               job.weights.has_value() ? &*job.weights : nullptr, hooks));
-  if (progress) progress(LoadStage::kFactorised, MillisecondsSince(job.start));
+  if (progress) progress(LoadStage::kFactorized, MillisecondsSince(job.start));
   MeshSolvePlan solve = PlanMeshSolve(*model, context->solve_settings());
-  DEFORM_ASSIGN_OR_RETURN(
-      std::shared_ptr<const MeshEntry> entry,
-      context->registry().Register(std::move(slot), job.name, std::move(model),
-                                   std::move(job.file_metadata), std::move(solve), std::move(job.id)));
+  DEFORM_ASSIGN_OR_RETURN(std::shared_ptr<const MeshEntry> entry,
+                          context->registry().Register(std::move(slot), job.name, std::move(model),
+                                                       std::move(job.file_metadata),
+                                                       std::move(solve), std::move(job.id)));
   spdlog::info(
       "mesh={} tenant={} name='{}' loaded: {} vertices, precompute {:.1f} ms, factor {:.1f} ms "
       "({}), about {} KiB",
@@ -81,8 +81,7 @@ StatusOr<std::shared_ptr<const MeshEntry>> Build(ServiceContext* context, Admiss
 }  // namespace
 
 StatusOr<std::shared_ptr<const MeshEntry>> BuildAndRegister(ServiceContext* context,
-                                                            Admission::MeshSlot slot,
-                                                            LoadJob job,
+                                                            Admission::MeshSlot slot, LoadJob job,
                                                             const LoadProgress& progress) {
   const auto started = std::chrono::steady_clock::now();
   ServiceMetrics* metrics = job.metrics;

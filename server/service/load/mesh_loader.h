@@ -1,8 +1,9 @@
 // Turns a parsed mesh and skeleton into a registered deformation model, reporting the stages a
 // LoadMesh client sees. Shared by the LoadMesh RPC and the server's --preload flags.
 //
-// Runs for as long as the precomputation takes (it grows with the mesh: docs/performance.md, "Time to first frame"): call it on a
-// worker thread, never on a gRPC thread. Thread-safe; `progress` is called on the calling thread.
+// Runs for as long as the precomputation takes (it grows with the mesh: docs/performance.md, "Time
+// to first frame"): call it on a worker thread, never on a gRPC thread. Thread-safe; `progress` is
+// called on the calling thread.
 #pragma once
 
 #include <chrono>
@@ -26,7 +27,7 @@ namespace deform::service {
 enum class LoadStage {
   kValidated,   // mesh and skeleton checked
   kWeights,     // weights, regions and symbolic analysis done
-  kFactorised,  // first numeric factorisation done
+  kFactorized,  // first numeric factorization done
 };
 
 // `elapsed_ms` is measured from the `start` given to BuildAndRegister. Each stage is reported as
@@ -40,7 +41,7 @@ struct LoadJob {
   Skeleton skeleton;
   ModelOptions options;  // options.limits.max_vertices is set from the context's limits
   std::optional<SkinWeights> weights;  // a rig's own weights: binding from them (Build)
-  MeshFileMetadata file_metadata;  // from a glTF rig: the file's vertex order, units, up axis
+  MeshFileMetadata file_metadata;      // from a glTF rig: the file's vertex order, units, up axis
   std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
   // Stops the build between its phases once cancelled (BuildHooks::cancel); null: never. Must
   // outlive BuildAndRegister.
@@ -59,8 +60,7 @@ struct LoadJob {
 // Errors: INVALID_ARGUMENT for a bad mesh or options (naming the problem), RESOURCE_EXHAUSTED for
 // limits.
 StatusOr<std::shared_ptr<const MeshEntry>> BuildAndRegister(ServiceContext* context,
-                                                            Admission::MeshSlot slot,
-                                                            LoadJob job,
+                                                            Admission::MeshSlot slot, LoadJob job,
                                                             const LoadProgress& progress = {});
 
 }  // namespace deform::service

@@ -15,7 +15,8 @@ std::vector<float> RestInClientOrder(const MeshEntry& entry) {
   const TriangleMesh& mesh = entry.model->mesh();
   std::vector<float> rest(3 * static_cast<std::size_t>(entry.client_vertex_count()));
   EncodeInClientOrder(mesh.vertices.data(), mesh.num_vertices(),
-                      entry.file_metadata.file_vertex_to_mesh, reinterpret_cast<char*>(rest.data()));
+                      entry.file_metadata.file_vertex_to_mesh,
+                      reinterpret_cast<char*>(rest.data()));
   return rest;
 }
 

@@ -51,7 +51,7 @@ ServiceMetrics::ServiceMetrics() : registry_(std::make_shared<prometheus::Regist
                      .Register(*registry_);
   auto& frame_bytes = BuildCounter()
                           .Name("deformd_frame_bytes_sent_total")
-                          .Help("Serialised bytes of the Deform frames written, by encoding")
+                          .Help("Serialized bytes of the Deform frames written, by encoding")
                           .Register(*registry_);
   for (int i = 0; i < kEncodings; ++i) {
     // Index 0 shares float32's series (an unset encoding is float32).
@@ -95,9 +95,9 @@ ServiceMetrics::ServiceMetrics() : registry_(std::make_shared<prometheus::Regist
   const auto build_bounds = Exponential(0.01, 2, 16);  // 10 ms .. 5.5 min
   build_ok_seconds_ = &builds.Add({{"result", "ok"}}, build_bounds);
   build_error_seconds_ = &builds.Add({{"result", "error"}}, build_bounds);
-  refactorisation_seconds_ = &BuildHistogram()
-                                  .Name("deformd_refactorisation_seconds")
-                                  .Help("Stiffness refactorisations of Deform streams")
+  refactorization_seconds_ = &BuildHistogram()
+                                  .Name("deformd_refactorization_seconds")
+                                  .Help("Stiffness refactorizations of Deform streams")
                                   .Register(*registry_)
                                   .Add({}, Exponential(0.001, 2, 14));
   const auto gauge = [this](const char* name, const char* help) {
@@ -111,10 +111,10 @@ ServiceMetrics::ServiceMetrics() : registry_(std::make_shared<prometheus::Regist
   memory_reserved_ =
       gauge("deformd_memory_budget_reserved_bytes", "Memory budget held by loads in progress");
   memory_streams_ = gauge("deformd_memory_budget_streams_bytes",
-                          "Memory budget held by streams' buffers and own factorisations");
+                          "Memory budget held by streams' buffers and own factorizations");
   memory_budget_ = gauge("deformd_memory_budget_bytes", "The memory budget (--max-memory-mb)");
   notice_backlog_ =
-      gauge("deformd_notice_backlog_bytes", "Serialised bytes of notices waiting unwritten");
+      gauge("deformd_notice_backlog_bytes", "Serialized bytes of notices waiting unwritten");
   BuildGauge()
       .Name("deformd_build_info")
       .Help("The build's version and commit, as --version prints them (value 1)")
@@ -148,8 +148,8 @@ void ServiceMetrics::BuildFinished(double seconds, bool ok) {
   (ok ? build_ok_seconds_ : build_error_seconds_)->Observe(seconds);
 }
 
-void ServiceMetrics::RefactorisationFinished(double seconds) {
-  refactorisation_seconds_->Observe(seconds);
+void ServiceMetrics::RefactorizationFinished(double seconds) {
+  refactorization_seconds_->Observe(seconds);
 }
 
 void ServiceMetrics::SetGauges(const Gauges& gauges) {

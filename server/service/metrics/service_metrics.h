@@ -2,7 +2,7 @@
 //
 // What is counted, and where (metric names as exposed):
 //  - deformd_frames_sent_total{encoding}, deformd_frame_bytes_sent_total{encoding}: Deform frames
-//    whose write completed (what clients received), and their serialised DeformResponse bytes;
+//    whose write completed (what clients received), and their serialized DeformResponse bytes;
 //    encoding is float32, quantized or predicted.
 //  - deformd_frame_server_seconds: histogram of a written frame's server time (queue, right-hand
 //    side, solve and encode: DeformFrame.timings).
@@ -13,7 +13,7 @@
 //  - deformd_rpcs_total{method,code}: finished RPCs by method (the five DeformService methods by
 //    name, every other method as "other") and status code name ("OK", "NOT_FOUND", ...).
 //  - deformd_build_seconds{result}: mesh builds (LoadMesh, --preload, --store), ok or error.
-//  - deformd_refactorisation_seconds: stiffness refactorisations of Deform streams.
+//  - deformd_refactorization_seconds: stiffness refactorizations of Deform streams.
 //  - Gauges set at each scrape (SetGauges): deformd_streams_open, deformd_meshes_loaded,
 //    deformd_loads_in_progress, deformd_memory_budget_used_bytes,
 //    deformd_memory_budget_reserved_bytes, deformd_memory_budget_streams_bytes,
@@ -51,10 +51,10 @@ namespace deform::service {
 class ServiceMetrics {
  public:
   // The encodings and notice kinds as the proto numbers them (FrameEncoding, Notice.Kind).
-  static constexpr int kEncodings = 4;     // index 0 (unspecified) counts as float32
-  static constexpr int kNoticeKinds = 4;   // index 0 (unspecified) is never written
+  static constexpr int kEncodings = 4;    // index 0 (unspecified) counts as float32
+  static constexpr int kNoticeKinds = 4;  // index 0 (unspecified) is never written
   static constexpr int kStatusCodes = kCanonicalStatusCodes;  // grpc::StatusCode 0..16
-  static constexpr int kMethods = 6;       // five DeformService methods and "other"
+  static constexpr int kMethods = 6;  // five DeformService methods and "other"
 
   ServiceMetrics();
   ~ServiceMetrics();
@@ -62,7 +62,7 @@ class ServiceMetrics {
   ServiceMetrics& operator=(const ServiceMetrics&) = delete;
 
   // A Deform frame's write completed: `encoding` as in FrameEncoding (out of range: float32),
-  // `bytes` its serialised size, `server_seconds` its server time, `skipped_poses` its count.
+  // `bytes` its serialized size, `server_seconds` its server time, `skipped_poses` its count.
   void FrameWritten(int encoding, std::size_t bytes, double server_seconds,
                     std::uint64_t skipped_poses);
   // A notice's write completed; `kind` as in Notice.Kind (out of range: ignored).
@@ -71,7 +71,7 @@ class ServiceMetrics {
   // status code (out of range: UNKNOWN).
   void RpcFinished(std::string_view method, int code);
   void BuildFinished(double seconds, bool ok);
-  void RefactorisationFinished(double seconds);
+  void RefactorizationFinished(double seconds);
 
   // The gauges, from the caller's snapshot of the service (before each scrape).
   struct Gauges {
@@ -99,7 +99,7 @@ class ServiceMetrics {
   std::array<std::array<prometheus::Counter*, kStatusCodes>, kMethods> rpcs_{};
   prometheus::Histogram* build_ok_seconds_ = nullptr;
   prometheus::Histogram* build_error_seconds_ = nullptr;
-  prometheus::Histogram* refactorisation_seconds_ = nullptr;
+  prometheus::Histogram* refactorization_seconds_ = nullptr;
   prometheus::Gauge* streams_open_ = nullptr;
   prometheus::Gauge* meshes_loaded_ = nullptr;
   prometheus::Gauge* loads_in_progress_ = nullptr;

@@ -11,7 +11,7 @@
 namespace deform::service {
 
 // A new random id. Aborts the process if the kernel's random source fails (it does not on Linux
-// >= 3.17 once the pool is initialised; an id from a weaker source would be worse than no id).
+// >= 3.17 once the pool is initialized; an id from a weaker source would be worse than no id).
 std::string NewMeshId();
 
 // True for text of NewMeshId()'s form (used to check ids read back from a store).

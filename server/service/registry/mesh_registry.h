@@ -27,11 +27,11 @@
 
 #include "core/base/status.h"
 #include "core/model/deformation_model.h"
-#include "service/base/annotated_mutex.h"
-#include "service/workers/mesh_solve_plan.h"
 #include "service/access/admission.h"
 #include "service/access/identity.h"
+#include "service/base/annotated_mutex.h"
 #include "service/base/thread_annotations.h"
+#include "service/workers/mesh_solve_plan.h"
 
 namespace deform::service {
 
@@ -123,7 +123,7 @@ class MeshRegistry {
   std::map<std::uint64_t, std::shared_ptr<MeshEntry>> meshes_ DEFORM_GUARDED_BY(mutex_);
   std::unordered_map<std::string, std::uint64_t> order_of_id_ DEFORM_GUARDED_BY(mutex_);
   std::uint64_t next_order_ DEFORM_GUARDED_BY(mutex_) = 1;  // also counts registrations
-  std::atomic<int> open_streams_{0};  // changed under mutex_, read without it
+  std::atomic<int> open_streams_{0};                        // changed under mutex_, read without it
 };
 
 }  // namespace deform::service

@@ -100,8 +100,7 @@ StatusOr<StoredMesh> ParseEntry(std::string_view data) {
   unsigned char digest[EVP_MAX_MD_SIZE];
   unsigned int length = 0;
   EVP_Digest(body.data(), body.size(), digest, &length, EVP_sha256(), nullptr);
-  if (length != kDigestBytes ||
-      std::memcmp(digest, data.data() + body.size(), kDigestBytes) != 0) {
+  if (length != kDigestBytes || std::memcmp(digest, data.data() + body.size(), kDigestBytes) != 0) {
     return Status::InvalidArgument("checksum mismatch (truncated or altered)");
   }
   std::size_t offset = kMagic.size();
@@ -137,8 +136,7 @@ StatusOr<std::unique_ptr<MeshStore>> MeshStore::Open(const std::string& dir) {
     return Status::FailedPrecondition("the store '" + dir + "' is not a directory");
   }
   if (info.st_uid != ::geteuid()) {
-    return Status::FailedPrecondition("the store directory '" + dir +
-                                      "' belongs to another user");
+    return Status::FailedPrecondition("the store directory '" + dir + "' belongs to another user");
   }
   if ((info.st_mode & 0777) != 0700 && ::chmod(dir.c_str(), 0700) != 0) {
     return Status::FailedPrecondition("cannot make the store directory '" + dir +
@@ -224,8 +222,8 @@ std::vector<StoredMesh> MeshStore::LoadAll() const {
     std::ifstream in(path, std::ios::binary);
     std::ostringstream data;
     data << in.rdbuf();
-    StatusOr<StoredMesh> stored = in ? ParseEntry(data.str())
-                                     : StatusOr<StoredMesh>(Status::NotFound("cannot read it"));
+    StatusOr<StoredMesh> stored =
+        in ? ParseEntry(data.str()) : StatusOr<StoredMesh>(Status::NotFound("cannot read it"));
     if (stored.ok() && EntryPath(stored->id) != path) {
       stored = Status::InvalidArgument("its id '" + stored->id + "' does not match its file name");
     }

@@ -14,8 +14,8 @@
 // all that. An entry whose checksum, lengths, id or tenant do not check out is corrupt: LoadAll()
 // logs and skips it (the file stays for inspection); it never stops the server.
 //
-// Not encrypted: the host's disk encryption protects the files at rest (docs/operations.md, "Threat model").
-// Thread-safe (each call works on its own files).
+// Not encrypted: the host's disk encryption protects the files at rest (docs/operations.md, "Threat
+// model"). Thread-safe (each call works on its own files).
 #pragma once
 
 #include <memory>

@@ -9,14 +9,14 @@
 
 #include "health.pb.h"
 #include "service/base/annotated_mutex.h"
-#include "service/rpc/deform_service.h"
-#include "service/load/load_request.h"
 #include "service/base/log_text.h"
-#include "service/load/mesh_loader.h"
-#include "service/registry/mesh_store.h"
-#include "service/rpc/metrics_endpoint.h"
-#include "service/metrics/rpc_metrics_interceptor.h"
 #include "service/context/service_context.h"
+#include "service/load/load_request.h"
+#include "service/load/mesh_loader.h"
+#include "service/metrics/rpc_metrics_interceptor.h"
+#include "service/registry/mesh_store.h"
+#include "service/rpc/deform_service.h"
+#include "service/rpc/metrics_endpoint.h"
 #include "service/transport/transport_security.h"
 
 namespace deform::service {
@@ -35,7 +35,7 @@ void ApplyConnectionOptions(const ConnectionOptions& options, grpc::ServerBuilde
                               options.min_client_ping_interval_ms);
 }
 
-// The metrics page: the gauges from the service's state now, then everything serialised.
+// The metrics page: the gauges from the service's state now, then everything serialized.
 std::string RenderMetrics(ServiceContext* context) {
   ServiceMetrics::Gauges gauges;
   gauges.streams_open = context->streams().count();
@@ -54,8 +54,8 @@ std::string RenderMetrics(ServiceContext* context) {
 // began).
 StatusOr<std::shared_ptr<const MeshEntry>> Restore(ServiceContext* context, StoredMesh* stored,
                                                    std::chrono::steady_clock::time_point start) {
-  DEFORM_ASSIGN_OR_RETURN(LoadJob job,
-                          LoadJobFromRequest(stored->header, &stored->mesh_bytes, context->limits()));
+  DEFORM_ASSIGN_OR_RETURN(
+      LoadJob job, LoadJobFromRequest(stored->header, &stored->mesh_bytes, context->limits()));
   job.id = stored->id;
   job.start = start;
   job.metrics = &context->metrics();
@@ -77,7 +77,7 @@ struct DeformServer::Impl {
   std::unique_ptr<MetricsEndpoint> metrics;  // null without options.metrics_address
   int port = 0;
   std::vector<std::function<void(std::chrono::milliseconds)>> transport_stops;
-  Mutex shutdown_mutex;  // serialises Shutdown()
+  Mutex shutdown_mutex;  // serializes Shutdown()
   bool shut_down DEFORM_GUARDED_BY(shutdown_mutex) = false;
 };
 
@@ -108,10 +108,9 @@ Status DeformServer::Start() {
   if (!impl_->options.metrics_address.empty()) {
     ServiceContext* context = &impl_->context;
     DEFORM_ASSIGN_OR_RETURN(
-        impl_->metrics,
-        MetricsEndpoint::Start(impl_->options.metrics_address,
-                               impl_->options.security.allow_plaintext, &context->auth(),
-                               [context] { return RenderMetrics(context); }));
+        impl_->metrics, MetricsEndpoint::Start(
+                            impl_->options.metrics_address, impl_->options.security.allow_plaintext,
+                            &context->auth(), [context] { return RenderMetrics(context); }));
   }
   impl_->server = builder.BuildAndStart();
   if (impl_->server == nullptr || impl_->port == 0) {

@@ -1,6 +1,6 @@
 // The deformation server: the gRPC server with the DeformService, health checking and
-// reflection, over a ServiceContext (registry, worker pool, open streams). Used by deformd and by the
-// in-process tests. No gRPC headers here.
+// reflection, over a ServiceContext (registry, worker pool, open streams). Used by deformd and by
+// the in-process tests. No gRPC headers here.
 //
 // Life cycle: construct, optionally Preload(), Start(), then Shutdown() (also done by the
 // destructor). Thread safety: Shutdown() may be called from any thread, once or more; the other
@@ -15,8 +15,8 @@
 #include "core/base/status.h"
 #include "core/io/model_input.h"
 #include "service/access/identity.h"
-#include "service/registry/mesh_registry.h"
 #include "service/base/service_options.h"
+#include "service/registry/mesh_registry.h"
 
 namespace deform::service {
 
@@ -31,9 +31,10 @@ class DeformServer {
 
   // Binds options.listen_address and starts serving, with TLS or plaintext as options.security
   // says (transport_security.h), and GET /metrics on options.metrics_address if given (plain HTTP,
-  // loopback unless allow_plaintext: metrics_endpoint.h). FAILED_PRECONDITION if the address cannot be bound, the server
-  // was already started, or the transport policy refuses (plaintext on a non-loopback address
-  // without allow_plaintext); NOT_FOUND for an unreadable certificate or key file.
+  // loopback unless allow_plaintext: metrics_endpoint.h). FAILED_PRECONDITION if the address cannot
+  // be bound, the server was already started, or the transport policy refuses (plaintext on a
+  // non-loopback address without allow_plaintext); NOT_FOUND for an unreadable certificate or key
+  // file.
   Status Start();
   // The bound port (useful with port 0), or 0 before Start().
   int port() const;
@@ -62,9 +63,9 @@ class DeformServer {
   // for the next call. On error the old tokens stay and the error is returned (and logged).
   Status ReloadTokens();
 
-  // Another transport over the same context (deformd's HTTP port, rpc/web_server.h): Shutdown() calls
-  // `stop` with a grace period after the streams were drained and gRPC has stopped, before the
-  // worker pool stops, so that its streams end while the pool still runs. Before Start().
+  // Another transport over the same context (deformd's HTTP port, rpc/web_server.h): Shutdown()
+  // calls `stop` with a grace period after the streams were drained and gRPC has stopped, before
+  // the worker pool stops, so that its streams end while the pool still runs. Before Start().
   void AddTransportStop(std::function<void(std::chrono::milliseconds)> stop);
 
   // Drains: marks the server not serving, ends open Deform streams with UNAVAILABLE, stops

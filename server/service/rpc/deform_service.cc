@@ -3,11 +3,11 @@
 #include <string_view>
 
 #include "service/deform/deform_stream_reactor.h"
-#include "service/transport/grpc_stream_adapter.h"
 #include "service/load/load_mesh_reactor.h"
+#include "service/rpc/unary_calls.h"
+#include "service/transport/grpc_stream_adapter.h"
 #include "service/transport/rejected_call.h"
 #include "service/transport/status_mapping.h"
-#include "service/rpc/unary_calls.h"
 
 namespace deform::service {
 namespace {
@@ -51,13 +51,15 @@ grpc::ServerUnaryReactor* DeformServiceImpl::GetMeshInfo(grpc::CallbackServerCon
 grpc::ServerUnaryReactor* DeformServiceImpl::ListMeshes(grpc::CallbackServerContext* context,
                                                         const v1::ListMeshesRequest* request,
                                                         v1::ListMeshesResponse* response) {
-  return FinishUnary(context, ListMeshesCall(*context_, AuthorizationOf(context), *request, response));
+  return FinishUnary(context,
+                     ListMeshesCall(*context_, AuthorizationOf(context), *request, response));
 }
 
 grpc::ServerUnaryReactor* DeformServiceImpl::UnloadMesh(grpc::CallbackServerContext* context,
                                                         const v1::UnloadMeshRequest* request,
                                                         v1::UnloadMeshResponse* response) {
-  return FinishUnary(context, UnloadMeshCall(*context_, AuthorizationOf(context), *request, response));
+  return FinishUnary(context,
+                     UnloadMeshCall(*context_, AuthorizationOf(context), *request, response));
 }
 
 grpc::ServerBidiReactor<v1::DeformRequest, v1::DeformResponse>* DeformServiceImpl::Deform(

@@ -3,9 +3,9 @@
 #include <string>
 
 #include "service/access/audit_log.h"
+#include "service/base/request_limits.h"
 #include "service/messages/frame_encoding.h"
 #include "service/messages/proto_conversion.h"
-#include "service/base/request_limits.h"
 
 namespace deform::service {
 namespace {

@@ -15,13 +15,13 @@
 #include <thread>
 #include <vector>
 
+#include "service/base/log_text.h"
 #include "service/deform/deform_stream_reactor.h"
 #include "service/load/load_mesh_reactor.h"
-#include "service/base/log_text.h"
+#include "service/rpc/static_files.h"
+#include "service/rpc/unary_calls.h"
 #include "service/transport/status_mapping.h"
 #include "service/transport/transport_security.h"
-#include "service/rpc/unary_calls.h"
-#include "service/rpc/static_files.h"
 #include "service/transport/web_auth.h"
 #include "service/transport/websocket_session.h"
 
@@ -153,7 +153,8 @@ template <typename RequestMessage, typename ResponseMessage, typename Call>
 Response UnaryCall(Shared& shared, const Request& request, std::string_view method, Call call) {
   RequestMessage message;
   if (!message.ParseFromString(request.body())) {
-    shared.context->metrics().RpcFinished(method, static_cast<int>(grpc::StatusCode::INVALID_ARGUMENT));
+    shared.context->metrics().RpcFinished(method,
+                                          static_cast<int>(grpc::StatusCode::INVALID_ARGUMENT));
     return ErrorResponse(request, grpc::StatusCode::INVALID_ARGUMENT,
                          "the body is not a " + RequestMessage::descriptor()->full_name());
   }
@@ -324,8 +325,9 @@ class HttpSession final : public Abortable, public std::enable_shared_from_this<
     const WebSocketLimits limits{shared_->options.max_message_bytes,
                                  shared_->options.max_messages_per_second};
     service::ServiceContext* context = shared_->context;
-    const std::string session_log = log_context_ + " tenant=" + service::EscapeForLog(caller->tenant) +
-                                (deform ? " ws=Deform" : " ws=LoadMesh");
+    const std::string session_log = log_context_ +
+                                    " tenant=" + service::EscapeForLog(caller->tenant) +
+                                    (deform ? " ws=Deform" : " ws=LoadMesh");
     if (deform) {
       auto session = std::make_shared<WebSocketSession<v1::DeformRequest, v1::DeformResponse>>(
           std::move(stream_), limits, slot_, session_log);

@@ -1,6 +1,6 @@
 // deformd's optional HTTP port (--http ADDR): the browser viewer's static files, the unary calls
-// as HTTP POSTs and the two streaming calls as WebSockets, all over the ServiceContext the gRPC port
-// uses (no second implementation of anything: the same authentication, tenancy, limits, worker
+// as HTTP POSTs and the two streaming calls as WebSockets, all over the ServiceContext the gRPC
+// port uses (no second implementation of anything: the same authentication, tenancy, limits, worker
 // pool, outbox and backpressure; stream_transport.h, unary_calls.h).
 //
 // Endpoints (paths are the API's, deform.v1.DeformService):

@@ -2,8 +2,8 @@
 // forwards gRPC's reactions to the handler and the handler's reads, writes and finish to gRPC.
 //
 // Ownership: gRPC holds the adapter from the service method until OnDone(), which forwards to the
-// handler and then deletes the adapter. The handler owns itself (self_owning_handler.h) and keeps only
-// a raw pointer to the adapter, which it uses only before Finish() (the transport contract).
+// handler and then deletes the adapter. The handler owns itself (self_owning_handler.h) and keeps
+// only a raw pointer to the adapter, which it uses only before Finish() (the transport contract).
 // Thread safety: as grpc::ServerBidiReactor.
 #pragma once
 

@@ -18,7 +18,6 @@
 
 namespace deform::service {
 
-
 // True for "127.x.x.x:port", "[::1]:port", "localhost:port" (what only this machine reaches).
 bool IsLoopbackAddress(const std::string& listen_address);
 
@@ -28,7 +27,6 @@ bool IsLoopbackAddress(const std::string& listen_address);
 // unreadable file. `description` receives what is served, for the log ("TLS", "mutual TLS",
 // "plaintext").
 StatusOr<std::shared_ptr<grpc::ServerCredentials>> MakeServerCredentials(
-    const TransportSecurity& security, const std::string& listen_address,
-    std::string* description);
+    const TransportSecurity& security, const std::string& listen_address, std::string* description);
 
 }  // namespace deform::service

@@ -8,8 +8,8 @@ MeshSolvePlan PlanMeshSolve(const DeformationModel& model, const SolveSettings& 
   const MaterialFactorization& factorization = *model.default_factorization();
   if (factorization.linear_response() != nullptr) return plan;
   if (settings.slots >= 2 && factorization.factor().bytes() >= settings.parallel_min_factor_bytes) {
-    auto parallel = std::make_unique<ParallelSolvePlan>(
-        factorization.factor().PlanParallel(settings.slots));
+    auto parallel =
+        std::make_unique<ParallelSolvePlan>(factorization.factor().PlanParallel(settings.slots));
     if (parallel->parts >= 2) plan.parallel_plan = std::move(parallel);
   }
   if (settings.max_frames >= 2 && settings.slots > 0) {

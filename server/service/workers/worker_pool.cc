@@ -112,7 +112,7 @@ bool WorkerPool::WaitsForItsBatchLocked(const FrameTask& task) {
 }
 
 std::shared_ptr<FrameTask> WorkerPool::TakeUrgentLocked(std::shared_ptr<FrameTask>* others,
-                                                         int* count, const void** split_key) {
+                                                        int* count, const void** split_key) {
   *count = 0;
   *split_key = nullptr;
   // The first task that may run now, unlinked through the link that owns it.
@@ -174,8 +174,8 @@ void WorkerPool::WorkerLoop() {
     int count = 0;
     const void* split_key = nullptr;  // a split batch's, marked running by TakeUrgentLocked
     std::shared_ptr<FrameTask> task = urgent_head_ != nullptr && !background_owed
-                                           ? TakeUrgentLocked(others.data(), &count, &split_key)
-                                           : nullptr;
+                                          ? TakeUrgentLocked(others.data(), &count, &split_key)
+                                          : nullptr;
     if (task != nullptr) {
       lock.Unlock();
       if (count == 0) {

@@ -1,11 +1,11 @@
 // A fixed pool of worker threads for everything that must not run on gRPC's threads: per-frame
-// solves (urgent) and mesh precomputation or refactorisation (background).
+// solves (urgent) and mesh precomputation or refactorization (background).
 //
 // Scheduling: two queues, each in FIFO order. Background tasks run on at most max(1, threads - 1)
 // workers at once, so with two or more workers one of them is always free for frames while
 // meshes are being built. Urgent tasks go first, except that with two or more workers a queued
 // background task is owed a worker whenever none is running one: a worker that becomes free takes
-// it before the next urgent task, so builds and refactorisations progress however busy the frames
+// it before the next urgent task, so builds and refactorizations progress however busy the frames
 // keep the pool (a guaranteed share of one worker). With one worker urgent tasks always go first.
 //
 // Batches: an urgent task may name a batch key (FrameTask::BatchKey). A worker that takes such a
@@ -119,7 +119,7 @@ class WorkerPool {
   // max_batch_ - 1, within kBatchScanLimit) into `others`; returns the task, or null when every
   // queued task must wait. `split_key`: the key of a split batch, now marked running, or null.
   std::shared_ptr<FrameTask> TakeUrgentLocked(std::shared_ptr<FrameTask>* others, int* count,
-                                               const void** split_key) DEFORM_REQUIRES(mutex_);
+                                              const void** split_key) DEFORM_REQUIRES(mutex_);
   // Counts the queued tasks of each running split batch's key (within kBatchScanLimit) into
   // running_split_queued_: one pass over the queue for all of them.
   void CountQueuedOfRunningLocked() DEFORM_REQUIRES(mutex_);
@@ -144,7 +144,7 @@ class WorkerPool {
 
   int thread_count_ = 0;  // set by the constructor, then read-only
   int max_batch_ = 1;     // set by the constructor, then read-only
-  Mutex join_mutex_;      // serialises Shutdown()
+  Mutex join_mutex_;      // serializes Shutdown()
   std::vector<std::thread> threads_ DEFORM_GUARDED_BY(join_mutex_);
 };
 

@@ -1,5 +1,5 @@
 // Compact frames: each encoding decodes within its stated error, the prediction is bit-exact
-// between encoder and decoder, a residual too large falls back to quantisation, and malformed
+// between encoder and decoder, a residual too large falls back to quantization, and malformed
 // input is refused.
 #include "core/codec/frame_codec.h"
 
@@ -86,7 +86,7 @@ PredictedCase MakePredictedCase(int n, double angle) {
   const std::vector<double> rest = BentTube(n, 0.0);
   c.rest.assign(rest.begin(), rest.end());
   const float cs = static_cast<float>(std::cos(angle)), sn = static_cast<float>(std::sin(angle));
-  c.transforms = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0,  // bone 0
+  c.transforms = {1, 0, 0, 0, 0, 1,  0,   0, 0, 0,  1,  0,   // bone 0
                   1, 0, 0, 0, 0, cs, -sn, 0, 0, sn, cs, 0};  // bone 1
   c.frame.resize(3 * n);
   for (int i = 0; i < n; ++i) {
@@ -108,18 +108,19 @@ TEST(FrameCodec, PredictedFramesDecodeWithinHalfAStepAndAreSmaller) {
   FrameEncoder predicted_encoder(c.rest, c.weights, 2, step);
   std::vector<unsigned char> bytes(predicted_encoder.max_encoded_bytes());
   EncodedFrameHeader header;
-  const std::size_t size = predicted_encoder.Encode(c.frame.data(), {}, c.transforms.data(),
-                                                    &header, bytes.data());
+  const std::size_t size =
+      predicted_encoder.Encode(c.frame.data(), {}, c.transforms.data(), &header, bytes.data());
   ASSERT_EQ(header.encoding, FrameEncoding::kPredicted);
   EXPECT_DOUBLE_EQ(header.max_error, step / 2);
   FrameDecoder decoder(n);
   ASSERT_TRUE(decoder.SetPrediction(c.rest, c.weights, 2).ok());
   std::vector<float> decoded(3 * n);
-  ASSERT_TRUE(decoder.Decode(header, bytes.data(), size, c.transforms.data(),
-                             c.transforms.size(), decoded.data())
+  ASSERT_TRUE(decoder
+                  .Decode(header, bytes.data(), size, c.transforms.data(), c.transforms.size(),
+                          decoded.data())
                   .ok());
   EXPECT_LE(LargestError(c.frame, decoded), step / 2 * 1.0001 + 1e-6);
-  // The same frame quantised in its box takes more bytes.
+  // The same frame quantized in its box takes more bytes.
   FrameEncoder quantized_encoder(n);
   std::vector<unsigned char> quantized(quantized_encoder.max_encoded_bytes());
   EncodedFrameHeader quantized_header;
@@ -154,23 +155,23 @@ TEST(FrameCodec, MalformedInputIsRefused) {
   FrameDecoder decoder(n);
   std::vector<float> decoded(3 * n);
   // No prediction set.
-  EXPECT_FALSE(decoder.Decode(header, bytes.data(), size, c.transforms.data(), 24, decoded.data())
-                   .ok());
+  EXPECT_FALSE(
+      decoder.Decode(header, bytes.data(), size, c.transforms.data(), 24, decoded.data()).ok());
   ASSERT_TRUE(decoder.SetPrediction(c.rest, c.weights, 2).ok());
   // Wrong transform count, truncated bytes, garbage, a bad step.
-  EXPECT_FALSE(decoder.Decode(header, bytes.data(), size, c.transforms.data(), 12, decoded.data())
-                   .ok());
-  EXPECT_FALSE(decoder.Decode(header, bytes.data(), size / 2, c.transforms.data(), 24,
-                              decoded.data())
-                   .ok());
+  EXPECT_FALSE(
+      decoder.Decode(header, bytes.data(), size, c.transforms.data(), 12, decoded.data()).ok());
+  EXPECT_FALSE(
+      decoder.Decode(header, bytes.data(), size / 2, c.transforms.data(), 24, decoded.data()).ok());
   std::vector<unsigned char> garbage(size, 0xAB);
-  EXPECT_FALSE(decoder.Decode(header, garbage.data(), garbage.size(), c.transforms.data(), 24,
-                              decoded.data())
-                   .ok());
+  EXPECT_FALSE(
+      decoder
+          .Decode(header, garbage.data(), garbage.size(), c.transforms.data(), 24, decoded.data())
+          .ok());
   EncodedFrameHeader bad = header;
   bad.step = std::nan("");
-  EXPECT_FALSE(decoder.Decode(bad, bytes.data(), size, c.transforms.data(), 24, decoded.data())
-                   .ok());
+  EXPECT_FALSE(
+      decoder.Decode(bad, bytes.data(), size, c.transforms.data(), 24, decoded.data()).ok());
   // Weights naming a bone the frames do not carry.
   PredictionWeights wrong = c.weights;
   wrong.bones[5] = 7;

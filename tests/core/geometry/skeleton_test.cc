@@ -24,7 +24,7 @@ std::string CreateError(std::vector<Joint> joints, std::vector<std::pair<int, in
   return skeleton.status().message();
 }
 
-TEST(Skeleton, DerivesParentsAndNormalisesAxes) {
+TEST(Skeleton, DerivesParentsAndNormalizesAxes) {
   auto skeleton = Skeleton::Create(ThreeJoints(), {{1, 2}, {0, 1}});
   ASSERT_TRUE(skeleton.ok()) << skeleton.status().ToString();
   EXPECT_EQ(skeleton->bone(0).parent_bone, 1);

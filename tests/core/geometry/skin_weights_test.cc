@@ -12,11 +12,11 @@ SkinWeights TwoVertices() {
   SkinWeights w;
   w.num_bones = 3;
   w.AddVertex({2, 0, 2}, {0.5, 1.0, 0.5});  // bone 2 twice: summed
-  w.AddVertex({1}, {4.0});                  // one bone, not normalised
+  w.AddVertex({1}, {4.0});                  // one bone, not normalized
   return w;
 }
 
-TEST(SkinWeights, NormalisesSortsAndSumsRepeats) {
+TEST(SkinWeights, NormalizesSortsAndSumsRepeats) {
   auto normalized = NormalizeSkinWeights(TwoVertices(), 2, 3);
   ASSERT_TRUE(normalized.ok()) << normalized.status().ToString();
   ASSERT_EQ(normalized->offsets, (std::vector<int>{0, 2, 3}));

@@ -153,7 +153,7 @@ struct PrimitiveData {
 };
 
 // The Tube as one primitive's data with rigid weights (joint 0 below y = 1, joint 1 from there),
-// exactly representable as normalised bytes.
+// exactly representable as normalized bytes.
 inline PrimitiveData RigidTubePrimitive(const TestRig& tube) {
   PrimitiveData data;
   for (int v = 0; v < tube.mesh.num_vertices(); ++v) {

@@ -32,7 +32,7 @@ TEST(ReadMeshTest, MalformedOffIsNamed) {
 }
 
 TEST(ReadMeshTest, OffIndexWithTwoSignsIsInvalid) {
-  // "+-1" once reached OpenMesh, whose reader failed on it and left the index uninitialised.
+  // "+-1" once reached OpenMesh, whose reader failed on it and left the index uninitialized.
   const auto result = ReadMesh("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 +-1 2 1\n", MeshFormat::kOff);
   ASSERT_FALSE(result.ok());
   EXPECT_EQ(result.status().code(), StatusCode::kInvalidArgument);

@@ -440,7 +440,7 @@ TEST(ReadGltf, RefusesWhatASkinnedMeshCannotBe) {
     builder.doc()["meshes"][0]["primitives"][0]["attributes"].erase("WEIGHTS_0");
     ExpectRefused(builder.ToGltf(), StatusCode::kInvalidArgument, "no JOINTS_0 and WEIGHTS_0");
   }
-  {  // byte weights that are not normalised
+  {  // byte weights that are not normalized
     GltfBuilder builder = rig();
     const int weights = builder.doc()["meshes"][0]["primitives"][0]["attributes"]["WEIGHTS_0"];
     builder.doc()["accessors"][weights]["componentType"] = gltf_test::kUnsignedByte;

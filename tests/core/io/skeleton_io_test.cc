@@ -79,7 +79,7 @@ TEST(SkeletonJson, RoundTripsNamesAndDegreesOfFreedom) {
   auto skeleton = ParseSkeletonJson(json);
   ASSERT_TRUE(skeleton.ok()) << skeleton.status().ToString();
   ASSERT_EQ(skeleton->joint(1).dofs.size(), 1u);
-  EXPECT_DOUBLE_EQ(skeleton->joint(1).dofs[0].axis.x(), 1.0);  // normalised
+  EXPECT_DOUBLE_EQ(skeleton->joint(1).dofs[0].axis.x(), 1.0);  // normalized
   auto again = ParseSkeletonJson(SkeletonToJson(*skeleton));
   ASSERT_TRUE(again.ok()) << again.status().ToString();
   EXPECT_EQ(again->joint(1).name, "knee");

@@ -155,7 +155,7 @@ TEST(ReadWeightsCsv, RefusesMalformedInput) {
   ExpectRefused("99999999,0,1\n", kCsv, StatusCode::kResourceExhausted, "vertex index 99999999");
 }
 
-TEST(LoadSkinWeightsFile, WidensACsvToTheSkeletonAndNormalises) {
+TEST(LoadSkinWeightsFile, WidensACsvToTheSkeletonAndNormalizes) {
   const std::string path =
       (std::filesystem::temp_directory_path() / "deform_weights_widen_test.csv").string();
   {
@@ -177,7 +177,7 @@ TEST(LoadSkinWeightsFile, WidensACsvToTheSkeletonAndNormalises) {
 }
 
 // The arm's authored weights: one row per vertex of the mesh of that size, one column per bone of
-// arm.tgf; each row sums to one after normalisation.
+// arm.tgf; each row sums to one after normalization.
 void CheckSharedArmWeights(const std::string& mesh_path, const std::string& weights_path,
                            int expected_rows) {
   auto mesh = ReadMeshFile(mesh_path);

@@ -91,7 +91,7 @@ TEST(DeformationModel, SparseSolveMatchesADenseSolve) {
   EXPECT_LT((Eigen::MatrixXd(scratch.solution) - expected).norm(), 1e-9 * expected.norm());
 }
 
-TEST(DeformationModel, RefactorisationAfterAStiffnessChangeEqualsAFreshFactorisation) {
+TEST(DeformationModel, RefactorizationAfterAStiffnessChangeEqualsAFreshFactorization) {
   const JointMaterial stiff{9.0, 2.5, 6.0};
   auto model = BuildPhantomModel();
   Stiffness stiffness;
@@ -107,7 +107,7 @@ TEST(DeformationModel, RefactorisationAfterAStiffnessChangeEqualsAFreshFactorisa
   const Positions a = DeformOnce(*model, pose, refactored->get());
   const Positions b = DeformOnce(*fresh, pose);
   EXPECT_LT(MaxDistance(a, b), 1e-10 * model->bounding_box_diagonal());
-  // And the stiffness matters: the default factorisation gives another shape.
+  // And the stiffness matters: the default factorization gives another shape.
   EXPECT_GT(MaxDistance(a, DeformOnce(*model, pose)), 1e-6 * model->bounding_box_diagonal());
 }
 
@@ -124,9 +124,9 @@ TEST(DeformationModel, AFrameAllocatesNothing) {
   EXPECT_EQ(test_support::AllocationCount() - before, 0);
 }
 
-// Deform() refuses a factorisation or scratch made by another model: false and nothing written in
+// Deform() refuses a factorization or scratch made by another model: false and nothing written in
 // release builds, an assertion in debug builds.
-TEST(DeformationModel, RefusesAFactorisationOrScratchOfAnotherModel) {
+TEST(DeformationModel, RefusesAFactorizationOrScratchOfAnotherModel) {
   auto model = BuildPhantomModel(600);
   auto other = BuildPhantomModel(600);  // the same mesh, yet another model
   const Pose pose = PoseFromSpec(model->skeleton(), "knee:flexion:45");
@@ -355,7 +355,7 @@ TEST(DeformationModel, ABatchOfTheSharedLegOnTwoThreadsEqualsTheFramesSolvedOneB
   frames.ExpectSolvedAlone(*model, count);
 }
 
-TEST(DeformationModel, ThreadsShareOneModelAndFactorisation) {
+TEST(DeformationModel, ThreadsShareOneModelAndFactorization) {
   auto model = BuildPhantomModel();
   const Pose pose = PoseFromSpec(model->skeleton(), "knee:flexion:60");
   const Positions expected = DeformOnce(*model, pose);
@@ -458,7 +458,7 @@ TEST(DeformationModel, RefusesBadStiffness) {
   EXPECT_TRUE(model->Factorize(good).ok());
 }
 
-TEST(DeformationModel, ReportsValidationAndThePrecomputationBeforeFactorising) {
+TEST(DeformationModel, ReportsValidationAndThePrecomputationBeforeFactorizing) {
   auto phantom = MakeKneePhantom(600);
   std::vector<std::string> calls;
   BuildHooks hooks;
@@ -506,7 +506,7 @@ TEST(DeformationModel, ACancelledBuildStopsAtTheEndOfThePhaseInProgress) {
   EXPECT_EQ(stopped.status().ToString(), "FAILED_PRECONDITION: cancelled during validation");
   EXPECT_FALSE(precomputed);
 
-  // Cancelled once the precomputation is done: the numeric factorisation is not interrupted, the
+  // Cancelled once the precomputation is done: the numeric factorization is not interrupted, the
   // build stops after it.
   CancelToken late;
   hooks.cancel = &late;
@@ -514,7 +514,7 @@ TEST(DeformationModel, ACancelledBuildStopsAtTheEndOfThePhaseInProgress) {
   hooks.precomputed = [&] { late.Cancel(); };
   auto after_factor = DeformationModel::Build(phantom->mesh, phantom->skeleton, {}, hooks);
   EXPECT_EQ(after_factor.status().ToString(),
-            "FAILED_PRECONDITION: cancelled during the numeric factorisation");
+            "FAILED_PRECONDITION: cancelled during the numeric factorization");
 
   CancelToken never;
   hooks.cancel = &never;
@@ -576,8 +576,8 @@ TEST(DeformationModel, BuildPhasesAreTheCancellablePhasesInOrder) {
   EXPECT_EQ(names, (std::vector<std::string>{
                        "validation", "the mesh's adjacency", "the binding", "the joint regions",
                        "the harmonic weights", "the Laplacian system", "the binding report",
-                       "the symbolic analysis", "the numeric factorisation"}));
-  // The phases cover the build: precomputation and factorisation, validation besides.
+                       "the symbolic analysis", "the numeric factorization"}));
+  // The phases cover the build: precomputation and factorization, validation besides.
   EXPECT_GE(total, model->precompute_seconds());
   EXPECT_NEAR(model->build_phases().back().seconds,
               model->default_factorization()->factor_seconds(), 1e-12);

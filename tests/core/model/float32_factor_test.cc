@@ -44,7 +44,7 @@ TEST(Float32Factor, FramesStayWithinTheTransportRoundingOfTheDoubleFrames) {
             MaterialFactorization::kFloat32ProbeTolerance);
   EXPECT_LT(rounded_factorization.factor().bytes(),
             0.7 * exact->default_factorization()->factor().bytes());
-  // A refactorisation is built in double: that is what it holds while it runs.
+  // A refactorization is built in double: that is what it holds while it runs.
   EXPECT_EQ(rounded->FactorizationBytes(), exact->FactorizationBytes());
   const double diagonal = exact->bounding_box_diagonal();
   for (const char* spec : {"knee:flexion:0", "knee:flexion:45", "knee:flexion:120",
@@ -56,7 +56,7 @@ TEST(Float32Factor, FramesStayWithinTheTransportRoundingOfTheDoubleFrames) {
     EXPECT_LT(difference, 1e-6 * diagonal) << spec;
     EXPECT_GT(difference, 1e-12 * diagonal) << spec << ": the float32 values were not used";
   }
-  // A factorisation for other stiffness is probed and rounded too.
+  // A factorization for other stiffness is probed and rounded too.
   Stiffness stiffer;
   stiffer.joint_materials.push_back({1, JointMaterial{9.0, 2.5, 6.0}});  // the knee
   auto other = rounded->Factorize(stiffer);

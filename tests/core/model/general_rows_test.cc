@@ -79,7 +79,7 @@ struct Fixture {
     weights.offsets.push_back(static_cast<int>(weights.bones.size()));
   }
 
-  // L'^T r with r_j = w_j^2 T_j delta_j, T_j the normalised blend of vertex j's quaternions with
+  // L'^T r with r_j = w_j^2 T_j delta_j, T_j the normalized blend of vertex j's quaternions with
   // signs aligned to its first bone's, every row summed in full.
   Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> Expected() const {
     Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> r(n, 3);
@@ -132,7 +132,7 @@ TEST_P(GeneralRowsTest, AnchorTargetsAreAddedToTheirRows) {
 
 // The plan's product equals the full product to round-off, for every kernel this CPU runs and
 // split into parts as a parallel assembly splits it.
-TEST_P(GeneralRowsTest, TheProductEqualsTheFullProductOfTheNormalisedBlend) {
+TEST_P(GeneralRowsTest, TheProductEqualsTheFullProductOfTheNormalizedBlend) {
   if (!SolveKernelAvailable(GetParam())) GTEST_SKIP() << "this CPU lacks the instruction set";
   const Fixture f;
   const RigidRows rigid = RigidRows::Find(f.system, f.weights);

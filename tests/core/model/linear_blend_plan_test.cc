@@ -63,7 +63,8 @@ TEST(SimplexGridCell, TwoWeightsTakeTheTwoSamplesAroundTheSecond) {
   std::vector<double> coefficients;
   SimplexGridCell({0.7, 0.3}, 4, &shares, &coefficients);  // 0.3 lies between 1/4 and 2/4
   std::vector<std::pair<int, double>> second_share_and_coefficient;
-  for (int c = 0; c < 2; ++c) second_share_and_coefficient.emplace_back(shares[2 * c + 1], coefficients[c]);
+  for (int c = 0; c < 2; ++c)
+    second_share_and_coefficient.emplace_back(shares[2 * c + 1], coefficients[c]);
   std::sort(second_share_and_coefficient.begin(), second_share_and_coefficient.end());
   EXPECT_EQ(second_share_and_coefficient[0].first, 1);
   EXPECT_NEAR(second_share_and_coefficient[0].second, 0.8, 1e-12);
@@ -153,7 +154,8 @@ TEST(LinearBlendPlan, AgreeingBonesGiveTheirRotationExactly) {
   }
   const auto plan = LinearBlendPlan::Build(MakeBoneWeights(5, vertices), 5, 4);
   std::vector<RigidTransform> bones(5);
-  for (auto& bone : bones) bone.rotation = Eigen::AngleAxisd(0.9, Eigen::Vector3d(1, 2, 3).normalized());
+  for (auto& bone : bones)
+    bone.rotation = Eigen::AngleAxisd(0.9, Eigen::Vector3d(1, 2, 3).normalized());
   const Eigen::Matrix3d expected = bones[0].rotation.toRotationMatrix();
   for (int v = 0; v < 50; ++v) EXPECT_LT((BlendOf(plan, v, bones) - expected).norm(), 1e-13);
   // Grid points have at most `segments` non-zero shares: 5 bones in 4 segments need no knot of 5.
@@ -190,7 +192,8 @@ TEST(LinearBlendPlan, TheResponseEqualsTheSolveOnThreeBoneVertices) {
   (*model)->SolveInPlace(factorization, &solved);
   const double diagonal = (*model)->bounding_box_diagonal();
   EXPECT_LT(test_support::MaxDistance(fast.positions(), solved.positions()), 1e-10 * diagonal);
-  EXPECT_GT(test_support::MaxDistance(fast.positions(), (*model)->mesh().vertices), 0.05 * diagonal);
+  EXPECT_GT(test_support::MaxDistance(fast.positions(), (*model)->mesh().vertices),
+            0.05 * diagonal);
 }
 
 }  // namespace

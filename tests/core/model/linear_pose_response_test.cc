@@ -31,7 +31,7 @@ std::shared_ptr<const DeformationModel> BuildPhantomModel(const ModelOptions& op
   return test_support::BuildPhantomModel(vertices, options);
 }
 
-// The frame Deform() gives (from the response when the factorisation has one).
+// The frame Deform() gives (from the response when the factorization has one).
 Positions Frame(const DeformationModel& model, const MaterialFactorization& factorization,
                 const Pose& pose) {
   DeformScratch scratch = model.MakeScratch();

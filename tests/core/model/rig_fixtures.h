@@ -91,33 +91,33 @@ inline Rig TwoFingersOfOnePalm(int resolution = 2) {
   Rig rig;
   rig.mesh = VoxelMesh(cells, 1.0 / r);
   const double a = 1.5, b = 5.5 - 1.2;
-  rig.skeleton = MakeSkeleton(
-      {FreeJoint("wrist", {3.5, 0.5, 1}), FreeJoint("palm", {3.5, 5, 1}),
-       FreeJoint("knuckle_a", {a, 6.5, 1}), FreeJoint("middle_a", {a, 12, 1}),
-       FreeJoint("tip_a", {a, 17.5, 1}), FreeJoint("knuckle_b", {b, 6.5, 1}),
-       FreeJoint("middle_b", {b, 12, 1}), FreeJoint("tip_b", {b, 17.5, 1})},
-      {{0, 1}, {1, 2}, {2, 3}, {3, 4}, {1, 5}, {5, 6}, {6, 7}});
+  rig.skeleton =
+      MakeSkeleton({FreeJoint("wrist", {3.5, 0.5, 1}), FreeJoint("palm", {3.5, 5, 1}),
+                    FreeJoint("knuckle_a", {a, 6.5, 1}), FreeJoint("middle_a", {a, 12, 1}),
+                    FreeJoint("tip_a", {a, 17.5, 1}), FreeJoint("knuckle_b", {b, 6.5, 1}),
+                    FreeJoint("middle_b", {b, 12, 1}), FreeJoint("tip_b", {b, 17.5, 1})},
+                   {{0, 1}, {1, 2}, {2, 3}, {3, 4}, {1, 5}, {5, 6}, {6, 7}});
   return rig;
 }
 
 // A head (6 x 6 x 6 units, its bone inside) with an ear: a flap one unit thick hanging 8 units
 // down from the head's side, one unit beside an arm (a separate closed piece, 3 x 14 x 3, whose
-// bones run 1.2 units toward the ear). The ear's lower part is far nearer to the arm's bones than to
-// the head's. Joints: neck, crown (the head's bone), shoulder, elbow, wrist.
+// bones run 1.2 units toward the ear). The ear's lower part is far nearer to the arm's bones than
+// to the head's. Joints: neck, crown (the head's bone), shoulder, elbow, wrist.
 inline Rig EarBesideAnArm(int resolution = 2) {
   std::set<Cell> cells;
   const int r = resolution;
-  AddBox(&cells, {0, 14 * r, 0}, {6 * r, 20 * r, 6 * r});  // head
+  AddBox(&cells, {0, 14 * r, 0}, {6 * r, 20 * r, 6 * r});         // head
   AddBox(&cells, {6 * r, 6 * r, 2 * r}, {7 * r, 16 * r, 4 * r});  // ear
-  AddBox(&cells, {8 * r, 0, 1 * r}, {11 * r, 14 * r, 4 * r});  // arm
+  AddBox(&cells, {8 * r, 0, 1 * r}, {11 * r, 14 * r, 4 * r});     // arm
   Rig rig;
   rig.mesh = VoxelMesh(cells, 1.0 / r);
   const double arm_x = 9.5 - 1.2;
-  rig.skeleton = MakeSkeleton(
-      {FreeJoint("neck", {3, 14.5, 3}), FreeJoint("crown", {3, 19.5, 3}),
-       FreeJoint("shoulder", {arm_x, 13.5, 2.5}), FreeJoint("elbow", {arm_x, 7, 2.5}),
-       FreeJoint("wrist", {arm_x, 0.5, 2.5})},
-      {{0, 1}, {2, 3}, {3, 4}});
+  rig.skeleton =
+      MakeSkeleton({FreeJoint("neck", {3, 14.5, 3}), FreeJoint("crown", {3, 19.5, 3}),
+                    FreeJoint("shoulder", {arm_x, 13.5, 2.5}), FreeJoint("elbow", {arm_x, 7, 2.5}),
+                    FreeJoint("wrist", {arm_x, 0.5, 2.5})},
+                   {{0, 1}, {2, 3}, {3, 4}});
   return rig;
 }
 

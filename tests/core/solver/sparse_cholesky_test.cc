@@ -88,7 +88,7 @@ TEST_P(SparseCholeskyTest, SolveInPlaceEqualsSolveOutOfPlace) {
   EXPECT_EQ(Eigen::MatrixXd(x), Eigen::MatrixXd(b));
 }
 
-TEST_P(SparseCholeskyTest, RefactorisationReusesTheAnalysis) {
+TEST_P(SparseCholeskyTest, RefactorizationReusesTheAnalysis) {
   const int n = 200;
   ColMajorMatrix a = RandomSpdMatrix(n, 3, 13);
   auto symbolic = SymbolicCholesky::Analyze(a, GetParam());
@@ -110,7 +110,7 @@ TEST_P(SparseCholeskyTest, RefactorisationReusesTheAnalysis) {
   EXPECT_LT((x1 - x2).norm(), 1e-12 * x2.norm());
 }
 
-TEST_P(SparseCholeskyTest, ACancelledFactorisationStopsAndAnUncancelledOneCompletes) {
+TEST_P(SparseCholeskyTest, ACancelledFactorizationStopsAndAnUncancelledOneCompletes) {
   const int n = 3 * CholeskyFactor::kCancelCheckRows;
   ColMajorMatrix a = RandomSpdMatrix(n, 3, 29);
   auto symbolic = SymbolicCholesky::Analyze(a, GetParam());
@@ -119,7 +119,7 @@ TEST_P(SparseCholeskyTest, ACancelledFactorisationStopsAndAnUncancelledOneComple
   cancelled.Cancel();
   const auto stopped = CholeskyFactor::Factorize(*symbolic, a, &cancelled);
   EXPECT_EQ(stopped.status().ToString(),
-            "FAILED_PRECONDITION: cancelled during the numeric factorisation");
+            "FAILED_PRECONDITION: cancelled during the numeric factorization");
   // A parent's cancel (the server's shutdown) reaches it too.
   CancelToken child(&cancelled);
   EXPECT_FALSE(CholeskyFactor::Factorize(*symbolic, a, &child).ok());

@@ -11,8 +11,8 @@
 #include <algorithm>
 #include <chrono>
 #include <sstream>
-#include <thread>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "service/access/audit_log.h"
@@ -25,12 +25,12 @@
 namespace deform {
 namespace {
 
-using ::testing::HasSubstr;
-using ::testing::Not;
 using test_support::StreamRecorder;
 using test_support::TempDir;
 using test_support::TestServer;
 using test_support::TestServerOptions;
+using ::testing::HasSubstr;
+using ::testing::Not;
 
 std::string TokenLine(const std::string& token, const std::string& tenant,
                       const std::string& role) {
@@ -92,8 +92,8 @@ class TenancyTest : public ::testing::Test {
 TEST_F(TenancyTest, CallsWithoutAValidTokenAreUnauthenticated) {
   Start();
   const std::string mesh_id = LoadPhantom(*ward_a_);
-  for (const std::string& token : {std::string(), std::string("not-a-token"),
-                                   service::Sha256Hex("token-of-ward-a")}) {
+  for (const std::string& token :
+       {std::string(), std::string("not-a-token"), service::Sha256Hex("token-of-ward-a")}) {
     SCOPED_TRACE("token '" + token + "'");
     auto client = server_->NewClient(WithToken(token));
     std::vector<v1::MeshSummary> meshes;
@@ -247,22 +247,21 @@ TEST(TokenTableTest, ParsesCommentsAndRefusesBadLines) {
   ASSERT_NE(table->Find(hash), nullptr);
   EXPECT_EQ(table->Find(hash)->tenant, "ward-1");
   EXPECT_EQ(table->Find(hash)->role, service::Role::kOperator);
-  for (const std::string& bad :
-       std::vector<std::string>{hash + " ward-1", hash + " ward-1 admin", "abc ward-1 tenant",
-                                hash + " ward/1 tenant",
-        hash + " ward-1 tenant\n" + hash + " ward-2 tenant"}) {
+  for (const std::string& bad : std::vector<std::string>{
+           hash + " ward-1", hash + " ward-1 admin", "abc ward-1 tenant", hash + " ward/1 tenant",
+           hash + " ward-1 tenant\n" + hash + " ward-2 tenant"}) {
     SCOPED_TRACE(bad);
     EXPECT_EQ(service::TokenTable::Parse(bad).status().code(), StatusCode::kInvalidArgument);
   }
   TempDir dir;
   service::Authenticator tokens;
-  ASSERT_TRUE(tokens.LoadTokenFile(dir.Write("tokens", TokenLine("secret", "ward-1", "tenant")))
-                  .ok());
+  ASSERT_TRUE(
+      tokens.LoadTokenFile(dir.Write("tokens", TokenLine("secret", "ward-1", "tenant"))).ok());
   EXPECT_TRUE(tokens.uses_tokens());
   EXPECT_TRUE(tokens.Authenticate("Bearer secret").ok());
   EXPECT_TRUE(tokens.Authenticate("bearer secret").ok());  // the scheme is case-insensitive
-  for (const char* refused : {"", "Bearer", "Bearer ", "Basic c2VjcmV0", "secret",
-                              "Bearer secret2", "Bearer SECRET"}) {
+  for (const char* refused :
+       {"", "Bearer", "Bearer ", "Basic c2VjcmV0", "secret", "Bearer secret2", "Bearer SECRET"}) {
     SCOPED_TRACE(refused);
     EXPECT_EQ(tokens.Authenticate(refused).status().code(), StatusCode::kUnauthenticated);
   }

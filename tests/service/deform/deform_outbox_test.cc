@@ -90,8 +90,8 @@ TEST(DeformOutboxTest, TheBacklogIsBoundedInBytesForEveryKind) {
   const std::string long_message(100'000, 'm');  // cut to kMaxNoticeMessageBytes
   int added = 0;
   for (int k = 0; k < 10'000; ++k) {
-    const auto kind = k % 2 == 0 ? v1::Notice::KIND_POSE_REJECTED
-                                 : v1::Notice::KIND_STIFFNESS_REJECTED;
+    const auto kind =
+        k % 2 == 0 ? v1::Notice::KIND_POSE_REJECTED : v1::Notice::KIND_STIFFNESS_REJECTED;
     if (outbox.AddNotice(kind, 0, 1, long_message)) ++added;
   }
   EXPECT_TRUE(outbox.notice_backlog_full());

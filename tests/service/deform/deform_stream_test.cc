@@ -88,8 +88,7 @@ class DeformStreamTest : public ServiceTest, public ::testing::WithParamInterfac
 class DeformStreamGrpcTest : public ServiceTest {};
 
 INSTANTIATE_TEST_SUITE_P(Transports, DeformStreamTest,
-                         ::testing::Values(Transport::kGrpc, Transport::kWebSocket),
-                         TransportName);
+                         ::testing::Values(Transport::kGrpc, Transport::kWebSocket), TransportName);
 
 TEST_P(DeformStreamTest, FrameEqualsTheCoreResultForTheSamePose) {
   StartServer();
@@ -643,8 +642,7 @@ class LoneFrameSplitTest : public DeformStreamTest {
 
 // Fewer streams open than workers (two of three): a lone frame is split over the workers.
 INSTANTIATE_TEST_SUITE_P(Transports, LoneFrameSplitTest,
-                         ::testing::Values(Transport::kGrpc, Transport::kWebSocket),
-                         TransportName);
+                         ::testing::Values(Transport::kGrpc, Transport::kWebSocket), TransportName);
 
 TEST_P(LoneFrameSplitTest, FramesSplitOverTheWorkersWhileFewerStreamsThanWorkersAreOpen) {
   ExpectThreeFramesSolvedIn(/*workers=*/3, /*parts=*/3);

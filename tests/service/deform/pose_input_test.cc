@@ -66,7 +66,7 @@ TEST_F(PoseInputTest, RotationsComeBeforeAnglesOfTheSameJoint) {
   v1::PoseUpdate update = Angles({{"knee", "y", 30}});
   v1::JointRotation* rotation = update.add_rotations();
   rotation->set_joint("knee");
-  // 90 degrees about x, not normalised (the server normalises norms within 0.1 of 1).
+  // 90 degrees about x, not normalized (the server normalizes norms within 0.1 of 1).
   rotation->set_w(1.05 * std::cos(M_PI / 4));
   rotation->set_x(1.05 * std::sin(M_PI / 4));
   PoseInput input;

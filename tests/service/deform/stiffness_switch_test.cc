@@ -1,5 +1,5 @@
-// StiffnessSwitch: one refactorisation at a time, the newest waiting update, the newest finished
-// factorisation, and versions.
+// StiffnessSwitch: one refactorization at a time, the newest waiting update, the newest finished
+// factorization, and versions.
 #include "service/deform/stiffness_switch.h"
 
 #include <gtest/gtest.h>
@@ -21,7 +21,7 @@ StiffnessSwitch::Update UpdateWithVersion(std::uint64_t version) {
   return update;
 }
 
-TEST(StiffnessSwitchTest, StartsWithTheInitialFactorisationAsVersionZero) {
+TEST(StiffnessSwitchTest, StartsWithTheInitialFactorizationAsVersionZero) {
   const Factorization initial = NewFactorization();
   StiffnessSwitch stiffness;
   stiffness.Reset(initial);
@@ -32,7 +32,7 @@ TEST(StiffnessSwitchTest, StartsWithTheInitialFactorisationAsVersionZero) {
   EXPECT_FALSE(stiffness.refactor_running());
 }
 
-TEST(StiffnessSwitchTest, TheNewestUpdateWaitsBehindTheRunningRefactorisation) {
+TEST(StiffnessSwitchTest, TheNewestUpdateWaitsBehindTheRunningRefactorization) {
   StiffnessSwitch stiffness;
   stiffness.Reset(NewFactorization());
   stiffness.RefactorStarted();
@@ -49,7 +49,7 @@ TEST(StiffnessSwitchTest, TheNewestUpdateWaitsBehindTheRunningRefactorisation) {
   EXPECT_FALSE(stiffness.busy());
 }
 
-TEST(StiffnessSwitchTest, TheNewestFinishedFactorisationIsAppliedAndReplacesCurrent) {
+TEST(StiffnessSwitchTest, TheNewestFinishedFactorizationIsAppliedAndReplacesCurrent) {
   const Factorization initial = NewFactorization();
   const Factorization first = NewFactorization();
   const Factorization second = NewFactorization();

@@ -1,5 +1,5 @@
 // A Deform stream's own memory is in the budgets (Admission::MemoryHold): its buffers from
-// `start` (before they are allocated), and the factorisation of a stiffness update while the
+// `start` (before they are allocated), and the factorization of a stiffness update while the
 // stream holds it. A stream that does not fit is RESOURCE_EXHAUSTED naming the budget; a
 // stiffness update that does not fit is KIND_STIFFNESS_REJECTED naming it, and the stream goes on
 // with its frames. Everything is released when the stream ends.
@@ -118,7 +118,7 @@ TEST_F(StreamMemoryTest, StreamsBeyondTheBudgetAreRefusedNamingIt) {
   }
 }
 
-TEST_F(StreamMemoryTest, AStiffnessFactorisationIsCountedWhileTheStreamHoldsIt) {
+TEST_F(StreamMemoryTest, AStiffnessFactorizationIsCountedWhileTheStreamHoldsIt) {
   const std::size_t one = OneStream();
   StartWithSpare(one + factorization_bytes_ + factorization_bytes_ / 2);
   StreamRecorder recorder;
@@ -133,15 +133,15 @@ TEST_F(StreamMemoryTest, AStiffnessFactorisationIsCountedWhileTheStreamHoldsIt) 
   weight->set_weight(20);
   ASSERT_TRUE(stream->SendStiffness(stiffness));
   ASSERT_TRUE(recorder.WaitForNotice(v1::Notice::KIND_STIFFNESS_APPLIED));
-  EXPECT_EQ(StreamBytes(), one + factorization_bytes_) << "the stream's own factorisation";
+  EXPECT_EQ(StreamBytes(), one + factorization_bytes_) << "the stream's own factorization";
 
-  // A second update needs a second factorisation beside the first while it is built: no room.
+  // A second update needs a second factorization beside the first while it is built: no room.
   weight->set_weight(5);
   ASSERT_TRUE(stream->SendStiffness(stiffness));
   ASSERT_TRUE(recorder.WaitForNotice(v1::Notice::KIND_STIFFNESS_REJECTED));
   const auto rejected = recorder.FindNotice(v1::Notice::KIND_STIFFNESS_REJECTED);
   EXPECT_EQ(rejected->stiffness_version(), 2u);
-  EXPECT_THAT(rejected->message(), HasSubstr("the factorisation of stiffness version 2"));
+  EXPECT_THAT(rejected->message(), HasSubstr("the factorization of stiffness version 2"));
   EXPECT_THAT(rejected->message(), HasSubstr("--max-memory-mb"));
   EXPECT_EQ(StreamBytes(), one + factorization_bytes_);
 

@@ -72,9 +72,11 @@ TEST_F(LoadMeshTest, PhantomLoadReportsEveryStageInOrder) {
       },
       "knee");
   ASSERT_TRUE(status.ok()) << status.error_message();
-  EXPECT_THAT(stages, ElementsAre(v1::LoadMeshResponse::STAGE_RECEIVED, v1::LoadMeshResponse::STAGE_VALIDATED,
-                                  v1::LoadMeshResponse::STAGE_WEIGHTS, v1::LoadMeshResponse::STAGE_FACTORISED,
-                                  v1::LoadMeshResponse::STAGE_READY));
+  EXPECT_THAT(
+      stages,
+      ElementsAre(v1::LoadMeshResponse::STAGE_RECEIVED, v1::LoadMeshResponse::STAGE_VALIDATED,
+                  v1::LoadMeshResponse::STAGE_WEIGHTS, v1::LoadMeshResponse::STAGE_FACTORISED,
+                  v1::LoadMeshResponse::STAGE_READY));
   for (std::size_t k = 1; k < elapsed.size(); ++k) EXPECT_LE(elapsed[k - 1], elapsed[k]);
 
   auto phantom = MakeKneePhantom(600);
@@ -378,8 +380,9 @@ TEST_F(LoadMeshTest, AFileDeclaringAMeshThatCannotFitIsRefusedBeforeItIsParsed) 
   EXPECT_EQ(server_->server().context().admission().loads_in_progress(), 0);
   EXPECT_EQ(server_->server().context().admission().memory_bytes_reserved(), 0u);
   // A file that declares what it holds loads as before.
-  EXPECT_TRUE(client_->LoadMeshBytes("fits", v1::MESH_FORMAT_OBJ, files.mesh_bytes,
-                                     v1::SKELETON_FORMAT_JSON, files.skeleton_bytes, {}, &summary)
+  EXPECT_TRUE(client_
+                  ->LoadMeshBytes("fits", v1::MESH_FORMAT_OBJ, files.mesh_bytes,
+                                  v1::SKELETON_FORMAT_JSON, files.skeleton_bytes, {}, &summary)
                   .ok());
   ExpectBackgroundStreamAlive();
 }

@@ -1,5 +1,5 @@
 // Root motion over gRPC: the pose's root transform moves the whole body rigidly (world frame), on
-// both rotation blends; quaternions too large to square are normalised, not turned into the rest
+// both rotation blends; quaternions too large to square are normalized, not turned into the rest
 // pose; a bad root is rejected with a notice while the stream goes on.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -72,7 +72,7 @@ TEST_F(RootMotionTest, RootTransformMovesTheRestMeshRigidly) {
   ExpectBackgroundStreamAlive();
 }
 
-TEST_F(RootMotionTest, NearlyUnitQuaternionsAreNormalised) {
+TEST_F(RootMotionTest, NearlyUnitQuaternionsAreNormalized) {
   StartServer();
   const std::string mesh_id = LoadPhantom(400);
   v1::PoseUpdate scaled = RootPose(90, Eigen::Vector3d::Zero());

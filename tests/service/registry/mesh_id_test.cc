@@ -1,5 +1,7 @@
 // Mesh ids are 128 random bits: they differ between two servers, carry no sequence, and an id
 // kept from a previous server is NOT_FOUND on the next one (instead of naming its first mesh).
+#include "service/registry/mesh_id.h"
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -8,16 +10,15 @@
 #include <string>
 #include <vector>
 
-#include "service/registry/mesh_id.h"
 #include "tests/service/support/stream_recorder.h"
 #include "tests/service/support/test_server.h"
 
 namespace deform {
 namespace {
 
-using ::testing::HasSubstr;
 using test_support::StreamRecorder;
 using test_support::TestServer;
+using ::testing::HasSubstr;
 
 std::string LoadPhantom(client::DeformClient& client) {
   v1::MeshSummary summary;

@@ -72,8 +72,8 @@ class StoredServer {
     EXPECT_TRUE(server_->Start().ok());
   }
   std::unique_ptr<client::DeformClient> NewClient(const std::string& token) const {
-    return std::make_unique<client::DeformClient>(
-        "127.0.0.1:" + std::to_string(server_->port()), WithToken(token));
+    return std::make_unique<client::DeformClient>("127.0.0.1:" + std::to_string(server_->port()),
+                                                  WithToken(token));
   }
   int restored() const { return restored_; }
 
@@ -91,8 +91,7 @@ std::string UploadPhantomAsObj(client::DeformClient& client, const TempDir& dir)
   v1::MethodOptions options;
   options.set_rotation_blend(v1::ROTATION_BLEND_LINEAR);
   v1::MeshSummary summary;
-  const grpc::Status status =
-      client.LoadMeshFiles(mesh_path, skeleton_path, options, &summary);
+  const grpc::Status status = client.LoadMeshFiles(mesh_path, skeleton_path, options, &summary);
   EXPECT_TRUE(status.ok()) << status.error_message();
   return summary.mesh_id();
 }

@@ -1,6 +1,8 @@
 // The real deformd and command-line clients in processes: SIGHUP rotates tokens; plaintext on a
 // non-loopback address needs --plaintext; the health probe and deform-vr talk TLS with a token;
 // --store brings a mesh back after a restart under its id (the same pose, the same frame).
+#include "tests/service/support/deformd_process.h"
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -10,19 +12,18 @@
 #include <string>
 #include <vector>
 
+#include "deform_client.h"
 #include "service/access/identity.h"
-#include "tests/service/support/deformd_process.h"
 #include "tests/service/support/temp_dir.h"
 #include "tests/service/support/test_certificates.h"
-#include "deform_client.h"
 
 namespace deform {
 namespace {
 
-using ::testing::HasSubstr;
 using test_support::DeformdProcess;
 using test_support::TempDir;
 using test_support::TestCertificates;
+using ::testing::HasSubstr;
 
 std::string TokenLine(const std::string& token, const std::string& tenant) {
   return service::Sha256Hex(token) + " " + tenant + " tenant\n";
@@ -44,8 +45,7 @@ TEST(DeformdProcessTest, SighupReloadsTheTokenFile) {
                          dir.Path("log"));
   ASSERT_TRUE(deformd.WaitForListening()) << deformd.Log();
   EXPECT_TRUE(List(deformd.target(), "first-token").ok());
-  EXPECT_EQ(List(deformd.target(), "second-token").error_code(),
-            grpc::StatusCode::UNAUTHENTICATED);
+  EXPECT_EQ(List(deformd.target(), "second-token").error_code(), grpc::StatusCode::UNAUTHENTICATED);
 
   dir.Write("tokens", TokenLine("second-token", "ward-a"));
   deformd.Signal(SIGHUP);
@@ -78,11 +78,11 @@ TEST(DeformdProcessTest, CommandLineClientsTalkTlsWithAToken) {
   ASSERT_TRUE(certificates.ok());
   TempDir dir;
   const std::string tokens = dir.Write("tokens", TokenLine("vr-token", "ward-a"));
-  DeformdProcess deformd({"--listen", "127.0.0.1:0", "--workers", "1", "--token-file", tokens,
-                          "--tls-cert", certificates.Path("server.pem"), "--tls-key",
-                          certificates.Path("server.key"), "--tls-client-ca",
-                          certificates.Path("ca.pem")},
-                         dir.Path("log"));
+  DeformdProcess deformd(
+      {"--listen", "127.0.0.1:0", "--workers", "1", "--token-file", tokens, "--tls-cert",
+       certificates.Path("server.pem"), "--tls-key", certificates.Path("server.key"),
+       "--tls-client-ca", certificates.Path("ca.pem")},
+      dir.Path("log"));
   ASSERT_TRUE(deformd.WaitForListening()) << deformd.Log();
   EXPECT_THAT(deformd.Log(), HasSubstr("(mutual TLS)"));
   const std::string tls = " --tls-ca " + certificates.Path("ca.pem") + " --tls-cert " +
@@ -113,8 +113,8 @@ std::string ReadFile(const std::string& path) {
 
 TEST(DeformdProcessTest, StoreBringsAMeshBackAfterARestart) {
   TempDir dir;
-  const std::vector<std::string> args = {"--listen", "127.0.0.1:0", "--workers", "1", "--store",
-                                         dir.Path("store")};
+  const std::vector<std::string> args = {"--listen", "127.0.0.1:0", "--workers",
+                                         "1",        "--store",     dir.Path("store")};
   std::string mesh_id;
   {
     DeformdProcess deformd(args, dir.Path("first.log"));

@@ -3,11 +3,11 @@
 // backlog), the real deformd executable where only a process shows the defect (binding, the
 // linked health descriptor, SIGTERM). Every test also checks that the server keeps serving.
 #include <arpa/inet.h>
+#include <gmock/gmock.h>
 #include <google/protobuf/descriptor.pb.h>
 #include <google/protobuf/unknown_field_set.h>
 #include <grpcpp/generic/generic_stub.h>
 #include <grpcpp/grpcpp.h>
-#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <netinet/in.h>
 #include <signal.h>
@@ -25,8 +25,8 @@
 #include <vector>
 
 #include "deform_client.h"
-#include "service/deform/deform_outbox.h"
 #include "service/context/service_context.h"
+#include "service/deform/deform_outbox.h"
 #include "tests/service/support/deformd_process.h"
 #include "tests/service/support/service_fixture.h"
 #include "tests/service/support/stream_recorder.h"
@@ -75,8 +75,7 @@ TEST_F(HostileClientTest, OversizedStringsAreRefusedNamingTheFieldAndTheLimit) {
   const std::string mesh_id = LoadPhantom(300);
 
   v1::MeshSummary summary;
-  const grpc::Status long_name =
-      client_->LoadPhantom(300, {}, &summary, {}, std::string(300, 'n'));
+  const grpc::Status long_name = client_->LoadPhantom(300, {}, &summary, {}, std::string(300, 'n'));
   EXPECT_EQ(long_name.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
   EXPECT_THAT(long_name.error_message(), HasSubstr("name is 300 bytes long"));
   EXPECT_THAT(long_name.error_message(), HasSubstr("limit of 256 bytes"));
@@ -126,8 +125,7 @@ TEST_F(HostileClientTest, SixteenKilobyteUnknownIdGetsAShortInvalidArgument) {
   StreamRecorder recorder;
   auto stream = client_->OpenStream(id, recorder.Callbacks());
   const grpc::Status streamed = stream->Wait();
-  EXPECT_EQ(streamed.error_code(), grpc::StatusCode::INVALID_ARGUMENT)
-      << streamed.error_message();
+  EXPECT_EQ(streamed.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << streamed.error_message();
   EXPECT_THAT(streamed.error_message(), HasSubstr("start.mesh_id is 16384 bytes long"));
   ExpectBackgroundStreamAlive();
 }
@@ -180,9 +178,8 @@ TEST_F(HostileClientTest, NoticeFloodFromAClientThatDoesNotReadStaysBounded) {
   EXPECT_GT(static_cast<std::size_t>(sent.load()) * 250,
             4 * service::DeformOutbox::kMaxNoticeBacklogBytes);
   EXPECT_GT(peak, 0);
-  EXPECT_LE(static_cast<std::size_t>(peak),
-            service::DeformOutbox::kMaxNoticeBacklogBytes +
-                2 * service::DeformOutbox::kMaxNoticeMessageBytes);
+  EXPECT_LE(static_cast<std::size_t>(peak), service::DeformOutbox::kMaxNoticeBacklogBytes +
+                                                2 * service::DeformOutbox::kMaxNoticeMessageBytes);
   stop = true;
   context.TryCancel();
   writer.join();
@@ -314,7 +311,7 @@ TEST(HostileDeployment, SecondServerOnATakenAddressExitsNonZero) {
   EXPECT_EQ(first.Wait(std::chrono::seconds(10)), std::optional<int>(0));
 }
 
-// Server reflection over a generic stream: the responses to `requests` (serialised
+// Server reflection over a generic stream: the responses to `requests` (serialized
 // ServerReflectionRequest messages), or an empty vector on failure.
 std::vector<std::string> AskReflection(const std::string& target,
                                        const std::vector<std::string>& requests) {
@@ -342,7 +339,8 @@ std::vector<std::string> AskReflection(const std::string& target,
     std::vector<grpc::Slice> slices;
     (void)reply.Dump(&slices);
     std::string bytes;
-    for (const grpc::Slice& s : slices) bytes.append(reinterpret_cast<const char*>(s.begin()), s.size());
+    for (const grpc::Slice& s : slices)
+      bytes.append(reinterpret_cast<const char*>(s.begin()), s.size());
     responses.push_back(bytes);
   }
   call->WritesDone(reinterpret_cast<void*>(4));
@@ -387,9 +385,8 @@ TEST(HostileDeployment, ReflectionDescribesTheHealthService) {
   const int port = server.WaitForListeningPort();
   ASSERT_GT(port, 0) << server.output();
   // ServerReflectionRequest: list_services = 7, file_containing_symbol = 4.
-  const std::vector<std::string> responses =
-      AskReflection("127.0.0.1:" + std::to_string(port),
-                    {Field(7, "*"), Field(4, "grpc.health.v1.Health")});
+  const std::vector<std::string> responses = AskReflection(
+      "127.0.0.1:" + std::to_string(port), {Field(7, "*"), Field(4, "grpc.health.v1.Health")});
   ASSERT_EQ(responses.size(), 2u);
   // ServerReflectionResponse.list_services_response = 6 { service = 1 { name = 1 } }.
   std::vector<std::string> names;
@@ -436,8 +433,8 @@ double SecondsToExitAfterSigterm(double grace_s, bool frozen_stream) {
   EXPECT_EQ(meshes.size(), 1u);
   if (meshes.size() != 1) return 1e9;
 
-  auto stub = v1::DeformService::NewStub(
-      grpc::CreateChannel(target, grpc::InsecureChannelCredentials()));
+  auto stub =
+      v1::DeformService::NewStub(grpc::CreateChannel(target, grpc::InsecureChannelCredentials()));
   grpc::ClientContext context;
   std::unique_ptr<grpc::ClientReaderWriter<v1::DeformRequest, v1::DeformResponse>> frozen;
   std::atomic<bool> stop{false};
@@ -479,9 +476,10 @@ TEST(HostileDeployment, SigtermExitsWithinTheGracePeriodWhateverTheClientsDo) {
   EXPECT_LT(idle, grace_s);
   const double frozen = SecondsToExitAfterSigterm(grace_s, /*frozen_stream=*/true);
   EXPECT_LT(frozen, grace_s);
-  std::printf("SIGTERM to exit 0 (grace %.0f s): %.2f s with an idle connection, %.2f s with an "
-              "idle connection and a frozen stream\n",
-              grace_s, idle, frozen);
+  std::printf(
+      "SIGTERM to exit 0 (grace %.0f s): %.2f s with an idle connection, %.2f s with an "
+      "idle connection and a frozen stream\n",
+      grace_s, idle, frozen);
 }
 
 }  // namespace

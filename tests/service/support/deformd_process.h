@@ -101,7 +101,8 @@ class DeformdProcess {
   }
 
   // Waits until the output contains `text`.
-  bool WaitForLog(const std::string& text, std::chrono::seconds timeout = std::chrono::seconds(30)) {
+  bool WaitForLog(const std::string& text,
+                  std::chrono::seconds timeout = std::chrono::seconds(30)) {
     const auto deadline = std::chrono::steady_clock::now() + timeout;
     while (std::chrono::steady_clock::now() < deadline) {
       if (output().find(text) != std::string::npos) return true;

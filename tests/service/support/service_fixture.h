@@ -71,8 +71,8 @@ class ServiceTest : public ::testing::Test {
 
   // A Deform stream of the test's on `mesh_id`, over the test's transport (the background stream
   // always runs over gRPC).
-  std::unique_ptr<client::DeformStream> OpenStream(const std::string& mesh_id,
-                                                   client::DeformClient::StreamCallbacks callbacks) {
+  std::unique_ptr<client::DeformStream> OpenStream(
+      const std::string& mesh_id, client::DeformClient::StreamCallbacks callbacks) {
     if (transport_ == Transport::kWebSocket) {
       return std::make_unique<WebSocketDeformStream>(server_->web_port(), mesh_id,
                                                      std::move(callbacks));

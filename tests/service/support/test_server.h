@@ -10,9 +10,9 @@
 #include <string>
 
 #include "deform_client.h"
+#include "service/base/service_options.h"
 #include "service/rpc/deform_server.h"
 #include "service/rpc/web_server.h"
-#include "service/base/service_options.h"
 
 namespace deform::test_support {
 

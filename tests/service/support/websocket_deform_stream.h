@@ -98,9 +98,8 @@ class WebSocketDeformStream final : public client::DeformStream {
       if (closed_ || status_.has_value()) return false;
       if (text) closed_ = true;
     }
-    boost::asio::post(io_, [this, text, bytes = std::move(bytes)]() mutable {
-      Enqueue(text, std::move(bytes));
-    });
+    boost::asio::post(
+        io_, [this, text, bytes = std::move(bytes)]() mutable { Enqueue(text, std::move(bytes)); });
     return true;
   }
 

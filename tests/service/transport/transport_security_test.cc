@@ -2,6 +2,8 @@
 // trusts its CA and refuses a plaintext client and a client trusting another CA; with a client CA
 // (mutual TLS) it refuses a client without a certificate or with one from another CA. Without a
 // certificate the server refuses to serve plaintext on a non-loopback address unless asked to.
+#include "service/transport/transport_security.h"
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -9,17 +11,16 @@
 #include <vector>
 
 #include "service/rpc/deform_server.h"
-#include "service/transport/transport_security.h"
 #include "tests/service/support/test_certificates.h"
 #include "tests/service/support/test_server.h"
 
 namespace deform {
 namespace {
 
-using ::testing::HasSubstr;
 using test_support::TestCertificates;
 using test_support::TestServer;
 using test_support::TestServerOptions;
+using ::testing::HasSubstr;
 
 service::ServerOptions TlsServerOptions(const TestCertificates& certificates, bool mutual) {
   service::ServerOptions options = TestServerOptions();
@@ -91,7 +92,8 @@ TEST(TransportSecurityTest, MutualTlsRefusesClientsWithoutACertificateFromItsCa)
             grpc::StatusCode::UNAVAILABLE);
   EXPECT_EQ(List(server, TlsClientOptions(certificates, "ca.pem", "other-client")).error_code(),
             grpc::StatusCode::UNAVAILABLE);
-  const grpc::Status with_certificate = List(server, TlsClientOptions(certificates, "ca.pem", "client"));
+  const grpc::Status with_certificate =
+      List(server, TlsClientOptions(certificates, "ca.pem", "client"));
   EXPECT_TRUE(with_certificate.ok()) << with_certificate.error_message();
 }
 

@@ -300,7 +300,7 @@ TEST(WorkerPoolTest, BackgroundWorkLeavesOneWorkerForFrameTasks) {
 
 // Urgent work that never lets up: runs, then posts itself again until stopped.
 class EndlessFrameTask final : public FrameTask,
-                                public std::enable_shared_from_this<EndlessFrameTask> {
+                               public std::enable_shared_from_this<EndlessFrameTask> {
  public:
   EndlessFrameTask(WorkerPool* pool, std::atomic<bool>* stop) : pool_(pool), stop_(stop) {}
   void RunUrgent() override {

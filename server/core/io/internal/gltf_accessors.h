@@ -19,7 +19,7 @@ struct AccessorSpec {
   std::string what;                       // for messages: "POSITION of primitive 0"
   std::initializer_list<int> types;       // TINYGLTF_TYPE_*
   std::initializer_list<int> components;  // TINYGLTF_COMPONENT_TYPE_*
-  // Integer components: kNever (indices, JOINTS), or kRequired (normalised WEIGHTS).
+  // Integer components: kNever (indices, JOINTS), or kRequired (normalized WEIGHTS).
   enum class IntegerNormalization { kNever, kRequired } integers = IntegerNormalization::kNever;
   // More elements are RESOURCE_EXHAUSTED (checked before anything is allocated).
   std::uint64_t max_count = std::numeric_limits<std::uint64_t>::max();
@@ -28,7 +28,7 @@ struct AccessorSpec {
   std::uint64_t exact_count = 0;
 };
 
-// An accessor's elements as doubles, `components` values an element, row after row. Normalised
+// An accessor's elements as doubles, `components` values an element, row after row. Normalized
 // integers are mapped to [0, 1]; floats are checked finite.
 struct AccessorValues {
   int count = 0;
@@ -42,7 +42,7 @@ struct AccessorValues {
 };
 
 // Reads accessor `index` of `model`. INVALID_ARGUMENT naming spec.what and the accessor when the
-// index, type, component type, normalisation, bufferView, stride, offset or count is not what the
+// index, type, component type, normalization, bufferView, stride, offset or count is not what the
 // spec allows or does not fit the buffer data, for sparse accessors (not supported) and for
 // non-finite floats, and for a count other than spec.exact_count; RESOURCE_EXHAUSTED beyond
 // spec.max_count.

@@ -14,8 +14,8 @@ struct FileMesh {
   Positions positions;  // #file vertices by 3, as the file holds them (floats)
   Triangles triangles;  // indices into positions
   // Per file vertex, its influences with non-zero weight: "bones" are the skin's joint indices
-  // (JOINTS_n values), weights as read (WEIGHTS_n, normalised integers mapped to [0, 1]), not
-  // normalised per vertex.
+  // (JOINTS_n values), weights as read (WEIGHTS_n, normalized integers mapped to [0, 1]), not
+  // normalized per vertex.
   SkinWeights joint_weights;
 };
 

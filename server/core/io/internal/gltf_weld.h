@@ -2,7 +2,7 @@
 // duplicates across primitives) back into one vertex each for the solve.
 //
 // Two file vertices are welded when their positions are exactly equal (the file's float values;
-// -0 equals +0) and their normalised weights name the same bones with weights within
+// -0 equals +0) and their normalized weights name the same bones with weights within
 // kWeldWeightTolerance. Copies made for a seam are bit-identical in position, so no tolerance is
 // needed there, and none risks joining vertices that are merely close. Coincident vertices with
 // different weights stay apart (the mesh is then open there, as the file's own skinning is).
@@ -29,7 +29,7 @@ struct WeldedMesh {
   std::vector<int> unused_vertices;  // the file vertices no triangle uses, ascending
 };
 
-// `positions` and `weights` (normalised: entries sorted by bone) in file order; `triangles` index
+// `positions` and `weights` (normalized: entries sorted by bone) in file order; `triangles` index
 // file vertices (in range). Welded vertices are numbered in order of first appearance in the file.
 WeldedMesh WeldSeams(const Positions& positions, const SkinWeights& weights,
                      const Triangles& triangles);

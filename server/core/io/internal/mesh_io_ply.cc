@@ -4,7 +4,7 @@
 // element count (it stops only on a stream error, and keeps appending elements); crashes on a
 // "property" line before any "element"; loops over declared counts while the input has run out;
 // reads list properties outside the face's vertex_indices/texcoord as single values
-// (desynchronising the rest); skips face properties declared before vertex_indices; and leaves a
+// (desynchronizing the rest); skips face properties declared before vertex_indices; and leaves a
 // value unread when a known property (colour, normal, ...) has a type it cannot convert. It
 // supports list counts of uchar/uint8/uint16/int only, and finds the binary body by assuming
 // exactly one newline around "end_header". So the header is parsed here, checked against what
