@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Checks the layering of the core (server/core/CMakeLists.txt) and of the service
 # (server/service/CMakeLists.txt): every #include of a core or service header points to the
-# file's own layer or one it may use, no source file sits at the top of server/service, the core
+# file's own layer or one it may use, no source file sits outside a layer's folder, the core
 # includes nothing of the service, headers under a layer's internal/ folder are included only from
 # inside that layer, the core includes no gRPC or Protobuf, and (given the deformd
 # binary and the eval library) deformd defines none of the functions the eval library defines.
@@ -11,8 +11,32 @@ cd "$(dirname "$0")/.."
 DEFORMD="${1:-}"
 EVAL_LIBRARY="${2:-}"
 
-# layer -> the layers it may include (itself included)
-declare -A ALLOWED=(
+# One layered tree: every #include "<prefix>/<layer>/..." in a file under <root>/<layer>/ must name
+# a layer that $2's table allows for the file's own layer. A file outside every layer's folder
+# fails too.
+status=0
+check_layers() {  # ROOT PREFIX TABLE-NAME (an associative array: layer -> the layers it may use)
+  local root=$1 prefix=$2 file layer target used
+  local -n allowed=$3
+  while IFS= read -r -d '' file; do
+    layer=$(echo "${file#"$root"/}" | cut -s -d/ -f1)
+    if [ -z "$layer" ] || [ -z "${allowed[$layer]+set}" ]; then
+      [ "$(basename "$file")" = CMakeLists.txt ] && continue
+      echo "check-layers: $file is in no layer of $root (its CMakeLists.txt and this script list them)"
+      status=1; continue
+    fi
+    while IFS= read -r target; do
+      used=$(echo "$target" | cut -d/ -f2)
+      case " ${allowed[$layer]} " in
+        *" $used "*) ;;
+        *) echo "check-layers: $file includes $target ($prefix/$layer may not use $used)"; status=1 ;;
+      esac
+    done < <(grep -oE "#include \"$prefix/[a-z_]+/[^\"]+\"" "$file" | sed -E 's/#include "(.*)"/\1/')
+  done < <(find "$root" \( -name '*.h' -o -name '*.cc' \) -print0 | sort -z)
+}
+
+# The core's layers (server/core/CMakeLists.txt), itself included in each.
+declare -A CORE_LAYERS=(
   [base]="base"
   [geometry]="base geometry"
   [io]="base geometry io"
@@ -21,24 +45,9 @@ declare -A ALLOWED=(
   [eval]="base geometry solver model eval"
   [codec]="base codec"
 )
-status=0
-while IFS= read -r -d '' file; do
-  layer=$(echo "$file" | cut -d/ -f3)
-  while IFS= read -r target; do
-    used=$(echo "$target" | cut -d/ -f2)
-    case " ${ALLOWED[$layer]} " in
-      *" $used "*) ;;
-      *) echo "check-layers: $file includes $target ($layer may not use $used)"; status=1 ;;
-    esac
-  done < <(grep -oE '#include "core/[a-z_]+/[^"]+"' "$file" | sed -E 's/#include "(.*)"/\1/')
-  if grep -qE '#include <(grpc|grpcpp|google/protobuf)/|\.pb\.h"' "$file"; then
-    echo "check-layers: $file (numerical core) includes gRPC or Protobuf"; status=1
-  fi
-done < <(find server/core \( -name '*.h' -o -name '*.cc' \) -print0 | sort -z)
-
-# The service's layers -> the service layers each may include (itself included); every service
-# layer may include the core and the proto.
-declare -A SERVICE_ALLOWED=(
+check_layers server/core core CORE_LAYERS
+# The service's layers (server/service/CMakeLists.txt); each may include the core and the proto.
+declare -A SERVICE_LAYERS=(
   [base]="base"
   [metrics]="base metrics"
   [access]="base access"
@@ -51,27 +60,14 @@ declare -A SERVICE_ALLOWED=(
   [deform]="base metrics access workers registry transport messages context deform"
   [rpc]="base metrics access workers registry transport messages context load deform rpc"
 )
-while IFS= read -r -d '' file; do
-  layer=$(echo "$file" | cut -d/ -f3)
-  if [ "$(echo "$file" | tr -cd / | wc -c)" -lt 3 ]; then
-    echo "check-layers: $file sits at the top of server/service (put it in a layer's folder)"
-    status=1; continue
-  fi
-  if [ -z "${SERVICE_ALLOWED[$layer]+set}" ]; then
-    echo "check-layers: $file is in server/service/$layer, which is no layer" \
-      "(server/service/CMakeLists.txt and this script list them)"; status=1; continue
-  fi
-  while IFS= read -r target; do
-    used=$(echo "$target" | cut -d/ -f2)
-    case " ${SERVICE_ALLOWED[$layer]} " in
-      *" $used "*) ;;
-      *) echo "check-layers: $file includes $target (service/$layer may not use $used)"; status=1 ;;
-    esac
-  done < <(grep -oE '#include "service/[^"]+"' "$file" | sed -E 's/#include "(.*)"/\1/')
-done < <(find server/service \( -name '*.h' -o -name '*.cc' \) -print0 | sort -z)
+check_layers server/service service SERVICE_LAYERS
+
+# The numerical core: no gRPC, no Protobuf, nothing of the service.
 while IFS= read -r hit; do
-  echo "check-layers: ${hit%%:*} (numerical core) includes the service: ${hit#*:}"; status=1
-done < <(grep -rnE '#include "service/' server/core 2>/dev/null || true)
+  echo "check-layers: ${hit%%:*} (numerical core) includes gRPC, Protobuf or the service: ${hit#*:}"
+  status=1
+done < <(grep -rnE '#include <(grpc|grpcpp|google/protobuf)/|\.pb\.h"|#include "service/' \
+  server/core 2>/dev/null || true)
 
 # internal/ headers: only from their own layer's folder.
 while IFS= read -r hit; do
