@@ -42,7 +42,8 @@ declare -A CORE_LAYERS=(
   [io]="base geometry io"
   [solver]="base solver"
   [model]="base geometry solver model"
-  [eval]="base geometry solver model eval"
+  [constraints]="base geometry solver model constraints"
+  [eval]="base geometry solver model constraints eval"
   [codec]="base codec"
 )
 check_layers server/core core CORE_LAYERS

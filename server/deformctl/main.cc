@@ -2,6 +2,8 @@
 //
 //   deformctl deform [--mesh FILE --skeleton FILE [--weights FILE] | --mesh RIG.glb] --pose SPEC
 //                    [--method paper|paper-linear|laplacian|lbs|dqs] [--out FILE] [--repeat N]
+//                    [--bone-surface FILE:BONE ...] [--bones input|capsules|none]
+//                    [--contacts on|off] [--volume on|off] [--out-bones DIR]
 //   deformctl phantom --out FILE [--skeleton-out FILE] [--vertices N]
 //
 // Prints one JSON object on stdout; errors are one line on stderr and a non-zero exit code.
@@ -10,11 +12,16 @@
 #include <CLI/CLI.hpp>
 #include <fstream>
 #include <iostream>
+#include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "core/base/build_info.h"
+#include "core/constraints/skin_constraints.h"
 #include "core/eval/method_comparison.h"
+#include "core/io/bone_surface_io.h"
 #include "core/io/mesh_io.h"
 #include "core/io/model_input.h"
 #include "core/io/phantom.h"
@@ -36,6 +43,12 @@ struct DeformArgs {
   int repeat = 1;
   double radius_factor = 1.5;
   std::string ordering = "auto";
+  std::vector<std::string> bone_surfaces;  // FILE:BONE
+  std::string bones = "input";
+  bool contacts = true;
+  bool volume = true;
+  std::string out_bones_dir;
+  int bone_surface_count = 0;  // set once they are loaded
 };
 
 struct PhantomArgs {
@@ -78,6 +91,30 @@ nlohmann::ordered_json BindingJson(const deform::BindingReport& report) {
   return out;
 }
 
+// The bone surfaces of the run: the input's own (the phantom's), capsules made by the sizing rule
+// (MakeCapsuleBoneSurfaces), or none, and then every --bone-surface file.
+StatusOr<std::vector<deform::BoneSurface>> BoneSurfacesFrom(const DeformArgs& args,
+                                                            const deform::ModelInput& input) {
+  std::vector<deform::BoneSurface> surfaces;
+  if (args.bones == "input") {
+    surfaces = input.bones;
+  } else if (args.bones == "capsules") {
+    surfaces = deform::MakeCapsuleBoneSurfaces(input.mesh, input.skeleton);
+  } else if (args.bones != "none") {
+    return Status::InvalidArgument("--bones must be input, capsules or none");
+  }
+  for (const std::string& spec : args.bone_surfaces) {
+    DEFORM_ASSIGN_OR_RETURN(deform::BoneSurface surface,
+                            deform::LoadBoneSurfaceSpec(spec, input.skeleton));
+    surfaces.push_back(std::move(surface));
+  }
+  return surfaces;
+}
+
+nlohmann::ordered_json PenetrationJson(const deform::PenetrationSummary& summary) {
+  return {{"vertices", summary.vertices}, {"max_depth", summary.max_depth}};
+}
+
 nlohmann::ordered_json DeformReport(const DeformArgs& args, const deform::ModelInput& input,
                                     const deform::DeformationModel& model, deform::Method method,
                                     const deform::MethodRun& run, int clamped) {
@@ -98,6 +135,22 @@ nlohmann::ordered_json DeformReport(const DeformArgs& args, const deform::ModelI
   out["sink_fraction"] = q.clearance.sink_fraction;
   out["rigid_zone_error"] = q.rigid_zone_error;
   out["max_displacement"] = q.max_displacement;
+  out["bone_surfaces"] = args.bone_surface_count;
+  if (args.bone_surface_count > 0) out["bone_penetration"] = PenetrationJson(q.bone_penetration);
+  if (run.constraints.rounds > 0 || method == deform::Method::kPaper ||
+      method == deform::Method::kPaperLinear) {
+    const deform::ConstraintReport& c = run.constraints;
+    out["constraints"] = {{"contacts", args.contacts},
+                          {"volume", args.volume},
+                          {"penetration_before", PenetrationJson(c.before)},
+                          {"active_contacts", c.contacts},
+                          {"rounds", c.rounds},
+                          {"solves", c.solves},
+                          {"unit_solves", c.unit_solves},
+                          {"unresolved", c.unresolved},
+                          {"volume_change_before", c.volume_change_before},
+                          {"ms", run.constraint_seconds * 1e3}};
+  }
   out["precompute_ms"] = run.precompute_seconds * 1e3;
   out["factor_ms"] = run.factor_seconds * 1e3;
   out["factor_bytes"] = run.factor_bytes;
@@ -108,7 +161,7 @@ nlohmann::ordered_json DeformReport(const DeformArgs& args, const deform::ModelI
   return out;
 }
 
-int RunDeform(const DeformArgs& args) {
+int RunDeform(DeformArgs args) {
   auto method = deform::MethodFromName(args.method);
   if (!method.ok()) return Fail(method.status());
   auto options = ModelOptionsFrom(args);
@@ -125,8 +178,30 @@ int RunDeform(const DeformArgs& args) {
       deform::DeformationModel::Build(input->mesh, input->skeleton, *options,
                                       input->weights.has_value() ? &*input->weights : nullptr);
   if (!model.ok()) return Fail(model.status());
-  auto run = deform::RunMethod(**model, *method, pose, args.repeat);
+  auto surfaces = BoneSurfacesFrom(args, *input);
+  if (!surfaces.ok()) return Fail(surfaces.status());
+  args.bone_surface_count = static_cast<int>(surfaces->size());
+  std::shared_ptr<const deform::BoneContacts> bones;
+  if (!surfaces->empty()) {
+    auto made = deform::BoneContacts::Create(*surfaces, input->skeleton, input->mesh,
+                                             (*model)->rigid_bones());
+    if (!made.ok()) return Fail(made.status());
+    bones = *made;
+  }
+  deform::ConstraintOptions constraint_options;
+  constraint_options.keep_volume = args.volume;
+  if (!args.contacts) constraint_options.max_contacts = 0;
+  auto constraints = deform::SkinConstraints::Create(**model, bones, constraint_options);
+  if (!constraints.ok()) return Fail(constraints.status());
+  auto run = deform::RunMethod(**model, *method, pose, args.repeat, constraints->get());
   if (!run.ok()) return Fail(run.status());
+  if (!args.out_bones_dir.empty()) {
+    std::vector<deform::RigidTransform> transforms;
+    deform::ForwardKinematics(input->skeleton, pose, &transforms);
+    const Status written =
+        deform::WritePosedBoneSurfaces(*surfaces, input->skeleton, transforms, args.out_bones_dir);
+    if (!written.ok()) return Fail(written);
+  }
   if (!args.out_path.empty()) {
     const Status written =
         deform::WriteMeshFile({run->posed, input->mesh.triangles}, args.out_path);
@@ -157,6 +232,9 @@ int RunPhantom(const PhantomArgs& args) {
   std::cout << out.dump() << std::endl;
   return 0;
 }
+
+// "on" and "off" for a boolean option.
+std::map<std::string, bool> OnOff() { return {{"on", true}, {"off", false}}; }
 
 // An option whose default --help shows.
 template <typename T>
@@ -194,6 +272,24 @@ CLI::App* AddDeformCommand(CLI::App* app, DeformArgs* args) {
                  "Joint region radius in limb radii");
   AddWithDefault(command, "--ordering", &args->ordering,
                  "Fill-reducing ordering: auto | metis | amd | natural");
+  command->add_option("--bone-surface", args->bone_surfaces,
+                      "A bone surface FILE:BONE (a closed mesh file, .obj .ply .stl .off, carried "
+                      "by BONE: an index, HEAD-TAIL, or the joint it starts at); repeatable");
+  AddWithDefault(command, "--bones", &args->bones,
+                 "Bone surfaces besides --bone-surface: input (the phantom's femur, tibia and "
+                 "patella) | capsules (one per bone, sized by the skin) | none");
+  command
+      ->add_option("--contacts", args->contacts,
+                   "on | off: keep the skin outside the bone surfaces (paper, paper-linear)")
+      ->transform(CLI::CheckedTransformer(OnOff()))
+      ->default_str("on");
+  command
+      ->add_option("--volume", args->volume,
+                   "on | off: keep the skin's enclosed volume (paper, paper-linear)")
+      ->transform(CLI::CheckedTransformer(OnOff()))
+      ->default_str("on");
+  command->add_option("--out-bones", args->out_bones_dir,
+                      "Write each bone surface, posed, as DIR/NAME.obj");
   return command;
 }
 

@@ -52,9 +52,14 @@ StatusOr<std::shared_ptr<const DeformationModel>> VariantFor(const DeformationMo
                                  weights.has_value() ? &*weights : nullptr);
 }
 
-// Paper, paper-linear and laplacian: `repeat` frames of the model's Deform().
+bool Constrained(Method method) {
+  return method == Method::kPaper || method == Method::kPaperLinear;
+}
+
+// Paper, paper-linear and laplacian: `repeat` frames of the model's Deform(), constrained (paper
+// and paper-linear) when `constraints` are given.
 Status RunSolvingMethod(const DeformationModel& paper_model, Method method, const Pose& pose,
-                        int repeat, MethodRun* run) {
+                        int repeat, const SkinConstraints* constraints, MethodRun* run) {
   DEFORM_ASSIGN_OR_RETURN(const std::shared_ptr<const DeformationModel> variant,
                           VariantFor(paper_model, method));
   const DeformationModel& model = variant ? *variant : paper_model;
@@ -67,15 +72,33 @@ Status RunSolvingMethod(const DeformationModel& paper_model, Method method, cons
   }
   run->joint_nodes = model.num_joint_nodes();
   run->anchors = static_cast<int>(model.anchor_vertices().size());
+  // The variant solves with its own factorization, so it needs constraints of its own.
+  std::shared_ptr<const SkinConstraints> variant_constraints;
+  if (constraints != nullptr && !Constrained(method)) constraints = nullptr;
+  if (constraints != nullptr && variant) {
+    DEFORM_ASSIGN_OR_RETURN(
+        variant_constraints,
+        SkinConstraints::Create(model, constraints->bones_shared(), constraints->options()));
+    constraints = variant_constraints.get();
+  }
   DeformScratch scratch = model.MakeScratch();
-  std::vector<double> solve_seconds;
+  ConstraintScratch constraint_scratch;
+  if (constraints != nullptr) constraint_scratch = constraints->MakeScratch();
+  std::vector<double> solve_seconds, constraint_seconds;
   solve_seconds.reserve(repeat);
+  constraint_seconds.reserve(repeat);
   run->frame_seconds = Median(TimeFrames(repeat, [&] {
     DeformTimings timings;
     model.Deform(factorization, pose, &scratch, &timings);
     solve_seconds.push_back(timings.solve);
+    if (constraints != nullptr) {
+      const auto start = Clock::now();
+      constraints->Apply(factorization, &scratch, &constraint_scratch, &run->constraints);
+      constraint_seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
+    }
   }));
   run->solve_seconds = Median(solve_seconds);
+  if (!constraint_seconds.empty()) run->constraint_seconds = Median(constraint_seconds);
   run->posed = scratch.positions();
   return Status::Ok();
 }
@@ -132,11 +155,11 @@ StatusOr<MethodRun> RunMethod(const TriangleMesh& mesh, const Skeleton& skeleton
 }
 
 StatusOr<MethodRun> RunMethod(const DeformationModel& paper_model, Method method, const Pose& pose,
-                              int repeat) {
+                              int repeat, const SkinConstraints* constraints) {
   repeat = std::max(1, repeat);
   MethodRun run;
   if (Solves(method)) {
-    DEFORM_RETURN_IF_ERROR(RunSolvingMethod(paper_model, method, pose, repeat, &run));
+    DEFORM_RETURN_IF_ERROR(RunSolvingMethod(paper_model, method, pose, repeat, constraints, &run));
   } else {
     RunSkinningMethod(paper_model, method, pose, repeat, &run);
   }
@@ -145,7 +168,8 @@ StatusOr<MethodRun> RunMethod(const DeformationModel& paper_model, Method method
   Positions skinned;
   LinearBlendSkinning(paper_model.mesh().vertices, paper_model.bone_weights(), bones, &skinned);
   run.quality = MeasureQuality(paper_model.mesh(), run.posed, paper_model.skeleton(), bones,
-                               skinned, paper_model.rigid_bones());
+                               skinned, paper_model.rigid_bones(),
+                               constraints != nullptr ? constraints->bones() : nullptr);
   return run;
 }
 

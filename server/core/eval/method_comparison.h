@@ -6,6 +6,7 @@
 #include <memory>
 #include <string_view>
 
+#include "core/constraints/skin_constraints.h"
 #include "core/eval/quality.h"
 #include "core/model/deformation_model.h"
 
@@ -40,6 +41,10 @@ struct MethodRun {
   double frame_seconds = 0;
   int joint_nodes = 0;
   int anchors = 0;
+  // With constraints (paper and paper-linear): what they did to the last frame, and the median
+  // seconds of applying them (part of frame_seconds).
+  ConstraintReport constraints;
+  double constraint_seconds = 0;
 };
 
 // Builds what `method` needs (the paper's model for its weights, regions and anchors, plus the
@@ -50,7 +55,10 @@ StatusOr<MethodRun> RunMethod(const TriangleMesh& mesh, const Skeleton& skeleton
                               const ModelOptions& paper_options = ModelOptions::Paper());
 
 // As above, on an already built paper model (the comparison reuses it across methods and poses).
+// `constraints` (may be null) were made for `paper_model`: paper and paper-linear frames are
+// constrained with them (the default method's frame), and every method's frame is measured
+// against their bone surfaces.
 StatusOr<MethodRun> RunMethod(const DeformationModel& paper_model, Method method, const Pose& pose,
-                              int repeat = 1);
+                              int repeat = 1, const SkinConstraints* constraints = nullptr);
 
 }  // namespace deform

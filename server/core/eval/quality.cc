@@ -41,7 +41,8 @@ ClearanceStats SkinClearance(const Positions& rest, const Positions& posed,
 
 QualityReport MeasureQuality(const TriangleMesh& rest_mesh, const Positions& posed,
                              const Skeleton& skeleton, const std::vector<RigidTransform>& bones,
-                             const Positions& skinned, const std::vector<int>& rigid_bone) {
+                             const Positions& skinned, const std::vector<int>& rigid_bone,
+                             const BoneContacts* bone_surfaces) {
   QualityReport report;
   const double diagonal = BoundingBoxDiagonal(rest_mesh.vertices);
   const double rest_volume = EnclosedVolume(rest_mesh.vertices, rest_mesh.triangles);
@@ -53,6 +54,7 @@ QualityReport MeasureQuality(const TriangleMesh& rest_mesh, const Positions& pos
         std::max(report.rigid_zone_error, (posed.row(i) - skinned.row(i)).norm() / diagonal);
   }
   report.max_displacement = (posed - rest_mesh.vertices).rowwise().norm().maxCoeff() / diagonal;
+  if (bone_surfaces != nullptr) report.bone_penetration = bone_surfaces->Measure(posed, bones);
   return report;
 }
 

@@ -3,6 +3,7 @@
 
 #include <vector>
 
+#include "core/constraints/bone_contacts.h"
 #include "core/geometry/enclosed_volume.h"
 #include "core/geometry/mesh.h"
 #include "core/geometry/pose.h"
@@ -30,14 +31,17 @@ struct QualityReport {
   double rigid_zone_error = 0;
   // max over all vertices of |x_i - v_i| / bounding-box diagonal (meaningful for the rest pose).
   double max_displacement = 0;
+  // Skin vertices inside a bone surface and the deepest (model units); zero without bones.
+  PenetrationSummary bone_penetration;
 };
 
-// All measures at once.
+// All measures at once; the bone penetration when `bone_surfaces` is given.
 // `skinned` is linear blend skinning of the same pose with the model's own weights; the rigid-zone
 // error is the largest distance from it of the vertices with rigid_bone[i] >= 0 (those that follow
 // one bone alone), relative to the rest mesh's bounding-box diagonal.
 QualityReport MeasureQuality(const TriangleMesh& rest_mesh, const Positions& posed,
                              const Skeleton& skeleton, const std::vector<RigidTransform>& bones,
-                             const Positions& skinned, const std::vector<int>& rigid_bone);
+                             const Positions& skinned, const std::vector<int>& rigid_bone,
+                             const BoneContacts* bone_surfaces = nullptr);
 
 }  // namespace deform

@@ -202,14 +202,21 @@ bool TriangleBvh::Contains(const Eigen::Vector3d& point) const {
 }
 
 double TriangleBvh::DistanceToSurface(const Eigen::Vector3d& point) const {
-  double best = std::numeric_limits<double>::infinity();
+  return ClosestPoint(point).distance;
+}
+
+TriangleBvh::SurfacePoint TriangleBvh::ClosestPoint(const Eigen::Vector3d& point) const {
+  SurfacePoint best;
+  best.distance = std::numeric_limits<double>::infinity();
   if (triangles_.rows() == 0) return best;
   std::array<int, kMaxDepth> stack;
   int top = 0;
   stack[top++] = 0;
   while (top > 0) {
     const Node& node = nodes_[stack[--top]];
-    if (SquaredDistanceToBox(point, node.lower, node.upper) >= best * best) continue;
+    if (SquaredDistanceToBox(point, node.lower, node.upper) >= best.distance * best.distance) {
+      continue;
+    }
     if (node.count > 0) {
       for (int p = node.first; p < node.first + node.count; ++p) {
         const int f = order_[p];
@@ -217,7 +224,8 @@ double TriangleBvh::DistanceToSurface(const Eigen::Vector3d& point) const {
             ClosestPointOnTriangle(point, positions_.row(triangles_(f, 0)).transpose(),
                                    positions_.row(triangles_(f, 1)).transpose(),
                                    positions_.row(triangles_(f, 2)).transpose());
-        best = std::min(best, (closest - point).norm());
+        const double distance = (closest - point).norm();
+        if (distance < best.distance) best = {closest, f, distance};
       }
     } else {
       // Nearer child last, so it is popped first.
@@ -230,6 +238,13 @@ double TriangleBvh::DistanceToSurface(const Eigen::Vector3d& point) const {
     }
   }
   return best;
+}
+
+Eigen::Vector3d TriangleBvh::TriangleNormal(int f) const {
+  const Eigen::Vector3d a = positions_.row(triangles_(f, 0)).transpose();
+  const Eigen::Vector3d b = positions_.row(triangles_(f, 1)).transpose();
+  const Eigen::Vector3d c = positions_.row(triangles_(f, 2)).transpose();
+  return (b - a).cross(c - a).normalized();
 }
 
 }  // namespace deform

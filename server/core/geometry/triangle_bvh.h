@@ -37,6 +37,22 @@ class TriangleBvh {
   // The smallest distance from `point` to the surface (exact, by descending the tree).
   double DistanceToSurface(const Eigen::Vector3d& point) const;
 
+  // The point of the surface nearest to `point`, the triangle it lies on and its distance
+  // (exact, by descending the tree). For an empty mesh: triangle -1, distance infinity.
+  struct SurfacePoint {
+    Eigen::Vector3d point = Eigen::Vector3d::Zero();
+    int triangle = -1;
+    double distance = 0;
+  };
+  SurfacePoint ClosestPoint(const Eigen::Vector3d& point) const;
+  // The unit normal of triangle f, by its winding (counter-clockwise seen from outside for an
+  // outward-oriented mesh).
+  Eigen::Vector3d TriangleNormal(int f) const;
+
+  // The box of every triangle.
+  const Eigen::Vector3d& lower() const { return nodes_.front().lower; }
+  const Eigen::Vector3d& upper() const { return nodes_.front().upper; }
+
  private:
   struct Node {
     Eigen::Vector3d lower;

@@ -19,6 +19,7 @@ StatusOr<ModelInput> LoadPhantom(int phantom_vertices, const MeshLimits& limits)
   ModelInput input;
   input.mesh = std::move(phantom.mesh);
   input.skeleton = std::move(phantom.skeleton);
+  input.bones = std::move(phantom.bones);
   input.description = "phantom:" + std::to_string(phantom_vertices);
   return input;
 }

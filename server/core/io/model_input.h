@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/base/status.h"
+#include "core/geometry/bone_surface.h"
 #include "core/geometry/mesh.h"
 #include "core/geometry/skeleton.h"
 #include "core/geometry/skin_weights.h"
@@ -25,6 +26,8 @@ struct ModelInput {
   std::string units;        // "metre" for glTF; empty when the file does not say (OBJ...)
   std::string up_axis;      // "+Y" for glTF; empty when the file does not say
   std::string description;  // "phantom:2000" or the mesh path, for logs
+  // Bone surfaces that came with the input: the phantom's femur, tibia and patella.
+  std::vector<BoneSurface> bones;
 };
 
 // With an empty `mesh_path`, the knee phantom at `phantom_vertices` (the other paths must be empty

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <string>
 
+#include "core/geometry/primitive_surfaces.h"
+
 namespace deform {
 namespace {
 
@@ -108,6 +110,24 @@ Triangles PhantomTriangles(int rings, int segments) {
   return triangles;
 }
 
+// The femur and the tibia as capsules by MakeCapsuleBoneSurfaces' sizing rule, and a patella in
+// front of the knee: an ellipsoid (0.15 wide, 0.17 high, 0.07 thick) centred 0.32 in front of the
+// knee centre, 0.1 above it (the kneecap bump of the skin), turning by half the knee's rotation
+// about its centre, as the patella tracks the femoral groove while the tibia rolls.
+std::vector<BoneSurface> PhantomBones(const TriangleMesh& skin, const Skeleton& skeleton) {
+  std::vector<BoneSurface> bones = MakeCapsuleBoneSurfaces(skin, skeleton);
+  for (BoneSurface& bone : bones) bone.name = bone.bone == 0 ? "femur" : "tibia";
+  BoneSurface patella;
+  patella.name = "patella";
+  patella.bone = 0;
+  patella.blend_bone = 1;
+  patella.blend = 0.5;
+  patella.mesh = MakeEllipsoid(Eigen::Vector3d(0, kKneeY + 0.1, 0.32),
+                               Eigen::Vector3d(0.15, 0.17, 0.07).asDiagonal(), 16, 8);
+  bones.push_back(std::move(patella));
+  return bones;
+}
+
 }  // namespace
 
 StatusOr<KneePhantom> MakeKneePhantom(int target_vertices) {
@@ -125,6 +145,7 @@ StatusOr<KneePhantom> MakeKneePhantom(int target_vertices) {
   phantom.mesh.vertices = PhantomVertices(rings, segments);
   phantom.mesh.triangles = PhantomTriangles(rings, segments);
   DEFORM_ASSIGN_OR_RETURN(phantom.skeleton, PhantomSkeleton());
+  phantom.bones = PhantomBones(phantom.mesh, phantom.skeleton);
   return phantom;
 }
 

@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "internal/row_pattern.h"
+#include "internal/unit_solve.h"
 
 namespace deform {
 namespace {
@@ -232,6 +233,19 @@ Status CholeskyFactor::SolveFramesParallel(const ParallelSolvePlan& plan, const 
   DEFORM_RETURN_IF_ERROR(CheckFrameCount(frames));
   ParallelSolveFrames(View(), plan, kernel, b, x, frames, work, runner);
   return Status::Ok();
+}
+
+int CholeskyFactor::ForwardUnitSolve(int i, int* path, double* values, std::int64_t max_values,
+                                     double* work) const {
+  return deform::ForwardUnitSolve(View(), i, path, values, max_values, work);
+}
+
+void CholeskyFactor::LongestUnitSolvePath(std::int64_t* columns, int* supernodes) const {
+  deform::LongestUnitSolvePath(View(), columns, supernodes);
+}
+
+int CholeskyFactor::SupernodeWidth(int s) const {
+  return symbolic_->supernode_columns_[s + 1] - symbolic_->supernode_columns_[s];
 }
 
 SupernodalFactorView CholeskyFactor::View() const {

@@ -95,6 +95,19 @@ class CholeskyFactor {
   // Non-zeros of L (the explicit zeros of the supernodes' diagonal blocks not counted).
   std::int64_t nonzeros() const { return symbolic_ ? symbolic_->factor_nonzeros() : 0; }
 
+  // The forward pass for the unit right-hand side e_i: y = L^-1 P e_i, which is non-zero only on
+  // the columns of the supernodes from the one holding i's column to the root (a path of the
+  // elimination tree), so that (A^-1)_ij = y_i . y_j costs a path, not a solve. Writes the path's
+  // supernodes, ascending, into `path` and y on their columns, concatenated in that order, into
+  // `values`; returns the path's length, or -1 when y holds more than `max_values` values.
+  // `work`: size() doubles, zero on entry and left zero. Allocation-free; const and thread-safe.
+  int ForwardUnitSolve(int i, int* path, double* values, std::int64_t max_values,
+                       double* work) const;
+  // The most columns and the most supernodes on one path (what ForwardUnitSolve may write).
+  void LongestUnitSolvePath(std::int64_t* columns, int* supernodes) const;
+  // Supernode s's columns (in the factor's order): [first, first + width).
+  int SupernodeWidth(int s) const;
+
  private:
   using ColMajorMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
   // L column by column before it is packed: per column the diagonal first, then rows ascending.

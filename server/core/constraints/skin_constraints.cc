@@ -1,0 +1,336 @@
+#include "core/constraints/skin_constraints.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <utility>
+
+namespace deform {
+namespace {
+
+using Vec3 = Eigen::Map<const Eigen::Vector3d>;
+
+// Solves the q-square symmetric positive semi-definite system `a` (row-major, stride `stride`,
+// overwritten by its Cholesky factor) for `x` in place. Pivots are regularised by a tiny multiple
+// of the largest diagonal entry, so a degenerate set (two contacts on one vertex's plane) still
+// gives a solution. No allocation.
+void SolveSymmetric(double* a, int q, int stride, double* x) {
+  double largest = 0;
+  for (int i = 0; i < q; ++i) largest = std::max(largest, a[i * stride + i]);
+  const double floor = 1e-12 * std::max(largest, 1e-300);
+  for (int j = 0; j < q; ++j) {
+    double d = a[j * stride + j];
+    for (int p = 0; p < j; ++p) d -= a[j * stride + p] * a[j * stride + p];
+    d = std::sqrt(std::max(d, floor));
+    a[j * stride + j] = d;
+    for (int i = j + 1; i < q; ++i) {
+      double v = a[i * stride + j];
+      for (int p = 0; p < j; ++p) v -= a[i * stride + p] * a[j * stride + p];
+      a[i * stride + j] = v / d;
+    }
+  }
+  for (int i = 0; i < q; ++i) {
+    double v = x[i];
+    for (int p = 0; p < i; ++p) v -= a[i * stride + p] * x[p];
+    x[i] = v / a[i * stride + i];
+  }
+  for (int i = q - 1; i >= 0; --i) {
+    double v = x[i];
+    for (int p = i + 1; p < q; ++p) v -= a[p * stride + i] * x[p];
+    x[i] = v / a[i * stride + i];
+  }
+}
+
+// A model's factorization always has a factor, and the column counts are in range: its solves
+// cannot refuse.
+void Solved(const Status& status) {
+  assert(status.ok());
+  (void)status;
+}
+
+double Dot(const double* a, const double* b, std::size_t count) {
+  double sum = 0;
+  for (std::size_t i = 0; i < count; ++i) sum += a[i] * b[i];
+  return sum;
+}
+
+}  // namespace
+
+StatusOr<std::shared_ptr<const SkinConstraints>> SkinConstraints::Create(
+    const DeformationModel& model, std::shared_ptr<const BoneContacts> bones,
+    const ConstraintOptions& options) {
+  if (!(options.contact_margin >= 0 && options.contact_margin < 1)) {
+    return Status::InvalidArgument("contact_margin must be in [0, 1)");
+  }
+  if (options.max_contacts < 0 || options.max_contacts > ConstraintOptions::kMaxContacts) {
+    return Status::InvalidArgument("max_contacts must be in [0, " +
+                                   std::to_string(ConstraintOptions::kMaxContacts) + "]");
+  }
+  if (!(options.volume_tolerance > 0 && options.volume_tolerance < 1)) {
+    return Status::InvalidArgument("volume_tolerance must be in (0, 1)");
+  }
+  if (options.max_rounds < 1 || options.max_rounds > 16) {
+    return Status::InvalidArgument("max_rounds must be in [1, 16]");
+  }
+  std::shared_ptr<SkinConstraints> constraints(new SkinConstraints());
+  constraints->model_ = &model;
+  constraints->bones_ = std::move(bones);
+  constraints->options_ = options;
+  const TriangleMesh& mesh = model.mesh();
+  constraints->rows_ = mesh.num_vertices() + model.num_joint_nodes();
+  constraints->margin_ = options.contact_margin * model.bounding_box_diagonal();
+  constraints->closure_ = std::make_unique<VolumeClosure>(mesh.triangles, mesh.num_vertices());
+  constraints->rest_volume_ = constraints->closure_->Volume(mesh.vertices.data());
+  // The volume is the skin's between its rigid zones: a rigid zone follows its bone, so its
+  // vertices carry no share of the correction.
+  constraints->volume_free_.resize(mesh.num_vertices());
+  bool any_free = false;
+  for (int i = 0; i < mesh.num_vertices(); ++i) {
+    constraints->volume_free_[i] = model.rigid_bones()[i] < 0;
+    any_free = any_free || constraints->volume_free_[i];
+  }
+  const double cube = std::pow(model.bounding_box_diagonal(), 3);
+  if (constraints->bones_ != nullptr) {
+    model.default_factorization()->factor().LongestUnitSolvePath(&constraints->path_columns_,
+                                                                 &constraints->path_supernodes_);
+  }
+  constraints->keeps_volume_ =
+      options.keep_volume && any_free && std::abs(constraints->rest_volume_) > 1e-9 * cube;
+  return std::shared_ptr<const SkinConstraints>(std::move(constraints));
+}
+
+ConstraintScratch SkinConstraints::MakeScratch() const {
+  ConstraintScratch s;
+  s.owner = this;
+  const std::size_t rows = rows_;
+  const std::size_t k = options_.max_contacts;
+  s.base.resize(3 * rows);
+  s.correction.resize(3 * rows);
+  if (keeps_volume_) {
+    s.gradient.resize(3 * rows);
+    s.h.resize(3 * rows);
+  }
+  if (bones_ != nullptr && k > 0) {
+    s.unit_work.assign(rows, 0.0);
+    s.paths.resize(k * path_supernodes_);
+    s.path_lengths.resize(k);
+    s.path_values.resize(k * path_columns_);
+    s.found.resize(k);
+    s.contacts.resize(k);
+    s.inverse_block.resize(k * k);
+    s.in_set.assign(model_->mesh().num_vertices(), 0);
+  }
+  s.solve_work.resize(model_->default_factorization()->factor().WorkSize());
+  s.system.resize((k + 1) * (k + 1));
+  s.multipliers.resize(k + 1);
+  return s;
+}
+
+std::size_t SkinConstraints::ScratchBytes() const {
+  const std::size_t rows = rows_;
+  const std::size_t k = options_.max_contacts;
+  std::size_t doubles =
+      6 * rows + (k + 1) * (k + 2) + model_->default_factorization()->factor().WorkSize();
+  std::size_t bytes = 0;
+  if (keeps_volume_) doubles += 6 * rows;
+  if (bones_ != nullptr && k > 0) {
+    doubles += rows + k * path_columns_ + k * k;
+    bytes += (k * path_supernodes_ + k) * sizeof(int) + 2 * k * sizeof(BonePenetration) +
+             model_->mesh().num_vertices();
+  }
+  return bytes + doubles * sizeof(double);
+}
+
+double SkinConstraints::PathDot(const CholeskyFactor& factor, const ConstraintScratch& s, int l,
+                                int j) const {
+  const int* pl = s.paths.data() + static_cast<std::size_t>(l) * path_supernodes_;
+  const int* pj = s.paths.data() + static_cast<std::size_t>(j) * path_supernodes_;
+  const double* vl = s.path_values.data() + static_cast<std::size_t>(l) * path_columns_;
+  const double* vj = s.path_values.data() + static_cast<std::size_t>(j) * path_columns_;
+  const int nl = s.path_lengths[l], nj = s.path_lengths[j];
+  // Both paths run up to the root in ascending supernodes: merge them.
+  double dot = 0;
+  for (int a = 0, b = 0; a < nl && b < nj;) {
+    if (pl[a] < pj[b]) {
+      vl += factor.SupernodeWidth(pl[a++]);
+    } else if (pj[b] < pl[a]) {
+      vj += factor.SupernodeWidth(pj[b++]);
+    } else {
+      const int width = factor.SupernodeWidth(pl[a]);
+      dot += Dot(vl, vj, width);
+      vl += width;
+      vj += width;
+      ++a;
+      ++b;
+    }
+  }
+  return dot;
+}
+
+void SkinConstraints::AddContacts(const CholeskyFactor& factor, int count, ConstraintScratch* s,
+                                  ConstraintReport* report) const {
+  const std::size_t k = options_.max_contacts;
+  int& set = report->contacts;
+  for (int c = 0; c < count; ++c) {
+    const int j = set++;
+    s->contacts[j] = s->found[c];
+    s->in_set[s->found[c].vertex] = 1;
+    const int length = factor.ForwardUnitSolve(
+        s->found[c].vertex, s->paths.data() + j * static_cast<std::size_t>(path_supernodes_),
+        s->path_values.data() + j * static_cast<std::size_t>(path_columns_), path_columns_,
+        s->unit_work.data());
+    assert(length > 0);  // path_columns_ is the longest path's
+    s->path_lengths[j] = length;
+    ++report->unit_solves;
+    for (int l = 0; l <= j; ++l) {
+      const double v = PathDot(factor, *s, l, j);
+      s->inverse_block[l * k + j] = v;
+      s->inverse_block[j * k + l] = v;
+    }
+  }
+}
+
+void SkinConstraints::MoveContact(int from, int to, int set, ConstraintScratch* s) const {
+  const std::size_t k = options_.max_contacts;
+  s->contacts[to] = s->contacts[from];
+  std::copy_n(s->paths.begin() + from * static_cast<std::size_t>(path_supernodes_),
+              s->path_lengths[from],
+              s->paths.begin() + to * static_cast<std::size_t>(path_supernodes_));
+  std::copy_n(s->path_values.begin() + from * static_cast<std::size_t>(path_columns_),
+              path_columns_, s->path_values.begin() + to * static_cast<std::size_t>(path_columns_));
+  s->path_lengths[to] = s->path_lengths[from];
+  for (int l = 0; l < set; ++l) s->inverse_block[to * k + l] = s->inverse_block[from * k + l];
+  for (int l = 0; l < set; ++l) s->inverse_block[l * k + to] = s->inverse_block[l * k + from];
+  s->inverse_block[to * k + to] = s->inverse_block[from * k + from];
+}
+
+bool SkinConstraints::Apply(const MaterialFactorization& factorization, DeformScratch* frame,
+                            ConstraintScratch* s, ConstraintReport* report) const {
+  *report = {};
+  if (!model_->Owns(factorization, *frame) || s->owner != this) return false;
+  const CholeskyFactor& factor = factorization.factor();
+  const std::size_t values = 3 * static_cast<std::size_t>(rows_);
+  const int n = model_->mesh().num_vertices();
+  const int k_max = options_.max_contacts;
+  double* x = frame->solution.data();
+  std::copy(x, x + values, s->base.begin());
+  auto volume_change = [&](double volume) {
+    return rest_volume_ != 0 ? volume / rest_volume_ - 1 : 0.0;
+  };
+  int& set = report->contacts;
+  for (int round = 0;; ++round) {
+    PenetrationSummary summary;
+    int found = 0;
+    if (bones_ != nullptr) {
+      found = bones_->Find(x, frame->bone_transforms, s->found.data(), k_max - set, &summary,
+                           s->in_set.empty() ? nullptr : s->in_set.data());
+    }
+    const double volume = closure_->Volume(x);
+    if (round == 0) {
+      report->before = summary;
+      report->volume_change_before = volume_change(volume);
+    }
+    report->after = summary;
+    report->volume_change_after = volume_change(volume);
+    const bool volume_kept =
+        !keeps_volume_ ||
+        std::abs(volume - rest_volume_) <= options_.volume_tolerance * std::abs(rest_volume_);
+    // A held vertex still inside (its plane was tangent where the surface curves away): hold it
+    // on the tangent plane at its new nearest point.
+    int refreshed = 0;
+    for (int j = 0; j < set && bones_ != nullptr; ++j) {
+      BonePenetration now;
+      if (bones_->Deepest(s->contacts[j].vertex, x, frame->bone_transforms, &now)) {
+        s->contacts[j].normal = now.normal;
+        s->contacts[j].surface_point = now.surface_point;
+        ++refreshed;
+      }
+    }
+    if ((found == 0 && refreshed == 0 && volume_kept) || round == options_.max_rounds) break;
+    if (found > 0) AddContacts(factor, found, s, report);
+
+    // The volume row: g at the current frame, its target relative to x*.
+    bool volume_row = false;
+    double volume_target = 0;
+    if (keeps_volume_) {
+      closure_->Gradient(x, s->gradient.data());
+      for (int i = 0; i < n; ++i) {
+        if (!volume_free_[i]) std::fill_n(s->gradient.begin() + 3 * i, 3, 0.0);
+      }
+      std::fill(s->gradient.begin() + 3 * n, s->gradient.end(), 0.0);
+      double moved = 0;
+      for (std::size_t v = 0; v < values; ++v) moved += s->gradient[v] * (x[v] - s->base[v]);
+      volume_target = rest_volume_ - volume + moved;
+      Solved(factor.Solve3(s->gradient.data(), s->h.data(), s->solve_work.data()));
+      ++report->solves;
+      volume_row = Dot(s->gradient.data(), s->h.data(), values) > 0;
+    }
+
+    // The multipliers, dropping contacts that pull the skin inward until none does.
+    const int stride = k_max + 1;
+    double mu = 0;
+    for (;;) {
+      const int q = set + (volume_row ? 1 : 0);
+      for (int l = 0; l < set; ++l) {
+        const BonePenetration& cl = s->contacts[l];
+        for (int j = 0; j <= l; ++j) {
+          const double v = s->inverse_block[static_cast<std::size_t>(l) * k_max + j] *
+                           cl.normal.dot(s->contacts[j].normal);
+          s->system[l * stride + j] = v;
+          s->system[j * stride + l] = v;
+        }
+        const double target = cl.normal.dot(cl.surface_point) + margin_;
+        s->multipliers[l] = target - cl.normal.dot(Vec3(s->base.data() + 3 * cl.vertex));
+        if (volume_row) {
+          const double v = cl.normal.dot(Vec3(s->h.data() + 3 * cl.vertex));
+          s->system[l * stride + set] = v;
+          s->system[set * stride + l] = v;
+        }
+      }
+      if (volume_row) {
+        s->system[set * stride + set] = Dot(s->gradient.data(), s->h.data(), values);
+        s->multipliers[set] = volume_target;
+      }
+      if (q == 0) break;
+      SolveSymmetric(s->system.data(), q, stride, s->multipliers.data());
+      mu = volume_row ? s->multipliers[set] : 0;
+      // Drop every contact with a negative multiplier (from the end, swapping in the last).
+      bool dropped = false;
+      for (int j = set - 1; j >= 0; --j) {
+        if (s->multipliers[j] >= 0) continue;
+        dropped = true;
+        const int last = set - 1;
+        s->in_set[s->contacts[j].vertex] = 0;
+        if (j != last) {
+          MoveContact(last, j, set, s);
+          s->multipliers[j] = s->multipliers[last];
+        }
+        --set;
+      }
+      if (!dropped) break;
+    }
+
+    // x = x* + M^-1 sum_j lambda_j e_{i_j} n_j^T + mu M^-1 g.
+    std::copy(s->base.begin(), s->base.end(), x);
+    if (set > 0) {
+      std::fill(s->correction.begin(), s->correction.end(), 0.0);
+      for (int j = 0; j < set; ++j) {
+        const BonePenetration& c = s->contacts[j];
+        Eigen::Map<Eigen::Vector3d>(s->correction.data() + 3 * c.vertex) +=
+            s->multipliers[j] * c.normal;
+      }
+      Solved(factor.Solve3(s->correction.data(), s->correction.data(), s->solve_work.data()));
+      ++report->solves;
+      for (std::size_t v = 0; v < values; ++v) x[v] += s->correction[v];
+    }
+    if (volume_row) {
+      for (std::size_t v = 0; v < values; ++v) x[v] += mu * s->h[v];
+    }
+    ++report->rounds;
+  }
+  report->unresolved = report->after.vertices > 0;
+  for (int j = 0; j < set; ++j) s->in_set[s->contacts[j].vertex] = 0;
+  return true;
+}
+
+}  // namespace deform

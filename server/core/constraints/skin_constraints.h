@@ -1,0 +1,139 @@
+// Conditions on the whole skin that a frame's solve meets (METHOD.md, "Constraints the solve can
+// take"): skin kept outside the bone surfaces, and the enclosed volume kept.
+//
+// Applied after any of the model's solving paths (Deform, DeformBatch, their parallel forms, the
+// linear response) to the frame in a DeformScratch, with the same factorization: the frame x* is
+// the unconstrained minimiser of the model's energy |A x - b|^2, so the constrained frame is
+//
+//   x = argmin (x - x*)^T M (x - x*)  subject to  n_j . x_{i_j} = d_j        (contacts, j < k)
+//                                                 g . (x - x_c) = V_rest - V(x_c)  (volume)
+//
+// (x_c the frame of the previous round, x* in the first; g the volume's gradient at x_c, zero on
+// the rigid zones)
+//
+// with M = A^T A = P^T L L^T P, the one factorization: x = x* + sum_j lambda_j M^-1 e_{i_j} n_j^T +
+// mu M^-1 g. It needs (M^-1)_{i_l i_j} = y_l . y_j with y_j = L^-1 P e_{i_j}, each a forward pass
+// along one path of the elimination tree (CholeskyFactor::ForwardUnitSolve: a fraction of a
+// solve), and M^-1 g (one three-column solve), then a (k + 1)-square dense system and one more
+// three-column solve: low-rank terms on the one factorization, never a refactorization. Contacts
+// come from an active set: solve, find the vertices inside a bone, hold each on its nearest surface
+// point's tangent plane (plus a margin), solve again; a contact whose multiplier pulls the skin
+// inward leaves the set. The volume is linearised at the current frame each round, so a second
+// round removes what the linearisation left.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "core/base/status.h"
+#include "core/constraints/bone_contacts.h"
+#include "core/geometry/volume_closure.h"
+#include "core/model/deformation_model.h"
+
+namespace deform {
+
+struct ConstraintOptions {
+  // Contacts hold the skin this far outside a bone surface, as a fraction of the skin's
+  // bounding-box diagonal. Default: 1e-3.
+  double contact_margin = 1e-3;
+  // At most this many contact constraints in a frame (the k of the low-rank terms); a frame that
+  // needs more is flagged unresolved. In [0, kMaxContacts]. Default: 64.
+  int max_contacts = 64;
+  static constexpr int kMaxContacts = 256;
+  // Keep the enclosed volume of the skin (an open skin closed by a fan at each boundary loop)
+  // within volume_tolerance of its rest volume, relative. Default: on.
+  bool keep_volume = true;
+  double volume_tolerance = 1e-4;
+  // Rounds of the active set (each: find contacts, solve). In [1, 16]. Default: 8.
+  int max_rounds = 8;
+};
+
+// What the constraints did to one frame.
+struct ConstraintReport {
+  PenetrationSummary before;  // the frame as the model solved it
+  PenetrationSummary after;   // the frame returned
+  int contacts = 0;           // contact constraints in the last solve
+  int rounds = 0;             // constrained solves
+  int solves = 0;             // three-column solves with the factor (a frame's is one)
+  int unit_solves = 0;        // forward passes along one path (ForwardUnitSolve), one a contact
+  // Vertices left inside a bone (more contacts than max_contacts, or rounds exhausted).
+  bool unresolved = false;
+  double volume_change_before = 0;  // (V - V_rest) / V_rest
+  double volume_change_after = 0;
+};
+
+// Per-caller buffers of Apply; one per stream, made by MakeScratch.
+struct ConstraintScratch {
+ private:
+  friend class SkinConstraints;
+  std::vector<double> base;        // x*, (n + m) by 3
+  std::vector<double> gradient;    // g, (n + m) by 3 (zero on the joint nodes' and rigid rows)
+  std::vector<double> h;           // M^-1 g
+  std::vector<double> correction;  // right-hand side, then M^-1 sum lambda_j e_{i_j} n_j^T
+  std::vector<double> unit_work;   // ForwardUnitSolve's, n + m zeros
+  std::vector<int> paths;          // per contact, its path's supernodes (path_supernodes each)
+  std::vector<int> path_lengths;
+  std::vector<double> path_values;  // per contact, y on its path (path_columns each)
+  std::vector<double> solve_work;
+  std::vector<BonePenetration> found;
+  std::vector<BonePenetration> contacts;
+  std::vector<double> inverse_block;  // (M^-1)_{i_l i_j}, max_contacts square
+  std::vector<double> system;         // the (k + 1)-square system, then its Cholesky factor
+  std::vector<double> multipliers;    // its right-hand side, then lambda and mu
+  std::vector<char> in_set;           // per vertex: a contact holds it
+  const void* owner = nullptr;
+};
+
+class SkinConstraints {
+ public:
+  // Constraints for frames of `model` (which must outlive them). `bones` may be null (no
+  // contacts). INVALID_ARGUMENT for options out of range.
+  static StatusOr<std::shared_ptr<const SkinConstraints>> Create(
+      const DeformationModel& model, std::shared_ptr<const BoneContacts> bones,
+      const ConstraintOptions& options = {});
+
+  ConstraintScratch MakeScratch() const;
+  // The bytes MakeScratch allocates.
+  std::size_t ScratchBytes() const;
+
+  // Constrains the frame in `frame` (solved by the model with `factorization`; its
+  // bone_transforms are the frame's) in place. Allocation-free. False, with nothing changed, for
+  // another model's factorization or scratch, or another constraints' scratch.
+  bool Apply(const MaterialFactorization& factorization, DeformScratch* frame,
+             ConstraintScratch* scratch, ConstraintReport* report) const;
+
+  // Whether Apply ever changes a frame.
+  bool active() const { return bones_ != nullptr || keeps_volume_; }
+  const BoneContacts* bones() const { return bones_.get(); }
+  const std::shared_ptr<const BoneContacts>& bones_shared() const { return bones_; }
+  const ConstraintOptions& options() const { return options_; }
+  double rest_volume() const { return rest_volume_; }
+
+ private:
+  SkinConstraints() = default;
+  // Adds the contacts found[0, count) to the set and fills their rows and columns of the inverse
+  // block from their paths.
+  void AddContacts(const CholeskyFactor& factor, int count, ConstraintScratch* s,
+                   ConstraintReport* report) const;
+  // y_l . y_j of two contacts' paths.
+  double PathDot(const CholeskyFactor& factor, const ConstraintScratch& s, int l, int j) const;
+  // Moves contact `from` to slot `to` (its path and its row and column of the inverse block).
+  void MoveContact(int from, int to, int set, ConstraintScratch* s) const;
+
+  const DeformationModel* model_ = nullptr;
+  std::shared_ptr<const BoneContacts> bones_;
+  ConstraintOptions options_;
+  std::unique_ptr<VolumeClosure> closure_;
+  std::vector<char> volume_free_;  // per vertex: carries the volume gradient (not a rigid zone)
+  double rest_volume_ = 0;
+  bool keeps_volume_ = false;
+  double margin_ = 0;  // model units
+  int rows_ = 0;       // n + m
+  // The longest path of the factor's elimination tree (CholeskyFactor::LongestUnitSolvePath).
+  std::int64_t path_columns_ = 0;
+  int path_supernodes_ = 0;
+};
+
+}  // namespace deform

@@ -1,0 +1,123 @@
+#include "core/geometry/volume_closure.h"
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <numeric>
+#include <unordered_map>
+#include <unordered_set>
+#include <utility>
+
+namespace deform {
+namespace {
+
+using Vec = Eigen::Map<const Eigen::Vector3d>;
+
+int FindRoot(std::vector<int>& parent, int x) {
+  while (parent[x] != x) x = parent[x] = parent[parent[x]];
+  return x;
+}
+
+std::int64_t EdgeKey(int a, int b) {
+  return (static_cast<std::int64_t>(a) << 32) | static_cast<unsigned>(b);
+}
+
+}  // namespace
+
+VolumeClosure::VolumeClosure(const Triangles& triangles, int num_vertices)
+    : num_vertices_(num_vertices), triangles_(triangles) {
+  // Directed edges: an edge seen once (its reverse absent) lies on the boundary.
+  std::unordered_set<std::int64_t> directed;
+  for (int f = 0; f < triangles.rows(); ++f) {
+    for (int c = 0; c < 3; ++c)
+      directed.insert(EdgeKey(triangles(f, c), triangles(f, (c + 1) % 3)));
+  }
+  std::vector<std::pair<int, int>> boundary;
+  for (int f = 0; f < triangles.rows(); ++f) {
+    for (int c = 0; c < 3; ++c) {
+      const int a = triangles(f, c), b = triangles(f, (c + 1) % 3);
+      if (directed.count(EdgeKey(b, a)) == 0) boundary.emplace_back(a, b);
+    }
+  }
+  if (boundary.empty()) return;
+  // Group the boundary edges into loops (connected by their ends).
+  std::vector<int> parent(num_vertices);
+  std::iota(parent.begin(), parent.end(), 0);
+  for (const auto& [a, b] : boundary) parent[FindRoot(parent, a)] = FindRoot(parent, b);
+  std::unordered_map<int, std::vector<std::pair<int, int>>> by_root;
+  std::vector<int> roots;
+  for (const auto& edge : boundary) {
+    const int root = FindRoot(parent, edge.first);
+    auto [it, inserted] = by_root.try_emplace(root);
+    if (inserted) roots.push_back(root);
+    it->second.push_back(edge);
+  }
+  for (int root : roots) {
+    Loop loop{static_cast<int>(boundary_.size() / 2), static_cast<int>(by_root[root].size())};
+    for (const auto& [a, b] : by_root[root]) {
+      boundary_.push_back(a);
+      boundary_.push_back(b);
+    }
+    loops_.push_back(loop);
+  }
+}
+
+void VolumeClosure::Centroid(const double* xyz, const Loop& loop, double* c) const {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (int e = loop.first_edge; e < loop.first_edge + loop.edges; ++e) {
+    sum += Vec(xyz + 3 * boundary_[2 * e]) + Vec(xyz + 3 * boundary_[2 * e + 1]);
+  }
+  Eigen::Map<Eigen::Vector3d> centroid(c);
+  centroid = sum / (2.0 * loop.edges);
+}
+
+double VolumeClosure::Volume(const double* xyz) const {
+  double six_volume = 0;
+  for (int f = 0; f < triangles_.rows(); ++f) {
+    six_volume += Vec(xyz + 3 * triangles_(f, 0))
+                      .dot(Vec(xyz + 3 * triangles_(f, 1)).cross(Vec(xyz + 3 * triangles_(f, 2))));
+  }
+  for (const Loop& loop : loops_) {
+    double centroid[3];
+    Centroid(xyz, loop, centroid);
+    for (int e = loop.first_edge; e < loop.first_edge + loop.edges; ++e) {
+      // The fan triangle (centroid, b, a) closes edge (a, b).
+      six_volume += Vec(centroid).dot(
+          Vec(xyz + 3 * boundary_[2 * e + 1]).cross(Vec(xyz + 3 * boundary_[2 * e])));
+    }
+  }
+  return six_volume / 6.0;
+}
+
+void VolumeClosure::Gradient(const double* xyz, double* gradient) const {
+  Eigen::Map<Eigen::VectorXd>(gradient, 3 * num_vertices_).setZero();
+  auto g = [&](int i) { return Eigen::Map<Eigen::Vector3d>(gradient + 3 * i); };
+  for (int f = 0; f < triangles_.rows(); ++f) {
+    const int a = triangles_(f, 0), b = triangles_(f, 1), c = triangles_(f, 2);
+    const Vec pa(xyz + 3 * a), pb(xyz + 3 * b), pc(xyz + 3 * c);
+    g(a) += pb.cross(pc) / 6.0;
+    g(b) += pc.cross(pa) / 6.0;
+    g(c) += pa.cross(pb) / 6.0;
+  }
+  for (const Loop& loop : loops_) {
+    double centroid_data[3];
+    Centroid(xyz, loop, centroid_data);
+    const Vec centroid(centroid_data);
+    // d/d(centroid) of the loop's fan, spread over the edges' ends that make the centroid.
+    Eigen::Vector3d d_centroid = Eigen::Vector3d::Zero();
+    for (int e = loop.first_edge; e < loop.first_edge + loop.edges; ++e) {
+      const int a = boundary_[2 * e], b = boundary_[2 * e + 1];
+      const Vec pa(xyz + 3 * a), pb(xyz + 3 * b);
+      // Triangle (centroid, b, a): d/db = a x centroid, d/da = centroid x b, d/dc = b x a.
+      g(b) += pa.cross(centroid) / 6.0;
+      g(a) += centroid.cross(pb) / 6.0;
+      d_centroid += pb.cross(pa) / 6.0;
+    }
+    const Eigen::Vector3d share = d_centroid / (2.0 * loop.edges);
+    for (int e = loop.first_edge; e < loop.first_edge + loop.edges; ++e) {
+      g(boundary_[2 * e]) += share;
+      g(boundary_[2 * e + 1]) += share;
+    }
+  }
+}
+
+}  // namespace deform
