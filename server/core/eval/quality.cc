@@ -6,6 +6,7 @@
 #include <numeric>
 #include <unordered_map>
 
+#include "core/eval/triangle_counts.h"
 #include "core/geometry/skeleton_geometry.h"
 
 namespace deform {
@@ -53,6 +54,9 @@ QualityReport MeasureQuality(const TriangleMesh& rest_mesh, const Positions& pos
         std::max(report.rigid_zone_error, (posed.row(i) - skinned.row(i)).norm() / diagonal);
   }
   report.max_displacement = (posed - rest_mesh.vertices).rowwise().norm().maxCoeff() / diagonal;
+  report.inverted_triangles =
+      CountInvertedTriangles(rest_mesh.triangles, rest_mesh.vertices, posed, skinned);
+  report.self_intersections = CountSelfIntersections(rest_mesh.triangles, posed);
   return report;
 }
 

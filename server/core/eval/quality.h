@@ -30,6 +30,11 @@ struct QualityReport {
   double rigid_zone_error = 0;
   // max over all vertices of |x_i - v_i| / bounding-box diagonal (meaningful for the rest pose).
   double max_displacement = 0;
+  // Triangles turned over against LBS of the same pose or crushed to below 1e-12 of their rest
+  // area (CountInvertedTriangles, triangle_counts.h).
+  int inverted_triangles = 0;
+  // Pairs of triangles sharing no corner that intersect (CountSelfIntersections).
+  int self_intersections = 0;
 };
 
 // All measures at once.
