@@ -1,7 +1,8 @@
 // deformctl: the deformation core from the command line.
 //
 //   deformctl deform [--mesh FILE --skeleton FILE [--weights FILE] | --mesh RIG.glb] --pose SPEC
-//                    [--method paper|paper-linear|laplacian|lbs|dqs] [--out FILE] [--repeat N]
+//                    [--method paper|paper-linear|laplacian|lbs|dqs|cor|ddm] [--out FILE]
+//                    [--repeat N] [--joint-nodes on|off] [--material on|off]
 //   deformctl phantom --out FILE [--skeleton-out FILE] [--vertices N]
 //
 // Prints one JSON object on stdout; errors are one line on stderr and a non-zero exit code.
@@ -36,6 +37,8 @@ struct DeformArgs {
   int repeat = 1;
   double radius_factor = 1.5;
   std::string ordering = "auto";
+  std::string joint_nodes = "on";  // off: ModelOptions::use_joint_nodes = false
+  std::string material = "on";     // off: ModelOptions::uniform_material = true
 };
 
 struct PhantomArgs {
@@ -49,10 +52,13 @@ int Fail(const Status& status) {
   return 1;
 }
 
-// The paper's options with the command line's region radius factor and ordering.
+// The paper's options with the command line's region radius factor, ordering and ablation
+// switches (the joint nodes, the material weights).
 StatusOr<deform::ModelOptions> ModelOptionsFrom(const DeformArgs& args) {
   deform::ModelOptions options = deform::ModelOptions::Paper();
   options.regions.radius_factor = args.radius_factor;
+  options.use_joint_nodes = args.joint_nodes == "on";
+  options.uniform_material = args.material == "off";
   DEFORM_ASSIGN_OR_RETURN(options.ordering, deform::OrderingFromName(args.ordering));
   return options;
 }
@@ -89,6 +95,10 @@ nlohmann::ordered_json DeformReport(const DeformArgs& args, const deform::ModelI
   out["vertices"] = input.mesh.num_vertices();
   out["triangles"] = input.mesh.num_triangles();
   out["joint_nodes"] = run.joint_nodes;
+  // What the method ran with: laplacian is the model with neither, whatever the switches.
+  const bool plain = method == deform::Method::kLaplacian;
+  out["joint_nodes_enabled"] = !plain && model.options().use_joint_nodes;
+  out["material_enabled"] = !plain && !model.options().uniform_material;
   out["anchors"] = run.anchors;
   out["binding"] = BindingJson(model.binding_report());
   out["clamped_angles"] = clamped;
@@ -98,6 +108,8 @@ nlohmann::ordered_json DeformReport(const DeformArgs& args, const deform::ModelI
   out["sink_fraction"] = q.clearance.sink_fraction;
   out["rigid_zone_error"] = q.rigid_zone_error;
   out["max_displacement"] = q.max_displacement;
+  out["inverted_triangles"] = q.inverted_triangles;
+  out["self_intersections"] = q.self_intersections;
   out["precompute_ms"] = run.precompute_seconds * 1e3;
   out["factor_ms"] = run.factor_seconds * 1e3;
   out["factor_bytes"] = run.factor_bytes;
@@ -183,7 +195,7 @@ CLI::App* AddDeformCommand(CLI::App* app, DeformArgs* args) {
                  "JOINT:AXIS:DEGREES[,...], e.g. knee:flexion:90 or 1:x:90");
   AddWithDefault(command, "--method", &args->method,
                  "paper | paper-linear (linear rotation blend, no per-frame solve) | laplacian | "
-                 "lbs | dqs");
+                 "lbs | dqs | cor (optimized centres of rotation) | ddm (direct delta mush)");
   command->add_option("--out", args->out_path,
                       "Write the deformed mesh (format from the extension)");
   AddWithDefault(command, "--repeat", &args->repeat,
@@ -194,6 +206,12 @@ CLI::App* AddDeformCommand(CLI::App* app, DeformArgs* args) {
                  "Joint region radius in limb radii");
   AddWithDefault(command, "--ordering", &args->ordering,
                  "Fill-reducing ordering: auto | metis | amd | natural");
+  AddWithDefault(command, "--joint-nodes", &args->joint_nodes,
+                 "Joint centre nodes (off: the paper's model without them, for ablation)")
+      ->check(CLI::IsMember({"on", "off"}));
+  AddWithDefault(command, "--material", &args->material,
+                 "Material weights (off: every row weight 1, for ablation)")
+      ->check(CLI::IsMember({"on", "off"}));
   return command;
 }
 
