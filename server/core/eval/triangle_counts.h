@@ -16,8 +16,8 @@ int CountInvertedTriangles(const Triangles& triangles, const Positions& rest,
 
 // The unordered pairs of triangles that share no corner and intersect in `posed`, found with a
 // bounding-volume tree of the posed triangles (TriangleBvh::CountIntersectingTrianglePairs: a
-// segment-triangle test on each of the six edges; coplanar overlaps are not counted). A closed
-// surface that does not pass through itself counts 0.
+// segment-triangle test on each of the six edges; contacts without crossing and coplanar overlaps
+// are not counted). A closed surface that does not pass through itself counts 0.
 int CountSelfIntersections(const Triangles& triangles, const Positions& posed);
 
 }  // namespace deform

@@ -62,12 +62,14 @@ Eigen::Vector3d ClosestPointOnTriangle(const Eigen::Vector3d& p, const Eigen::Ve
   return a + ab * (vb * denominator) + ac * (vc * denominator);
 }
 
-// Whether the segment [from, to] meets triangle abc (Moller-Trumbore, barycentrics and the
-// segment parameter in their closed ranges: touching counts). A segment parallel to the plane
-// does not meet it.
+// Whether the segment [from, to] passes through the inside of triangle abc (Moller-Trumbore): the
+// barycentrics and the segment parameter at least kProperCrossing inside their ranges, so that a
+// corner resting on another triangle or an edge grazing it (contacts a generated mesh can have at
+// rest) is not a crossing. A segment parallel to the plane does not cross it.
 bool SegmentMeetsTriangle(const Eigen::Vector3d& from, const Eigen::Vector3d& to,
                           const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                           const Eigen::Vector3d& c) {
+  constexpr double kProperCrossing = 1e-9;
   const Eigen::Vector3d direction = to - from;
   const Eigen::Vector3d e1 = b - a;
   const Eigen::Vector3d e2 = c - a;
@@ -77,12 +79,12 @@ bool SegmentMeetsTriangle(const Eigen::Vector3d& from, const Eigen::Vector3d& to
   const double inverse = 1.0 / determinant;
   const Eigen::Vector3d s = from - a;
   const double u = s.dot(p) * inverse;
-  if (u < 0 || u > 1) return false;
+  if (u < kProperCrossing || u > 1 - kProperCrossing) return false;
   const Eigen::Vector3d q = s.cross(e1);
   const double v = direction.dot(q) * inverse;
-  if (v < 0 || u + v > 1) return false;
+  if (v < kProperCrossing || u + v > 1 - kProperCrossing) return false;
   const double t = e2.dot(q) * inverse;
-  return t >= 0 && t <= 1;
+  return t > kProperCrossing && t < 1 - kProperCrossing;
 }
 
 bool BoxesOverlap(const Eigen::Vector3d& lower_a, const Eigen::Vector3d& upper_a,

@@ -38,11 +38,12 @@ class TriangleBvh {
   // The smallest distance from `point` to the surface (exact, by descending the tree).
   double DistanceToSurface(const Eigen::Vector3d& point) const;
 
-  // The number of unordered pairs of triangles that share no corner and intersect: an edge of one
-  // meets the other (a segment-triangle test on each of the six edges, touching included), which
-  // for two triangles in general position is the same as their intersecting. Coplanar overlaps
-  // are not counted (no edge crosses the other's plane). Triangles sharing a corner or an edge are
-  // never counted: they touch by construction. Allocates nothing.
+  // The number of unordered pairs of triangles that share no corner and pass through each other:
+  // an edge of one crosses the inside of the other (a segment-triangle test on each of the six
+  // edges), which for two triangles in general position is the same as their intersecting. Mere
+  // contact (a corner on the other triangle, an edge grazing it, to 1e-9 of the barycentric
+  // range) and coplanar overlaps are not counted. Triangles sharing a corner or an edge are never
+  // counted: they touch by construction. Allocates nothing.
   int CountIntersectingTrianglePairs() const;
 
  private:
