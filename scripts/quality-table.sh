@@ -1,10 +1,16 @@
 #!/usr/bin/env bash
-# Prints a markdown table of the quality measures of all five methods (paper, its linear-blend fast
-# path paper-linear, laplacian, lbs, dqs) at 45, 90 and 120 degrees, for the built-in phantom and,
-# where ../shared/data is present, the shared legs, the arm (its natural elbow flexion, a negative
-# angle; with the binding through the body and with its authored weights) and the whole body (a
-# multi-joint pose: left knee DEG, left hip flexed DEG/2, right knee DEG/2). Needs a build
-# (scripts/build.sh) and python3. DEFORM_QUALITY_METHODS="paper-linear lbs" limits the methods.
+# Prints a markdown table of the quality measures of all seven methods (paper, its linear-blend
+# fast path paper-linear, laplacian, lbs, dqs, cor, ddm) at 45, 90 and 120 degrees, for the built-in
+# phantom and, where ../shared/data is present, the shared legs, the arm (its natural elbow
+# flexion, a negative angle; with the binding through the body and with its authored weights) and
+# the whole body (a multi-joint pose: left knee DEG, left hip flexed DEG/2, right knee DEG/2).
+# Needs a build (scripts/build.sh) and python3. DEFORM_QUALITY_METHODS="paper-linear lbs" limits
+# the methods, DEFORM_QUALITY_DEGREES="90 120" the angles.
+#
+# DEFORM_QUALITY_ABLATION=1 prints the ablation of METHOD.md's two additions instead (the paper's
+# figure 2): the paper's model plain (neither), with the joint node only, with the material
+# weights only, and with both, on every case at 90 and 120 degrees (deformctl's --joint-nodes and
+# --material switches).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 DEFORMCTL="${DEFORM_BUILD_DIR:-build}/server/deformctl/deformctl"
@@ -59,19 +65,44 @@ PY
   CASES+=("body_13380 (one tree)|$DATA/body/body_13380.obj|$PARENTED_SKELETON||joint5:x:DEG,joint4:x:-HALF,joint10:x:HALF")
 fi
 
-echo "| mesh | degrees | method | volume_change | clearance_min | clearance_p01 | sink_fraction | rigid_zone_error |"
-echo "|---|---|---|---|---|---|---|---|"
+# One row: the measures of deformctl's JSON on stdin, after the row's leading cells.
+row() {
+  python3 -c "import json,sys; d=json.load(sys.stdin); print('| $1 | %+.4f | %.3f | %.3f | %.4f | %.1e | %d | %d |' % (d['volume_change'], d['clearance_min'], d['clearance_p01'], d['sink_fraction'], d['rigid_zone_error'], d['inverted_triangles'], d['self_intersections']))"
+}
+
+if [ "${DEFORM_QUALITY_ABLATION:-0}" = 1 ]; then
+  # variant name | --joint-nodes | --material
+  VARIANTS=("plain|off|off" "node only|on|off" "material only|off|on" "both|on|on")
+  echo "| mesh | degrees | variant | volume_change | clearance_min | clearance_p01 | sink_fraction | rigid_zone_error | inverted_triangles | self_intersections |"
+  echo "|---|---|---|---|---|---|---|---|---|---|"
+else
+  echo "| mesh | degrees | method | volume_change | clearance_min | clearance_p01 | sink_fraction | rigid_zone_error | inverted_triangles | self_intersections |"
+  echo "|---|---|---|---|---|---|---|---|---|---|"
+fi
 for case in "${CASES[@]}"; do
   IFS='|' read -r name mesh skeleton weights pose <<<"$case"
   args=()
   [ -n "$mesh" ] && args=(--mesh "$mesh" --skeleton "$skeleton")
   [ -n "$weights" ] && args+=(--weights "$weights")
-  for degrees in 45 90 120; do
+  if [ "${DEFORM_QUALITY_ABLATION:-0}" = 1 ]; then
+    degree_list=${DEFORM_QUALITY_DEGREES:-90 120}
+  else
+    degree_list=${DEFORM_QUALITY_DEGREES:-45 90 120}
+  fi
+  for degrees in $degree_list; do
     spec=${pose//DEG/$degrees}
     spec=${spec//HALF/$((degrees / 2))}
-    for method in ${DEFORM_QUALITY_METHODS:-paper paper-linear laplacian lbs dqs}; do
+    if [ "${DEFORM_QUALITY_ABLATION:-0}" = 1 ]; then
+      for variant in "${VARIANTS[@]}"; do
+        IFS='|' read -r label nodes material <<<"$variant"
+        "$DEFORMCTL" deform "${args[@]}" --pose "$spec" --method paper --joint-nodes "$nodes" \
+          --material "$material" 2>/dev/null | row "$name | $degrees | $label"
+      done
+      continue
+    fi
+    for method in ${DEFORM_QUALITY_METHODS:-paper paper-linear laplacian lbs dqs cor ddm}; do
       "$DEFORMCTL" deform "${args[@]}" --pose "$spec" --method "$method" 2>/dev/null |
-        python3 -c "import json,sys; d=json.load(sys.stdin); print('| $name | $degrees | $method | %+.4f | %.3f | %.3f | %.4f | %.1e |' % (d['volume_change'], d['clearance_min'], d['clearance_p01'], d['sink_fraction'], d['rigid_zone_error']))"
+        row "$name | $degrees | $method"
     done
   done
 done

@@ -1,7 +1,8 @@
 // deformctl: the deformation core from the command line.
 //
 //   deformctl deform [--mesh FILE --skeleton FILE [--weights FILE] | --mesh RIG.glb] --pose SPEC
-//                    [--method paper|paper-linear|laplacian|lbs|dqs] [--out FILE] [--repeat N]
+//                    [--method paper|paper-linear|laplacian|lbs|dqs|cor|ddm] [--out FILE]
+//                    [--repeat N] [--joint-nodes on|off] [--material on|off]
 //                    [--bone-surface FILE:BONE ...] [--bones input|capsules|none]
 //                    [--contacts on|off] [--volume on|off] [--out-bones DIR]
 //   deformctl phantom --out FILE [--skeleton-out FILE] [--vertices N]
@@ -49,6 +50,8 @@ struct DeformArgs {
   bool volume = true;
   std::string out_bones_dir;
   int bone_surface_count = 0;  // set once they are loaded
+  std::string joint_nodes = "on";  // off: ModelOptions::use_joint_nodes = false
+  std::string material = "on";     // off: ModelOptions::uniform_material = true
 };
 
 struct PhantomArgs {
@@ -62,10 +65,13 @@ int Fail(const Status& status) {
   return 1;
 }
 
-// The paper's options with the command line's region radius factor and ordering.
+// The paper's options with the command line's region radius factor, ordering and ablation
+// switches (the joint nodes, the material weights).
 StatusOr<deform::ModelOptions> ModelOptionsFrom(const DeformArgs& args) {
   deform::ModelOptions options = deform::ModelOptions::Paper();
   options.regions.radius_factor = args.radius_factor;
+  options.use_joint_nodes = args.joint_nodes == "on";
+  options.uniform_material = args.material == "off";
   DEFORM_ASSIGN_OR_RETURN(options.ordering, deform::OrderingFromName(args.ordering));
   return options;
 }
@@ -126,6 +132,10 @@ nlohmann::ordered_json DeformReport(const DeformArgs& args, const deform::ModelI
   out["vertices"] = input.mesh.num_vertices();
   out["triangles"] = input.mesh.num_triangles();
   out["joint_nodes"] = run.joint_nodes;
+  // What the method ran with: laplacian is the model with neither, whatever the switches.
+  const bool plain = method == deform::Method::kLaplacian;
+  out["joint_nodes_enabled"] = !plain && model.options().use_joint_nodes;
+  out["material_enabled"] = !plain && !model.options().uniform_material;
   out["anchors"] = run.anchors;
   out["binding"] = BindingJson(model.binding_report());
   out["clamped_angles"] = clamped;
@@ -151,6 +161,8 @@ nlohmann::ordered_json DeformReport(const DeformArgs& args, const deform::ModelI
                           {"volume_change_before", c.volume_change_before},
                           {"ms", run.constraint_seconds * 1e3}};
   }
+  out["inverted_triangles"] = q.inverted_triangles;
+  out["self_intersections"] = q.self_intersections;
   out["precompute_ms"] = run.precompute_seconds * 1e3;
   out["factor_ms"] = run.factor_seconds * 1e3;
   out["factor_bytes"] = run.factor_bytes;
@@ -261,7 +273,7 @@ CLI::App* AddDeformCommand(CLI::App* app, DeformArgs* args) {
                  "JOINT:AXIS:DEGREES[,...], e.g. knee:flexion:90 or 1:x:90");
   AddWithDefault(command, "--method", &args->method,
                  "paper | paper-linear (linear rotation blend, no per-frame solve) | laplacian | "
-                 "lbs | dqs");
+                 "lbs | dqs | cor (optimized centres of rotation) | ddm (direct delta mush)");
   command->add_option("--out", args->out_path,
                       "Write the deformed mesh (format from the extension)");
   AddWithDefault(command, "--repeat", &args->repeat,
@@ -290,6 +302,12 @@ CLI::App* AddDeformCommand(CLI::App* app, DeformArgs* args) {
       ->default_str("on");
   command->add_option("--out-bones", args->out_bones_dir,
                       "Write each bone surface, posed, as DIR/NAME.obj");
+  AddWithDefault(command, "--joint-nodes", &args->joint_nodes,
+                 "Joint centre nodes (off: the paper's model without them, for ablation)")
+      ->check(CLI::IsMember({"on", "off"}));
+  AddWithDefault(command, "--material", &args->material,
+                 "Material weights (off: every row weight 1, for ablation)")
+      ->check(CLI::IsMember({"on", "off"}));
   return command;
 }
 

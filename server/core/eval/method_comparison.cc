@@ -8,6 +8,8 @@
 #include <vector>
 
 #include "core/base/median.h"
+#include "core/eval/direct_delta_mush.h"
+#include "core/eval/optimized_centers.h"
 #include "core/eval/skinning.h"
 
 namespace deform {
@@ -103,33 +105,50 @@ Status RunSolvingMethod(const DeformationModel& paper_model, Method method, cons
   return Status::Ok();
 }
 
-// LBS and DQS with the paper model's harmonic weights: `repeat` frames, each the whole frame.
+// The skinning baselines (LBS, DQS, CoR, DDM) with the paper model's weights: `repeat` frames,
+// each the whole frame; the precomputation of CoR and DDM is counted with the model's.
 void RunSkinningMethod(const DeformationModel& paper_model, Method method, const Pose& pose,
                        int repeat, MethodRun* run) {
+  const Positions& rest = paper_model.mesh().vertices;
+  const BoneWeights& weights = paper_model.bone_weights();
+  run->precompute_seconds = paper_model.precompute_seconds();
+  const auto start = Clock::now();
+  RotationCenters centers;
+  if (method == Method::kCor) centers = ComputeRotationCenters(paper_model.mesh(), weights);
+  DirectDeltaMush mush;
+  if (method == Method::kDdm) mush = DirectDeltaMush::Precompute(paper_model.mesh(), weights);
+  run->precompute_seconds += std::chrono::duration<double>(Clock::now() - start).count();
   std::vector<RigidTransform> bones;
+  DirectDeltaMush::BoneMatrices bone_matrices;
   run->frame_seconds = Median(TimeFrames(repeat, [&] {
     ForwardKinematics(paper_model.skeleton(), pose, &bones);
-    if (method == Method::kLbs) {
-      LinearBlendSkinning(paper_model.mesh().vertices, paper_model.bone_weights(), bones,
-                          &run->posed);
-    } else {
-      DualQuaternionSkinning(paper_model.mesh().vertices, paper_model.bone_weights(), bones,
-                             &run->posed);
+    switch (method) {
+      case Method::kLbs:
+        LinearBlendSkinning(rest, weights, bones, &run->posed);
+        break;
+      case Method::kDqs:
+        DualQuaternionSkinning(rest, weights, bones, &run->posed);
+        break;
+      case Method::kCor:
+        OptimizedCentersSkinning(rest, weights, centers, bones, &run->posed);
+        break;
+      default:
+        mush.Deform(bones, &run->posed, &bone_matrices);
+        break;
     }
   }));
   run->solve_seconds = run->frame_seconds;
-  run->precompute_seconds = paper_model.precompute_seconds();
 }
 
 }  // namespace
 
 StatusOr<Method> MethodFromName(std::string_view name) {
-  for (Method method :
-       {Method::kPaper, Method::kPaperLinear, Method::kLaplacian, Method::kLbs, Method::kDqs}) {
+  for (Method method : {Method::kPaper, Method::kPaperLinear, Method::kLaplacian, Method::kLbs,
+                        Method::kDqs, Method::kCor, Method::kDdm}) {
     if (name == MethodName(method)) return method;
   }
   return Status::InvalidArgument("unknown method '" + std::string(name) +
-                                 "' (known: paper, paper-linear, laplacian, lbs, dqs)");
+                                 "' (known: paper, paper-linear, laplacian, lbs, dqs, cor, ddm)");
 }
 
 const char* MethodName(Method method) {
@@ -144,6 +163,10 @@ const char* MethodName(Method method) {
       return "lbs";
     case Method::kDqs:
       return "dqs";
+    case Method::kCor:
+      return "cor";
+    case Method::kDdm:
+      return "ddm";
   }
   return "unknown";
 }

@@ -18,9 +18,11 @@ enum class Method {
   kLaplacian,    // plain Laplacian: no joint node, W = I
   kLbs,          // linear blend skinning with the harmonic weights
   kDqs,          // dual quaternion skinning with the harmonic weights
+  kCor,  // skinning with optimized centres of rotation (Le & Hodgins 2016): optimized_centers.h
+  kDdm,  // Direct Delta Mush (Le & Lewis 2019), full matrices: direct_delta_mush.h
 };
 
-// "paper", "paper-linear", "laplacian", "lbs", "dqs".
+// "paper", "paper-linear", "laplacian", "lbs", "dqs", "cor", "ddm".
 const char* MethodName(Method method);
 // The method MethodName() names; INVALID_ARGUMENT listing the names for any other text.
 StatusOr<Method> MethodFromName(std::string_view name);
@@ -28,7 +30,9 @@ StatusOr<Method> MethodFromName(std::string_view name);
 struct MethodRun {
   Positions posed;  // #V by 3
   QualityReport quality;
-  double precompute_seconds = 0;   // model precomputation (weights, regions, symbolic analysis)
+  // Model precomputation (weights, regions, symbolic analysis); for cor and ddm plus their own
+  // (the centres of rotation, the Omega matrices).
+  double precompute_seconds = 0;
   double factor_seconds = 0;       // numeric factorization (0 for skinning)
   std::size_t factor_bytes = 0;    // bytes of the stored factor (0 for skinning)
   std::size_t response_bytes = 0;  // bytes of the linear response (paper-linear only)

@@ -6,6 +6,7 @@
 #include <numeric>
 #include <unordered_map>
 
+#include "core/eval/triangle_counts.h"
 #include "core/geometry/skeleton_geometry.h"
 
 namespace deform {
@@ -55,6 +56,9 @@ QualityReport MeasureQuality(const TriangleMesh& rest_mesh, const Positions& pos
   }
   report.max_displacement = (posed - rest_mesh.vertices).rowwise().norm().maxCoeff() / diagonal;
   if (bone_surfaces != nullptr) report.bone_penetration = bone_surfaces->Measure(posed, bones);
+  report.inverted_triangles =
+      CountInvertedTriangles(rest_mesh.triangles, rest_mesh.vertices, posed, skinned);
+  report.self_intersections = CountSelfIntersections(rest_mesh.triangles, posed);
   return report;
 }
 

@@ -33,6 +33,11 @@ struct QualityReport {
   double max_displacement = 0;
   // Skin vertices inside a bone surface and the deepest (model units); zero without bones.
   PenetrationSummary bone_penetration;
+  // Triangles turned over against LBS of the same pose or crushed to below 1e-12 of their rest
+  // area (CountInvertedTriangles, triangle_counts.h).
+  int inverted_triangles = 0;
+  // Pairs of triangles sharing no corner that intersect (CountSelfIntersections).
+  int self_intersections = 0;
 };
 
 // All measures at once; the bone penetration when `bone_surfaces` is given.

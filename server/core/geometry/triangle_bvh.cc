@@ -62,6 +62,36 @@ Eigen::Vector3d ClosestPointOnTriangle(const Eigen::Vector3d& p, const Eigen::Ve
   return a + ab * (vb * denominator) + ac * (vc * denominator);
 }
 
+// Whether the segment [from, to] passes through the inside of triangle abc (Moller-Trumbore): the
+// barycentrics and the segment parameter at least kProperCrossing inside their ranges, so that a
+// corner resting on another triangle or an edge grazing it (contacts a generated mesh can have at
+// rest) is not a crossing. A segment parallel to the plane does not cross it.
+bool SegmentMeetsTriangle(const Eigen::Vector3d& from, const Eigen::Vector3d& to,
+                          const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                          const Eigen::Vector3d& c) {
+  constexpr double kProperCrossing = 1e-9;
+  const Eigen::Vector3d direction = to - from;
+  const Eigen::Vector3d e1 = b - a;
+  const Eigen::Vector3d e2 = c - a;
+  const Eigen::Vector3d p = direction.cross(e2);
+  const double determinant = e1.dot(p);
+  if (std::abs(determinant) < 1e-300) return false;
+  const double inverse = 1.0 / determinant;
+  const Eigen::Vector3d s = from - a;
+  const double u = s.dot(p) * inverse;
+  if (u < kProperCrossing || u > 1 - kProperCrossing) return false;
+  const Eigen::Vector3d q = s.cross(e1);
+  const double v = direction.dot(q) * inverse;
+  if (v < kProperCrossing || u + v > 1 - kProperCrossing) return false;
+  const double t = e2.dot(q) * inverse;
+  return t > kProperCrossing && t < 1 - kProperCrossing;
+}
+
+bool BoxesOverlap(const Eigen::Vector3d& lower_a, const Eigen::Vector3d& upper_a,
+                  const Eigen::Vector3d& lower_b, const Eigen::Vector3d& upper_b) {
+  return (lower_a.array() <= upper_b.array()).all() && (lower_b.array() <= upper_a.array()).all();
+}
+
 }  // namespace
 
 TriangleBvh::TriangleBvh(const TriangleMesh& mesh)
@@ -245,6 +275,62 @@ Eigen::Vector3d TriangleBvh::TriangleNormal(int f) const {
   const Eigen::Vector3d b = positions_.row(triangles_(f, 1)).transpose();
   const Eigen::Vector3d c = positions_.row(triangles_(f, 2)).transpose();
   return (b - a).cross(c - a).normalized();
+}
+
+template <typename Visit>
+void TriangleBvh::ForEachInBox(const Eigen::Vector3d& lower, const Eigen::Vector3d& upper,
+                               Visit visit) const {
+  if (triangles_.rows() == 0) return;
+  std::array<int, kMaxDepth> stack;
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& node = nodes_[stack[--top]];
+    if (!BoxesOverlap(lower, upper, node.lower, node.upper)) continue;
+    if (node.count > 0) {
+      for (int p = node.first; p < node.first + node.count; ++p) visit(order_[p]);
+    } else {
+      stack[top++] = node.left;
+      stack[top++] = node.right;
+    }
+  }
+}
+
+bool TriangleBvh::TrianglesIntersect(int f, int g) const {
+  std::array<Eigen::Vector3d, 3> first, second;
+  for (int c = 0; c < 3; ++c) {
+    first[c] = positions_.row(triangles_(f, c)).transpose();
+    second[c] = positions_.row(triangles_(g, c)).transpose();
+  }
+  for (int e = 0; e < 3; ++e) {
+    if (SegmentMeetsTriangle(first[e], first[(e + 1) % 3], second[0], second[1], second[2]) ||
+        SegmentMeetsTriangle(second[e], second[(e + 1) % 3], first[0], first[1], first[2])) {
+      return true;
+    }
+  }
+  return false;
+}
+
+int TriangleBvh::CountIntersectingTrianglePairs() const {
+  int pairs = 0;
+  for (int f = 0; f < triangles_.rows(); ++f) {
+    Eigen::Vector3d lower = positions_.row(triangles_(f, 0)).transpose();
+    Eigen::Vector3d upper = lower;
+    for (int c = 1; c < 3; ++c) {
+      lower = lower.cwiseMin(positions_.row(triangles_(f, c)).transpose());
+      upper = upper.cwiseMax(positions_.row(triangles_(f, c)).transpose());
+    }
+    ForEachInBox(lower, upper, [&](int g) {
+      if (g <= f) return;  // each unordered pair once
+      for (int a = 0; a < 3; ++a) {
+        for (int b = 0; b < 3; ++b) {
+          if (triangles_(f, a) == triangles_(g, b)) return;  // adjacent: they share a corner
+        }
+      }
+      if (TrianglesIntersect(f, g)) ++pairs;
+    });
+  }
+  return pairs;
 }
 
 }  // namespace deform

@@ -56,18 +56,20 @@ TEST(MethodComparison, EveryMethodReproducesTheRestPose) {
   auto phantom = MakeKneePhantom(800);
   auto model = DeformationModel::Build(phantom->mesh, phantom->skeleton, ModelOptions::Paper());
   ASSERT_TRUE(model.ok());
-  for (Method m :
-       {Method::kPaper, Method::kPaperLinear, Method::kLaplacian, Method::kLbs, Method::kDqs}) {
+  for (Method m : {Method::kPaper, Method::kPaperLinear, Method::kLaplacian, Method::kLbs,
+                   Method::kDqs, Method::kCor, Method::kDdm}) {
     auto run = RunMethod(**model, m, Pose::Rest(phantom->skeleton));
     ASSERT_TRUE(run.ok());
     EXPECT_LT(run->quality.max_displacement, 1e-9) << MethodName(m);
     EXPECT_NEAR(run->quality.volume_change, 0, 1e-9) << MethodName(m);
+    EXPECT_EQ(run->quality.inverted_triangles, 0) << MethodName(m);
+    EXPECT_EQ(run->quality.self_intersections, 0) << MethodName(m);
   }
 }
 
 TEST(MethodComparison, MethodNamesRoundTrip) {
-  for (Method m :
-       {Method::kPaper, Method::kPaperLinear, Method::kLaplacian, Method::kLbs, Method::kDqs}) {
+  for (Method m : {Method::kPaper, Method::kPaperLinear, Method::kLaplacian, Method::kLbs,
+                   Method::kDqs, Method::kCor, Method::kDdm}) {
     EXPECT_EQ(*MethodFromName(MethodName(m)), m);
   }
   EXPECT_EQ(MethodFromName("arap").status().code(), StatusCode::kInvalidArgument);

@@ -1,0 +1,65 @@
+#!/usr/bin/env bash
+# deformctl deform's flags (ctest): deformctl_test.sh DEFORMCTL
+# On a small phantom: the ablation switches --joint-nodes and --material (default on/on, in the
+# JSON as joint_nodes_enabled and material_enabled, off removing the joint nodes or the material
+# weights), the methods cor and ddm (rest pose in, rest mesh out), the triangle counts in the JSON,
+# and bad values (exit 2 for a flag CLI11 refuses, 1 for an unknown method). Needs python3.
+set -euo pipefail
+DEFORMCTL="$1"
+WORK="$(mktemp -d)"
+trap 'rm -rf "$WORK"' EXIT
+failed=0
+
+# run NAME EXPECTED-EXIT PYTHON-CHECK ARGS...: the check is a Python expression over d (the JSON).
+run() {
+  local name=$1 expected=$2 check=$3
+  shift 3
+  local status=0
+  "$DEFORMCTL" deform --phantom-vertices 800 "$@" >"$WORK/out" 2>"$WORK/err" </dev/null || status=$?
+  if [ "$status" -ne "$expected" ]; then
+    echo "FAIL: $name: exit $status (expected $expected): $(head -c 300 "$WORK/err")" >&2
+    failed=1
+    return
+  fi
+  if [ -n "$check" ] &&
+    ! python3 -c "import json,sys; d=json.load(open(sys.argv[1])); sys.exit(0 if ($check) else 1)" \
+      "$WORK/out"; then
+    echo "FAIL: $name: '$check' does not hold for $(head -c 600 "$WORK/out")" >&2
+    failed=1
+    return
+  fi
+  echo "ok: $name"
+}
+
+run "defaults: both switches on" 0 \
+  "d['joint_nodes_enabled'] and d['material_enabled'] and d['joint_nodes'] > 0" \
+  --pose knee:flexion:90
+run "triangle counts are reported" 0 \
+  "isinstance(d['inverted_triangles'], int) and isinstance(d['self_intersections'], int)" \
+  --pose knee:flexion:90
+run "--joint-nodes off" 0 \
+  "not d['joint_nodes_enabled'] and d['material_enabled'] and d['joint_nodes'] == 0" \
+  --pose knee:flexion:90 --joint-nodes off
+run "--material off" 0 \
+  "d['joint_nodes_enabled'] and not d['material_enabled'] and d['joint_nodes'] > 0" \
+  --pose knee:flexion:90 --material off
+run "both off is the plain Laplacian's volume" 0 \
+  "not d['joint_nodes_enabled'] and not d['material_enabled']" \
+  --pose knee:flexion:90 --joint-nodes off --material off
+plain=$(python3 -c "import json; print(json.load(open('$WORK/out'))['volume_change'])")
+run "laplacian reports neither" 0 \
+  "not d['joint_nodes_enabled'] and not d['material_enabled'] and \
+   abs(d['volume_change'] - $plain) < 1e-12" \
+  --pose knee:flexion:90 --method laplacian
+run "--method cor: rest in, rest out" 0 "d['method'] == 'cor' and d['max_displacement'] < 1e-9" \
+  --method cor
+run "--method ddm: rest in, rest out" 0 "d['method'] == 'ddm' and d['max_displacement'] < 1e-9" \
+  --method ddm
+run "--method ddm bends the knee" 0 "abs(d['volume_change']) < 0.05 and d['max_displacement'] > 0.1" \
+  --method ddm --pose knee:flexion:90
+run "--joint-nodes maybe is refused" 2 "" --joint-nodes maybe
+run "--material 0 is refused" 2 "" --material 0
+run "an unknown method is refused" 1 "" --method arap
+
+[ "$failed" -eq 0 ] || exit 1
+echo "PASS: deformctl deform's flags"
