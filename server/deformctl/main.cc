@@ -2,6 +2,7 @@
 //
 //   deformctl deform [--mesh FILE --skeleton FILE [--weights FILE] | --mesh RIG.glb] --pose SPEC
 //                    [--method paper|paper-linear|laplacian|lbs|dqs] [--out FILE] [--repeat N]
+//                    [--laplacian uniform|cotangent|intrinsic]
 //   deformctl phantom --out FILE [--skeleton-out FILE] [--vertices N]
 //
 // Prints one JSON object on stdout; errors are one line on stderr and a non-zero exit code.
@@ -36,6 +37,7 @@ struct DeformArgs {
   int repeat = 1;
   double radius_factor = 1.5;
   std::string ordering = "auto";
+  std::string laplacian = "uniform";
 };
 
 struct PhantomArgs {
@@ -49,11 +51,13 @@ int Fail(const Status& status) {
   return 1;
 }
 
-// The paper's options with the command line's region radius factor and ordering.
+// The paper's options with the command line's region radius factor, ordering and Laplacian
+// weights.
 StatusOr<deform::ModelOptions> ModelOptionsFrom(const DeformArgs& args) {
   deform::ModelOptions options = deform::ModelOptions::Paper();
   options.regions.radius_factor = args.radius_factor;
   DEFORM_ASSIGN_OR_RETURN(options.ordering, deform::OrderingFromName(args.ordering));
+  DEFORM_ASSIGN_OR_RETURN(options.laplacian, deform::LaplacianWeightsFromName(args.laplacian));
   return options;
 }
 
@@ -91,6 +95,15 @@ nlohmann::ordered_json DeformReport(const DeformArgs& args, const deform::ModelI
   out["joint_nodes"] = run.joint_nodes;
   out["anchors"] = run.anchors;
   out["binding"] = BindingJson(model.binding_report());
+  const deform::LaplacianWeightReport& weights = model.laplacian_weight_report();
+  out["laplacian"] = {{"weights", deform::LaplacianWeightsName(weights.kind)},
+                      {"edges", weights.edges},
+                      {"negative_edges", weights.negative_edges},
+                      {"clamped_cotangents", weights.clamped_cotangents},
+                      {"uniform_rows", weights.uniform_rows},
+                      {"flips", weights.flips},
+                      {"new_neighbor_pairs", weights.new_neighbor_pairs},
+                      {"zeroed_edges", weights.zeroed_edges}};
   out["clamped_angles"] = clamped;
   out["volume_change"] = q.volume_change;
   out["clearance_min"] = q.clearance.min;
@@ -194,6 +207,9 @@ CLI::App* AddDeformCommand(CLI::App* app, DeformArgs* args) {
                  "Joint region radius in limb radii");
   AddWithDefault(command, "--ordering", &args->ordering,
                  "Fill-reducing ordering: auto | metis | amd | natural");
+  AddWithDefault(command, "--laplacian", &args->laplacian,
+                 "Laplacian edge weights: uniform | cotangent | intrinsic (intrinsic Delaunay "
+                 "cotangent)");
   return command;
 }
 
