@@ -3,6 +3,7 @@
 //   deformctl deform [--mesh FILE --skeleton FILE [--weights FILE] | --mesh RIG.glb] --pose SPEC
 //                    [--method paper|paper-linear|laplacian|lbs|dqs|cor|ddm] [--out FILE]
 //                    [--repeat N] [--joint-nodes on|off] [--material on|off]
+//                    [--laplacian uniform|cotangent|intrinsic]
 //                    [--bone-surface FILE:BONE ...] [--bones input|capsules|none]
 //                    [--contacts on|off] [--volume on|off] [--out-bones DIR]
 //   deformctl phantom --out FILE [--skeleton-out FILE] [--vertices N]
@@ -52,6 +53,7 @@ struct DeformArgs {
   int bone_surface_count = 0;  // set once they are loaded
   std::string joint_nodes = "on";  // off: ModelOptions::use_joint_nodes = false
   std::string material = "on";     // off: ModelOptions::uniform_material = true
+  std::string laplacian = "uniform";
 };
 
 struct PhantomArgs {
@@ -65,14 +67,15 @@ int Fail(const Status& status) {
   return 1;
 }
 
-// The paper's options with the command line's region radius factor, ordering and ablation
-// switches (the joint nodes, the material weights).
+// The paper's options with the command line's region radius factor, ordering, Laplacian weights
+// and ablation switches (the joint nodes, the material weights).
 StatusOr<deform::ModelOptions> ModelOptionsFrom(const DeformArgs& args) {
   deform::ModelOptions options = deform::ModelOptions::Paper();
   options.regions.radius_factor = args.radius_factor;
   options.use_joint_nodes = args.joint_nodes == "on";
   options.uniform_material = args.material == "off";
   DEFORM_ASSIGN_OR_RETURN(options.ordering, deform::OrderingFromName(args.ordering));
+  DEFORM_ASSIGN_OR_RETURN(options.laplacian, deform::LaplacianWeightsFromName(args.laplacian));
   return options;
 }
 
@@ -138,6 +141,15 @@ nlohmann::ordered_json DeformReport(const DeformArgs& args, const deform::ModelI
   out["material_enabled"] = !plain && !model.options().uniform_material;
   out["anchors"] = run.anchors;
   out["binding"] = BindingJson(model.binding_report());
+  const deform::LaplacianWeightReport& weights = model.laplacian_weight_report();
+  out["laplacian"] = {{"weights", deform::LaplacianWeightsName(weights.kind)},
+                      {"edges", weights.edges},
+                      {"negative_edges", weights.negative_edges},
+                      {"clamped_cotangents", weights.clamped_cotangents},
+                      {"uniform_rows", weights.uniform_rows},
+                      {"flips", weights.flips},
+                      {"new_neighbor_pairs", weights.new_neighbor_pairs},
+                      {"zeroed_edges", weights.zeroed_edges}};
   out["clamped_angles"] = clamped;
   out["volume_change"] = q.volume_change;
   out["clearance_min"] = q.clearance.min;
@@ -308,6 +320,9 @@ CLI::App* AddDeformCommand(CLI::App* app, DeformArgs* args) {
   AddWithDefault(command, "--material", &args->material,
                  "Material weights (off: every row weight 1, for ablation)")
       ->check(CLI::IsMember({"on", "off"}));
+  AddWithDefault(command, "--laplacian", &args->laplacian,
+                 "Laplacian edge weights: uniform | cotangent | intrinsic (intrinsic Delaunay "
+                 "cotangent)");
   return command;
 }
 

@@ -286,6 +286,8 @@ class DeformationModel {
   // binding; empty when the model bound automatically.
   const std::optional<SkinWeights>& given_weights() const { return given_weights_; }
   int num_joint_nodes() const { return system_.num_nodes; }
+  // What options.laplacian's edge weights came to (flips, negative weights, rows made uniform).
+  const LaplacianWeightReport& laplacian_weight_report() const { return system_.weight_report; }
   double bounding_box_diagonal() const { return diagonal_; }
   // Seconds spent in Build() before the first numeric factorization.
   double precompute_seconds() const { return precompute_seconds_; }

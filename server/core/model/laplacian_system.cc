@@ -8,23 +8,30 @@
 namespace deform {
 namespace {
 
-// L' (n by n + m): uniform weights over the one-ring plus the joint nodes of the vertex.
-RowMajorSparseMatrix BuildLaplacian(const VertexAdjacency& adjacency, const JointRegions& regions,
+// L' (n by n + m): the rows' edge `weights` plus the joint nodes of the vertex, each row summing
+// to 0. With uniform weights the arithmetic is the uniform Laplacian's own (1 * share is share).
+RowMajorSparseMatrix BuildLaplacian(const WeightedAdjacency& weights, const JointRegions& regions,
                                     int num_nodes, const ModelOptions& options) {
-  const int n = static_cast<int>(adjacency.offsets.size()) - 1;
+  const int n = static_cast<int>(weights.offsets.size()) - 1;
   std::vector<Eigen::Triplet<double>> triplets;
-  triplets.reserve(adjacency.neighbors.size() + n * 2);
+  triplets.reserve(weights.neighbors.size() + n * 2);
   for (int i = 0; i < n; ++i) {
     const int nodes = options.use_joint_nodes
                           ? regions.membership_offsets[i + 1] - regions.membership_offsets[i]
                           : 0;
-    // Weight of the edge to each joint node, in units of one one-ring edge.
-    const double node_edge =
-        options.joint_node_one_neighbor ? 1.0 : options.joint_node_balance * adjacency.degree(i);
-    const double share = 1.0 / (adjacency.degree(i) + nodes * node_edge);
+    double weight_sum = 0;
+    for (int p = weights.offsets[i]; p < weights.offsets[i + 1]; ++p) {
+      weight_sum += weights.weights[p];
+    }
+    // Weight of the edge to each joint node: the row's mean edge weight, or balance times the
+    // whole one-ring's.
+    const double node_edge = options.joint_node_one_neighbor
+                                 ? weight_sum / weights.degree(i)
+                                 : options.joint_node_balance * weight_sum;
+    const double share = 1.0 / (weight_sum + nodes * node_edge);
     triplets.emplace_back(i, i, 1.0);
-    for (int p = adjacency.offsets[i]; p < adjacency.offsets[i + 1]; ++p) {
-      triplets.emplace_back(i, adjacency.neighbors[p], -share);
+    for (int p = weights.offsets[i]; p < weights.offsets[i + 1]; ++p) {
+      triplets.emplace_back(i, weights.neighbors[p], -weights.weights[p] * share);
     }
     if (nodes > 0) {
       for (int p = regions.membership_offsets[i]; p < regions.membership_offsets[i + 1]; ++p) {
@@ -62,7 +69,9 @@ LaplacianSystem BuildLaplacianSystem(const TriangleMesh& mesh, const VertexAdjac
   for (int c = 0; c < system.num_nodes; ++c) {
     system.node_joints.push_back(regions.regions[c].joint);
   }
-  system.laplacian = BuildLaplacian(adjacency, regions, system.num_nodes, options);
+  const WeightedAdjacency edge_weights =
+      BuildLaplacianWeights(mesh, adjacency, options.laplacian, &system.weight_report);
+  system.laplacian = BuildLaplacian(edge_weights, regions, system.num_nodes, options);
   system.laplacian_transpose = system.laplacian.transpose();
   system.laplacian_transpose.makeCompressed();
   system.rest_deltas = RestDeltas(mesh, regions, system.laplacian, system.num_nodes);

@@ -19,6 +19,7 @@
 #include "core/geometry/mesh.h"
 #include "core/geometry/mesh_topology.h"
 #include "core/model/bone_weights.h"
+#include "core/model/cotangent_weights.h"
 #include "core/model/joint_regions.h"
 #include "core/model/model_options.h"
 
@@ -30,10 +31,14 @@ struct LaplacianSystem {
   int num_vertices = 0;          // n
   int num_nodes = 0;             // m: one per joint region with options.use_joint_nodes, else none
   std::vector<int> node_joints;  // the joint of each joint node (m)
-  // L' (n by n + m), uniform weights over the one-ring plus the vertex's joint nodes, compressed
-  // by rows; and its transpose for A^T b.
+  // L' (n by n + m), options.laplacian's edge weights (cotangent_weights.h) plus the vertex's joint
+  // nodes, compressed by rows; and its transpose for A^T b. Its pattern is the one-ring's except
+  // with kIntrinsicCotangent after flips (weight_report.new_neighbor_pairs): everything downstream
+  // (the normal matrix, RigidRows, GeneralRowsPlan, the linear response) reads the pattern from
+  // here.
   RowMajorSparseMatrix laplacian;
   RowMajorSparseMatrix laplacian_transpose;
+  LaplacianWeightReport weight_report;
   Positions rest_deltas;     // delta = L' x_rest, n by 3
   std::vector<int> anchors;  // the anchor vertices, ascending
   // Anchor a's target is sum_e anchor_weights[e] B_(anchor_bones[e]) (rest a) over its entries
@@ -49,7 +54,7 @@ struct LaplacianSystem {
 
 // Builds the system for `mesh` with its one-ring `adjacency`, joint `regions`, rigid zones
 // (`fixed_bone[i]` the bone vertex i belongs to wholly, -1 for none) and bone `weights` (what the
-// anchors follow). A region vertex's row refers
+// anchors follow). The rows' edge weights: options.laplacian. A region vertex's row refers
 // to its joint nodes with options.joint_node_balance (or as one more neighbour, with
 // joint_node_one_neighbor). Anchors: ChooseAnchors (anchors.h) with options.anchor_distance_factor
 // and options.anchor_min_fraction.

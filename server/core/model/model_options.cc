@@ -6,6 +6,27 @@
 
 namespace deform {
 
+const char* LaplacianWeightsName(LaplacianWeights weights) {
+  switch (weights) {
+    case LaplacianWeights::kUniform:
+      return "uniform";
+    case LaplacianWeights::kCotangent:
+      return "cotangent";
+    case LaplacianWeights::kIntrinsicCotangent:
+      return "intrinsic";
+  }
+  return "unknown";
+}
+
+StatusOr<LaplacianWeights> LaplacianWeightsFromName(std::string_view name) {
+  for (const LaplacianWeights weights : {LaplacianWeights::kUniform, LaplacianWeights::kCotangent,
+                                         LaplacianWeights::kIntrinsicCotangent}) {
+    if (name == LaplacianWeightsName(weights)) return weights;
+  }
+  return Status::InvalidArgument("laplacian must be uniform, cotangent or intrinsic, got '" +
+                                 std::string(name) + "'");
+}
+
 ModelOptions ModelOptions::PlainLaplacian(ModelOptions base) {
   base.use_joint_nodes = false;
   base.uniform_material = true;

@@ -2,6 +2,8 @@
 // DeformationModel::Build applies to them.
 #pragma once
 
+#include <string_view>
+
 #include "core/base/status.h"
 #include "core/geometry/mesh.h"
 #include "core/model/joint_regions.h"
@@ -30,6 +32,24 @@ enum class BindingMethod {
   kStraightLine,
 };
 
+// The edge weights w_ij of the Laplacian rows L' (cotangent_weights.h). The harmonic bone weights
+// always use uniform weights, whose maximum principle keeps them in [0, 1].
+enum class LaplacianWeights {
+  // 1 per one-ring edge: METHOD.md's reference.
+  kUniform,
+  // (cot a_ij + cot b_ij) / 2, the mesh's own: follows its metric; negative at obtuse triangles.
+  kCotangent,
+  // The cotangent weights of the intrinsic Delaunay triangulation of the same surface (edge
+  // flips): all non-negative; a flipped edge joins vertices that were not neighbours, so L' has
+  // entries outside the one-ring.
+  kIntrinsicCotangent,
+};
+
+// "uniform", "cotangent", "intrinsic".
+const char* LaplacianWeightsName(LaplacianWeights weights);
+// The inverse of LaplacianWeightsName; INVALID_ARGUMENT naming the choices for anything else.
+StatusOr<LaplacianWeights> LaplacianWeightsFromName(std::string_view name);
+
 struct ModelOptions {
   // Add a joint centre node per inner joint, joined to its region's vertices. Default: true.
   // false with uniform_material gives the plain Laplacian baseline.
@@ -52,6 +72,11 @@ struct ModelOptions {
   static constexpr double kMaxJointNodeBalance = 100;
   // Weigh the joint node as exactly one more neighbour (METHOD.md's 1/(d_i + 1)). Default: false.
   bool joint_node_one_neighbor = false;
+  // The Laplacian rows' edge weights. With weights w_ij, delta_i = v_i - (sum_j w_ij v_j +
+  // lambda s_i o_c) / (s_i (1 + lambda)), s_i = sum_j w_ij (the joint node weighs lambda s_i, or
+  // with joint_node_one_neighbor the row's mean weight s_i / d_i). Default: kUniform
+  // (docs/method.md, "Cotangent weights", says why).
+  LaplacianWeights laplacian = LaplacianWeights::kUniform;
   // Weight of the rows that move anchor vertices with their skinning (rigidly with their bone in
   // a rigid zone). Default: 40, the weight at which rigid zones follow linear blend skinning
   // closely without costing volume or clearance (docs/method.md, "Anchors").
