@@ -7,6 +7,12 @@
 # Needs a build (scripts/build.sh) and python3. DEFORM_QUALITY_METHODS="paper-linear lbs" limits
 # the methods, DEFORM_QUALITY_DEGREES="90 120" the angles.
 #
+# Every case has bone surfaces: the phantom its femur, tibia and patella, the shared meshes one
+# capsule per bone by MakeCapsuleBoneSurfaces' sizing rule (deformctl --bones capsules), and
+# bone_inside counts the skin vertices inside one. paper and paper-linear keep the skin outside
+# them and keep the volume (deformctl --contacts, --volume); DEFORM_QUALITY_CONSTRAINTS=off
+# measures them without.
+#
 # DEFORM_QUALITY_ABLATION=1 prints the ablation of METHOD.md's two additions instead (the paper's
 # figure 2): the paper's model plain (neither), with the joint node only, with the material
 # weights only, and with both, on every case at 90 and 120 degrees (deformctl's --joint-nodes and
@@ -67,23 +73,25 @@ fi
 
 # One row: the measures of deformctl's JSON on stdin, after the row's leading cells.
 row() {
-  python3 -c "import json,sys; d=json.load(sys.stdin); print('| $1 | %+.4f | %.3f | %.3f | %.4f | %.1e | %d | %d |' % (d['volume_change'], d['clearance_min'], d['clearance_p01'], d['sink_fraction'], d['rigid_zone_error'], d['inverted_triangles'], d['self_intersections']))"
+  python3 -c "import json,sys; d=json.load(sys.stdin); print('| $1 | %+.4f | %.3f | %.3f | %.4f | %.1e | %d | %d | %s |' % (d['volume_change'], d['clearance_min'], d['clearance_p01'], d['sink_fraction'], d['rigid_zone_error'], d['inverted_triangles'], d['self_intersections'], d.get('bone_penetration', {}).get('vertices', '-')))"
 }
 
 if [ "${DEFORM_QUALITY_ABLATION:-0}" = 1 ]; then
   # variant name | --joint-nodes | --material
   VARIANTS=("plain|off|off" "node only|on|off" "material only|off|on" "both|on|on")
-  echo "| mesh | degrees | variant | volume_change | clearance_min | clearance_p01 | sink_fraction | rigid_zone_error | inverted_triangles | self_intersections |"
-  echo "|---|---|---|---|---|---|---|---|---|---|"
+  echo "| mesh | degrees | variant | volume_change | clearance_min | clearance_p01 | sink_fraction | rigid_zone_error | inverted_triangles | self_intersections | bone_inside |"
+  echo "|---|---|---|---|---|---|---|---|---|---|---|"
 else
-  echo "| mesh | degrees | method | volume_change | clearance_min | clearance_p01 | sink_fraction | rigid_zone_error | inverted_triangles | self_intersections |"
-  echo "|---|---|---|---|---|---|---|---|---|---|"
+  echo "| mesh | degrees | method | volume_change | clearance_min | clearance_p01 | sink_fraction | rigid_zone_error | inverted_triangles | self_intersections | bone_inside |"
+  echo "|---|---|---|---|---|---|---|---|---|---|---|"
 fi
 for case in "${CASES[@]}"; do
   IFS='|' read -r name mesh skeleton weights pose <<<"$case"
   args=()
-  [ -n "$mesh" ] && args=(--mesh "$mesh" --skeleton "$skeleton")
+  [ -n "$mesh" ] && args=(--mesh "$mesh" --skeleton "$skeleton" --bones capsules)
   [ -n "$weights" ] && args+=(--weights "$weights")
+  constraints=${DEFORM_QUALITY_CONSTRAINTS:-on}
+  args+=(--contacts "$constraints" --volume "$constraints")
   if [ "${DEFORM_QUALITY_ABLATION:-0}" = 1 ]; then
     degree_list=${DEFORM_QUALITY_DEGREES:-90 120}
   else
@@ -95,8 +103,9 @@ for case in "${CASES[@]}"; do
     if [ "${DEFORM_QUALITY_ABLATION:-0}" = 1 ]; then
       for variant in "${VARIANTS[@]}"; do
         IFS='|' read -r label nodes material <<<"$variant"
+        # The paper's figure 2: the method's two additions alone, no constraints.
         "$DEFORMCTL" deform "${args[@]}" --pose "$spec" --method paper --joint-nodes "$nodes" \
-          --material "$material" 2>/dev/null | row "$name | $degrees | $label"
+          --material "$material" --contacts off --volume off 2>/dev/null | row "$name | $degrees | $label"
       done
       continue
     fi
