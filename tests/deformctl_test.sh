@@ -3,7 +3,9 @@
 # On a small phantom: the ablation switches --joint-nodes and --material (default on/on, in the
 # JSON as joint_nodes_enabled and material_enabled, off removing the joint nodes or the material
 # weights), the methods cor and ddm (rest pose in, rest mesh out), the triangle counts in the JSON,
-# and bad values (exit 2 for a flag CLI11 refuses, 1 for an unknown method). Needs python3.
+# the bone surfaces (the phantom's, capsules, files; bone_penetration for every method) and the
+# constraints (--contacts, --volume), and bad values (exit 2 for a flag CLI11 refuses, 1 for an
+# unknown method or a bad bone surface). Needs python3.
 set -euo pipefail
 DEFORMCTL="$1"
 WORK="$(mktemp -d)"
@@ -45,7 +47,7 @@ run "--material off" 0 \
   --pose knee:flexion:90 --material off
 run "both off is the plain Laplacian's volume" 0 \
   "not d['joint_nodes_enabled'] and not d['material_enabled']" \
-  --pose knee:flexion:90 --joint-nodes off --material off
+  --pose knee:flexion:90 --joint-nodes off --material off --contacts off --volume off
 plain=$(python3 -c "import json; print(json.load(open('$WORK/out'))['volume_change'])")
 run "laplacian reports neither" 0 \
   "not d['joint_nodes_enabled'] and not d['material_enabled'] and \
@@ -57,6 +59,46 @@ run "--method ddm: rest in, rest out" 0 "d['method'] == 'ddm' and d['max_displac
   --method ddm
 run "--method ddm bends the knee" 0 "abs(d['volume_change']) < 0.05 and d['max_displacement'] > 0.1" \
   --method ddm --pose knee:flexion:90
+run "bones: the phantom's three, none inside after the frame, volume kept" 0 \
+  "d['bone_surfaces'] == 3 and d['bone_penetration']['vertices'] == 0 and \
+   abs(d['volume_change']) < 1e-4 and d['constraints']['rounds'] >= 1" \
+  --pose knee:flexion:120
+run "constraints off: the model's own frame" 0 \
+  "d['constraints']['rounds'] == 0 and abs(d['volume_change']) > 1e-3" \
+  --pose knee:flexion:120 --contacts off --volume off
+run "--method lbs reports its bone penetration" 0 \
+  "d['bone_penetration']['vertices'] >= 0 and 'constraints' not in d" \
+  --pose knee:flexion:120 --method lbs
+run "--bones capsules on the phantom" 0 "d['bone_surfaces'] == 2" --bones capsules
+run "--bones none" 0 "d['bone_surfaces'] == 0 and 'bone_penetration' not in d" --bones none
+# A box around the whole leg (outward faces): a bone the rest skin is inside of.
+cat >"$WORK/box.obj" <<'OBJ'
+v -2 -1 -2
+v 2 -1 -2
+v 2 10 -2
+v -2 10 -2
+v -2 -1 2
+v 2 -1 2
+v 2 10 2
+v -2 10 2
+f 1 4 3
+f 1 3 2
+f 5 6 7
+f 5 7 8
+f 1 2 6
+f 1 6 5
+f 4 8 7
+f 4 7 3
+f 1 5 8
+f 1 8 4
+f 2 3 7
+f 2 7 6
+OBJ
+run "--bone-surface FILE:BONE that the rest skin is inside of is refused" 1 "" \
+  --bone-surface "$WORK/box.obj:hip"
+grep -q "at rest" "$WORK/err" || { echo "FAIL: the refusal does not say 'at rest'" >&2; failed=1; }
+run "--bone-surface with an unknown bone is refused" 1 "" --bone-surface "$WORK/box.obj:elbow"
+grep -q "no bone named 'elbow'" "$WORK/err" || { echo "FAIL: the refusal does not name the bone" >&2; failed=1; }
 run "--joint-nodes maybe is refused" 2 "" --joint-nodes maybe
 run "--material 0 is refused" 2 "" --material 0
 run "an unknown method is refused" 1 "" --method arap
