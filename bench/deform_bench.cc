@@ -30,6 +30,8 @@
 #include "bench/memory_bandwidth.h"
 #include "core/base/build_info.h"
 #include "core/base/median.h"
+#include "core/constraints/skin_constraints.h"
+#include "core/geometry/bone_surface.h"
 #include "core/io/model_input.h"
 #include "core/io/phantom.h"
 #include "core/model/deformation_model.h"
@@ -117,6 +119,50 @@ void BM_Frame(benchmark::State& state, BenchMesh mesh) {
   });
   ReportAgainstBound(state, frames->factorization->factor().bytes(), seconds);
   state.counters["vertices"] = frames->model->mesh().num_vertices();
+}
+
+// The bone surfaces of `mesh`'s limb: the phantom's own (femur, tibia, patella), capsules by the
+// sizing rule (MakeCapsuleBoneSurfaces) on the shared meshes.
+std::vector<BoneSurface> BenchBones(const BenchMesh& mesh, const DeformationModel& model) {
+  if (mesh.mesh_path.empty()) {
+    auto phantom = MakeKneePhantom();  // as ModelFor builds it
+    if (phantom.ok()) return phantom->bones;
+  }
+  return MakeCapsuleBoneSurfaces(model.mesh(), model.skeleton());
+}
+
+// A whole frame with the constraints (core/constraints): the frame of BM_Frame, then the skin held
+// outside the bones and the volume kept, at `degrees` of flexion (the benchmark pose where 0).
+// Compare with Frame/ of the same mesh in the same run.
+void BM_ConstrainedFrame(benchmark::State& state, BenchMesh mesh, int degrees) {
+  auto frames = SetUpFrames(state, mesh);
+  if (!frames) return;
+  if (degrees > 0) {
+    frames->pose =
+        PoseFromSpecOrRest(*frames->model, mesh.flexion_prefix + std::to_string(degrees));
+  }
+  auto bones = BoneContacts::Create(BenchBones(mesh, *frames->model), frames->model->skeleton(),
+                                    frames->model->mesh(), frames->model->rigid_bones());
+  if (!bones.ok()) {
+    state.SkipWithError(bones.status().ToString().c_str());
+    return;
+  }
+  auto constraints = SkinConstraints::Create(*frames->model, *bones);
+  if (!constraints.ok()) {
+    state.SkipWithError(constraints.status().ToString().c_str());
+    return;
+  }
+  ConstraintScratch scratch = (*constraints)->MakeScratch();
+  ConstraintReport report;
+  const auto seconds = TimeEach(state, [&] {
+    frames->model->Deform(*frames->factorization, frames->pose, &frames->scratch);
+    (*constraints)->Apply(*frames->factorization, &frames->scratch, &scratch, &report);
+  });
+  ReportAgainstBound(state, frames->factorization->factor().bytes(), seconds);
+  state.counters["inside_before"] = report.before.vertices;
+  state.counters["inside_after"] = report.after.vertices;
+  state.counters["contacts"] = report.contacts;
+  state.counters["solves"] = report.solves;
 }
 
 // A whole frame of the linear rotation blend (METHOD.md's fast path): kinematics and one pass over
@@ -496,6 +542,8 @@ void RegisterBenchmarks(const BenchMesh& mesh) {
   RegisterFor(mesh, "Precompute", BM_Precompute)->Iterations(large ? 1 : 3);
   RegisterFor(mesh, "Factorize", BM_Factorize)->Iterations(large ? 2 : 5);
   RegisterFor(mesh, "Frame", BM_Frame)->MinTime(1.0);
+  RegisterFor(mesh, "ConstrainedFrame", BM_ConstrainedFrame, 0)->MinTime(1.0);
+  RegisterFor(mesh, "ConstrainedFrame/degrees:120", BM_ConstrainedFrame, 120)->MinTime(1.0);
   RegisterFor(mesh, "LinearBlendFrame", BM_LinearBlendFrame)->MinTime(1.0);
   RegisterFor(mesh, "RightHandSide", BM_RightHandSide)->MinTime(0.5);
   RegisterFor(mesh, "TriangularSolve", BM_TriangularSolve, BestSolveKernel())->MinTime(1.0);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <limits>
 #include <utility>
 
 namespace deform {
@@ -91,11 +92,31 @@ StatusOr<std::shared_ptr<const SkinConstraints>> SkinConstraints::Create(
   }
   const double cube = std::pow(model.bounding_box_diagonal(), 3);
   if (constraints->bones_ != nullptr) {
+    constraints->adjacency_ = BuildVertexAdjacency(mesh.triangles, mesh.num_vertices());
     model.default_factorization()->factor().LongestUnitSolvePath(&constraints->path_columns_,
                                                                  &constraints->path_supernodes_);
   }
   constraints->keeps_volume_ =
       options.keep_volume && any_free && std::abs(constraints->rest_volume_) > 1e-9 * cube;
+  if (constraints->keeps_volume_) {
+    constraints->rest_gradient_.resize(3 * static_cast<std::size_t>(mesh.num_vertices()));
+    constraints->closure_->Gradient(mesh.vertices.data(), constraints->rest_gradient_.data());
+    std::vector<char> used(model.skeleton().num_bones(), 0);
+    const BoneWeights& weights = model.bone_weights();
+    for (int i = 0; i < mesh.num_vertices(); ++i) {
+      if (!constraints->volume_free_[i]) {
+        std::fill_n(constraints->rest_gradient_.begin() + 3 * i, 3, 0.0);
+        continue;
+      }
+      for (int e = weights.offsets[i]; e < weights.offsets[i + 1]; ++e) used[weights.bones[e]] = 1;
+    }
+    for (int k = 0; k < model.skeleton().num_bones(); ++k) {
+      if (used[k]) constraints->direction_bones_.push_back(k);
+    }
+    for (int i = 0; i < mesh.num_vertices(); ++i) {
+      if (constraints->volume_free_[i]) constraints->free_vertices_.push_back(i);
+    }
+  }
   return std::shared_ptr<const SkinConstraints>(std::move(constraints));
 }
 
@@ -109,6 +130,8 @@ ConstraintScratch SkinConstraints::MakeScratch() const {
   if (keeps_volume_) {
     s.gradient.resize(3 * rows);
     s.h.resize(3 * rows);
+    s.bone_directions.resize(direction_bones_.size() * 3 * rows);
+    s.rotations.resize(model_->skeleton().num_bones());
   }
   if (bones_ != nullptr && k > 0) {
     s.unit_work.assign(rows, 0.0);
@@ -132,7 +155,10 @@ std::size_t SkinConstraints::ScratchBytes() const {
   std::size_t doubles =
       6 * rows + (k + 1) * (k + 2) + model_->default_factorization()->factor().WorkSize();
   std::size_t bytes = 0;
-  if (keeps_volume_) doubles += 6 * rows;
+  if (keeps_volume_) {
+    doubles += 6 * rows + direction_bones_.size() * 3 * rows;
+    bytes += model_->skeleton().num_bones() * sizeof(Eigen::Matrix3d);
+  }
   if (bones_ != nullptr && k > 0) {
     doubles += rows + k * path_columns_ + k * k;
     bytes += (k * path_supernodes_ + k) * sizeof(int) + 2 * k * sizeof(BonePenetration) +
@@ -174,7 +200,6 @@ void SkinConstraints::AddContacts(const CholeskyFactor& factor, int count, Const
   for (int c = 0; c < count; ++c) {
     const int j = set++;
     s->contacts[j] = s->found[c];
-    s->in_set[s->found[c].vertex] = 1;
     const int length = factor.ForwardUnitSolve(
         s->found[c].vertex, s->paths.data() + j * static_cast<std::size_t>(path_supernodes_),
         s->path_values.data() + j * static_cast<std::size_t>(path_columns_), path_columns_,
@@ -204,13 +229,59 @@ void SkinConstraints::MoveContact(int from, int to, int set, ConstraintScratch* 
   s->inverse_block[to * k + to] = s->inverse_block[from * k + from];
 }
 
+void SkinConstraints::PoseVolumeDirections(const MaterialFactorization& factorization,
+                                           const std::vector<RigidTransform>& bones,
+                                           ConstraintScratch* s, ConstraintReport* report) const {
+  const std::size_t rows = rows_;
+  const int n = model_->mesh().num_vertices();
+  const int directions = static_cast<int>(direction_bones_.size());
+  if (s->directions_serial != factorization.serial()) {
+    // D_k = M^-1 (h_k g_rest) for this factorization: once per stream and stiffness.
+    const BoneWeights& weights = model_->bone_weights();
+    for (int d = 0; d < directions; ++d) {
+      double* column = s->bone_directions.data() + d * 3 * rows;
+      std::fill(column, column + 3 * rows, 0.0);
+      for (int i = 0; i < n; ++i) {
+        for (int e = weights.offsets[i]; e < weights.offsets[i + 1]; ++e) {
+          if (weights.bones[e] != direction_bones_[d]) continue;
+          for (int c = 0; c < 3; ++c)
+            column[3 * i + c] = weights.weights[e] * rest_gradient_[3 * i + c];
+        }
+      }
+      Solved(factorization.factor().Solve3(column, column, s->solve_work.data()));
+      ++report->solves;
+    }
+    s->directions_serial = factorization.serial();
+  }
+  // g = sum_k h_ik R_k g_rest_i and its direction M^-1 g = sum_k D_k R_k^T, by rows.
+  const BoneWeights& weights = model_->bone_weights();
+  for (std::size_t k = 0; k < bones.size(); ++k) {
+    s->rotations[k] = bones[k].rotation.toRotationMatrix();
+  }
+  std::fill(s->gradient.begin(), s->gradient.end(), 0.0);
+  for (int i : free_vertices_) {
+    const Vec3 g(rest_gradient_.data() + 3 * i);
+    Eigen::Map<Eigen::Vector3d> posed(s->gradient.data() + 3 * i);
+    for (int e = weights.offsets[i]; e < weights.offsets[i + 1]; ++e) {
+      posed += weights.weights[e] * (s->rotations[weights.bones[e]] * g);
+    }
+  }
+  std::fill(s->h.begin(), s->h.end(), 0.0);
+  for (int d = 0; d < directions; ++d) {
+    const Eigen::Matrix3d& rotation = s->rotations[direction_bones_[d]];
+    const double* column = s->bone_directions.data() + d * 3 * rows;
+    for (std::size_t r = 0; r < rows; ++r) {
+      Eigen::Map<Eigen::Vector3d>(s->h.data() + 3 * r) += rotation * Vec3(column + 3 * r);
+    }
+  }
+}
+
 bool SkinConstraints::Apply(const MaterialFactorization& factorization, DeformScratch* frame,
                             ConstraintScratch* s, ConstraintReport* report) const {
   *report = {};
   if (!model_->Owns(factorization, *frame) || s->owner != this) return false;
   const CholeskyFactor& factor = factorization.factor();
   const std::size_t values = 3 * static_cast<std::size_t>(rows_);
-  const int n = model_->mesh().num_vertices();
   const int k_max = options_.max_contacts;
   double* x = frame->solution.data();
   std::copy(x, x + values, s->base.begin());
@@ -218,6 +289,15 @@ bool SkinConstraints::Apply(const MaterialFactorization& factorization, DeformSc
     return rest_volume_ != 0 ? volume / rest_volume_ - 1 : 0.0;
   };
   int& set = report->contacts;
+  // The volume of x when a round already knows it (the cubic's value at its mu); NaN otherwise.
+  double known_volume = std::numeric_limits<double>::quiet_NaN();
+  double cubic[4] = {0, 0, 0, 0};
+  if (keeps_volume_) {
+    PoseVolumeDirections(factorization, frame->bone_transforms, s, report);
+    // Along x* + mu M^-1 g: its value at mu = 0 is the volume of x*.
+    closure_->VolumeAlong(s->base.data(), s->h.data(), cubic);
+    known_volume = cubic[0];
+  }
   for (int round = 0;; ++round) {
     PenetrationSummary summary;
     int found = 0;
@@ -225,7 +305,8 @@ bool SkinConstraints::Apply(const MaterialFactorization& factorization, DeformSc
       found = bones_->Find(x, frame->bone_transforms, s->found.data(), k_max - set, &summary,
                            s->in_set.empty() ? nullptr : s->in_set.data());
     }
-    const double volume = closure_->Volume(x);
+    const double volume = std::isnan(known_volume) ? closure_->Volume(x) : known_volume;
+    known_volume = std::numeric_limits<double>::quiet_NaN();
     if (round == 0) {
       report->before = summary;
       report->volume_change_before = volume_change(volume);
@@ -247,22 +328,30 @@ bool SkinConstraints::Apply(const MaterialFactorization& factorization, DeformSc
       }
     }
     if ((found == 0 && refreshed == 0 && volume_kept) || round == options_.max_rounds) break;
-    if (found > 0) AddContacts(factor, found, s, report);
+    // Deepest first, skipping the neighbours of the vertices held from this round on: a held
+    // vertex pulls its one-ring out with it, and the next round holds what is still inside.
+    const char mark = static_cast<char>(round + 1);
+    int kept = 0;
+    for (int c = 0; c < found; ++c) {
+      const int vertex = s->found[c].vertex;
+      bool beside = false;
+      for (int e = adjacency_.offsets[vertex]; e < adjacency_.offsets[vertex + 1] && !beside; ++e) {
+        beside = s->in_set[adjacency_.neighbors[e]] == mark;
+      }
+      if (beside) continue;
+      s->in_set[vertex] = mark;
+      s->found[kept++] = s->found[c];
+    }
+    if (kept > 0) AddContacts(factor, kept, s, report);
 
-    // The volume row: g at the current frame, its target relative to x*.
+    // The volume row: its gradient as the frame's bones turn the rest gradient, its direction
+    // in the solve's metric, and its target relative to x*.
     bool volume_row = false;
     double volume_target = 0;
     if (keeps_volume_) {
-      closure_->Gradient(x, s->gradient.data());
-      for (int i = 0; i < n; ++i) {
-        if (!volume_free_[i]) std::fill_n(s->gradient.begin() + 3 * i, 3, 0.0);
-      }
-      std::fill(s->gradient.begin() + 3 * n, s->gradient.end(), 0.0);
       double moved = 0;
       for (std::size_t v = 0; v < values; ++v) moved += s->gradient[v] * (x[v] - s->base[v]);
       volume_target = rest_volume_ - volume + moved;
-      Solved(factor.Solve3(s->gradient.data(), s->h.data(), s->solve_work.data()));
-      ++report->solves;
       volume_row = Dot(s->gradient.data(), s->h.data(), values) > 0;
     }
 
@@ -322,6 +411,24 @@ bool SkinConstraints::Apply(const MaterialFactorization& factorization, DeformSc
       Solved(factor.Solve3(s->correction.data(), s->correction.data(), s->solve_work.data()));
       ++report->solves;
       for (std::size_t v = 0; v < values; ++v) x[v] += s->correction[v];
+    }
+    if (volume_row && set == 0) {
+      // The volume alone: along x* + mu h it is a cubic in mu, so take its root next to the
+      // linearised mu (Newton on the cubic) and the volume is kept in this round, not the next.
+      auto cubic_at = [&](double t) {
+        return cubic[0] + t * (cubic[1] + t * (cubic[2] + t * cubic[3]));
+      };
+      for (int step = 0; step < 8; ++step) {
+        const double value = cubic_at(mu) - rest_volume_;
+        const double slope = cubic[1] + mu * (2 * cubic[2] + mu * 3 * cubic[3]);
+        if (!(std::abs(slope) > 0)) break;
+        const double next = mu - value / slope;
+        if (!std::isfinite(next)) break;
+        const bool settled = std::abs(next - mu) <= 1e-14 * std::max(1.0, std::abs(mu));
+        mu = next;
+        if (settled) break;
+      }
+      known_volume = cubic_at(mu);
     }
     if (volume_row) {
       for (std::size_t v = 0; v < values; ++v) x[v] += mu * s->h[v];

@@ -8,18 +8,22 @@
 //   x = argmin (x - x*)^T M (x - x*)  subject to  n_j . x_{i_j} = d_j        (contacts, j < k)
 //                                                 g . (x - x_c) = V_rest - V(x_c)  (volume)
 //
-// (x_c the frame of the previous round, x* in the first; g the volume's gradient at x_c, zero on
-// the rigid zones)
+// (x_c the frame of the previous round, x* in the first). The volume's gradient g is taken as the
+// frame's bones turn the rest gradient (g_i = sum_k h_ik R_k g_rest_i on the vertices outside the
+// rigid zones, zero on them), so that its direction in the solve's metric is
+// M^-1 g = sum_k D_k R_k^T with D_k = M^-1 (h_k g_rest) solved once per stream and factorization:
+// no solve per frame. Without contacts the volume along x* + mu M^-1 g is a cubic in mu, solved
+// exactly, so the volume is kept in one round.
 //
-// with M = A^T A = P^T L L^T P, the one factorization: x = x* + sum_j lambda_j M^-1 e_{i_j} n_j^T +
-// mu M^-1 g. It needs (M^-1)_{i_l i_j} = y_l . y_j with y_j = L^-1 P e_{i_j}, each a forward pass
-// along one path of the elimination tree (CholeskyFactor::ForwardUnitSolve: a fraction of a
-// solve), and M^-1 g (one three-column solve), then a (k + 1)-square dense system and one more
-// three-column solve: low-rank terms on the one factorization, never a refactorization. Contacts
-// come from an active set: solve, find the vertices inside a bone, hold each on its nearest surface
+// With M = A^T A = P^T L L^T P, the one factorization: x = x* + sum_j lambda_j M^-1 e_{i_j} n_j^T +
+// mu M^-1 g. The contacts need (M^-1)_{i_l i_j} = y_l . y_j with y_j = L^-1 P e_{i_j}, each a
+// forward pass along one path of the elimination tree (CholeskyFactor::ForwardUnitSolve: a
+// fraction of a solve), then a (k + 1)-square dense system and one three-column solve for the
+// correction: low-rank terms on the one factorization, never a refactorization. Contacts come
+// from an active set: solve, find the vertices inside a bone, hold each on its nearest surface
 // point's tangent plane (plus a margin), solve again; a contact whose multiplier pulls the skin
-// inward leaves the set. The volume is linearised at the current frame each round, so a second
-// round removes what the linearisation left.
+// inward leaves the set, and a held vertex still inside gets the tangent plane of its new nearest
+// point. One contact per vertex: skin caught between two bones is held out of the deeper.
 #pragma once
 
 #include <cstddef>
@@ -29,6 +33,7 @@
 
 #include "core/base/status.h"
 #include "core/constraints/bone_contacts.h"
+#include "core/geometry/mesh_topology.h"
 #include "core/geometry/volume_closure.h"
 #include "core/model/deformation_model.h"
 
@@ -68,12 +73,17 @@ struct ConstraintReport {
 struct ConstraintScratch {
  private:
   friend class SkinConstraints;
-  std::vector<double> base;        // x*, (n + m) by 3
-  std::vector<double> gradient;    // g, (n + m) by 3 (zero on the joint nodes' and rigid rows)
-  std::vector<double> h;           // M^-1 g
-  std::vector<double> correction;  // right-hand side, then M^-1 sum lambda_j e_{i_j} n_j^T
-  std::vector<double> unit_work;   // ForwardUnitSolve's, n + m zeros
-  std::vector<int> paths;          // per contact, its path's supernodes (path_supernodes each)
+  std::vector<double> base;      // x*, (n + m) by 3
+  std::vector<double> gradient;  // g, (n + m) by 3 (zero on the joint nodes' and rigid rows)
+  std::vector<double> h;         // M^-1 g
+  // D_k = M^-1 (h_k g_rest) per bone that weighs a free vertex, (n + m) by 3 each, for the
+  // factorization with this serial (MaterialFactorization::serial; 0: none yet).
+  std::vector<double> bone_directions;
+  std::uint64_t directions_serial = 0;
+  std::vector<Eigen::Matrix3d> rotations;  // the frame's bone rotations, K
+  std::vector<double> correction;          // right-hand side, then M^-1 sum lambda_j e_{i_j} n_j^T
+  std::vector<double> unit_work;           // ForwardUnitSolve's, n + m zeros
+  std::vector<int> paths;  // per contact, its path's supernodes (path_supernodes each)
   std::vector<int> path_lengths;
   std::vector<double> path_values;  // per contact, y on its path (path_columns each)
   std::vector<double> solve_work;
@@ -82,7 +92,7 @@ struct ConstraintScratch {
   std::vector<double> inverse_block;  // (M^-1)_{i_l i_j}, max_contacts square
   std::vector<double> system;         // the (k + 1)-square system, then its Cholesky factor
   std::vector<double> multipliers;    // its right-hand side, then lambda and mu
-  std::vector<char> in_set;           // per vertex: a contact holds it
+  std::vector<char> in_set;  // per vertex: 0, or 1 + the round from which a contact holds it
   const void* owner = nullptr;
 };
 
@@ -121,12 +131,21 @@ class SkinConstraints {
   double PathDot(const CholeskyFactor& factor, const ConstraintScratch& s, int l, int j) const;
   // Moves contact `from` to slot `to` (its path and its row and column of the inverse block).
   void MoveContact(int from, int to, int set, ConstraintScratch* s) const;
+  // The frame's volume gradient g (into s->gradient) and its direction M^-1 g (into s->h), from
+  // the bone directions (solved first when the scratch holds another factorization's).
+  void PoseVolumeDirections(const MaterialFactorization& factorization,
+                            const std::vector<RigidTransform>& bones, ConstraintScratch* s,
+                            ConstraintReport* report) const;
 
   const DeformationModel* model_ = nullptr;
   std::shared_ptr<const BoneContacts> bones_;
   ConstraintOptions options_;
   std::unique_ptr<VolumeClosure> closure_;
-  std::vector<char> volume_free_;  // per vertex: carries the volume gradient (not a rigid zone)
+  std::vector<char> volume_free_;      // per vertex: carries the volume gradient (not a rigid zone)
+  std::vector<double> rest_gradient_;  // the rest volume's gradient, zero off the free vertices
+  std::vector<int> direction_bones_;   // bones that weigh a free vertex
+  std::vector<int> free_vertices_;     // the vertices outside the rigid zones
+  VertexAdjacency adjacency_;          // the skin's one-rings (with bones)
   double rest_volume_ = 0;
   bool keeps_volume_ = false;
   double margin_ = 0;  // model units

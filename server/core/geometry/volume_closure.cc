@@ -88,6 +88,71 @@ double VolumeClosure::Volume(const double* xyz) const {
   return six_volume / 6.0;
 }
 
+namespace {
+
+// Adds the cubic of a . (b x c) with a = a0 + t a1 and so on to c (six times the volume's).
+void AddTripleCubic(const Eigen::Vector3d& a0, const Eigen::Vector3d& a1, const Eigen::Vector3d& b0,
+                    const Eigen::Vector3d& b1, const Eigen::Vector3d& c0, const Eigen::Vector3d& c1,
+                    double* c) {
+  const Eigen::Vector3d b0c0 = b0.cross(c0), b1c0 = b1.cross(c0), b0c1 = b0.cross(c1),
+                        b1c1 = b1.cross(c1);
+  c[0] += a0.dot(b0c0);
+  c[1] += a1.dot(b0c0) + a0.dot(b1c0 + b0c1);
+  c[2] += a1.dot(b1c0 + b0c1) + a0.dot(b1c1);
+  c[3] += a1.dot(b1c1);
+}
+
+}  // namespace
+
+void VolumeClosure::VolumeAlong(const double* xyz, const double* direction, double c[4]) const {
+  c[0] = c[1] = c[2] = c[3] = 0;
+  // Plain arithmetic: this pass runs every frame that keeps the volume (about the cost of a small
+  // mesh's solve), so it is written for the compiler to keep in registers.
+  double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+  const int* t = triangles_.data();
+  const int faces = static_cast<int>(triangles_.rows());
+  for (int f = 0; f < faces; ++f) {
+    const double* a0 = xyz + 3 * t[3 * f];
+    const double* b0 = xyz + 3 * t[3 * f + 1];
+    const double* c0 = xyz + 3 * t[3 * f + 2];
+    const double* a1 = direction + 3 * t[3 * f];
+    const double* b1 = direction + 3 * t[3 * f + 1];
+    const double* c1 = direction + 3 * t[3 * f + 2];
+    auto cross = [](const double* u, const double* v, double* w) {
+      w[0] = u[1] * v[2] - u[2] * v[1];
+      w[1] = u[2] * v[0] - u[0] * v[2];
+      w[2] = u[0] * v[1] - u[1] * v[0];
+    };
+    double bc[3], Bc[3], bC[3], BC[3];
+    cross(b0, c0, bc);
+    cross(b1, c0, Bc);
+    cross(b0, c1, bC);
+    cross(b1, c1, BC);
+    const double mixed[3] = {Bc[0] + bC[0], Bc[1] + bC[1], Bc[2] + bC[2]};
+    s0 += a0[0] * bc[0] + a0[1] * bc[1] + a0[2] * bc[2];
+    s1 += a1[0] * bc[0] + a1[1] * bc[1] + a1[2] * bc[2] + a0[0] * mixed[0] + a0[1] * mixed[1] +
+          a0[2] * mixed[2];
+    s2 += a1[0] * mixed[0] + a1[1] * mixed[1] + a1[2] * mixed[2] + a0[0] * BC[0] + a0[1] * BC[1] +
+          a0[2] * BC[2];
+    s3 += a1[0] * BC[0] + a1[1] * BC[1] + a1[2] * BC[2];
+  }
+  c[0] = s0;
+  c[1] = s1;
+  c[2] = s2;
+  c[3] = s3;
+  for (const Loop& loop : loops_) {
+    double centroid[3], moved[3];
+    Centroid(xyz, loop, centroid);
+    Centroid(direction, loop, moved);
+    for (int e = loop.first_edge; e < loop.first_edge + loop.edges; ++e) {
+      const int a = boundary_[2 * e], b = boundary_[2 * e + 1];
+      AddTripleCubic(Vec(centroid), Vec(moved), Vec(xyz + 3 * b), Vec(direction + 3 * b),
+                     Vec(xyz + 3 * a), Vec(direction + 3 * a), c);
+    }
+  }
+  for (int p = 0; p < 4; ++p) c[p] /= 6.0;
+}
+
 void VolumeClosure::Gradient(const double* xyz, double* gradient) const {
   Eigen::Map<Eigen::VectorXd>(gradient, 3 * num_vertices_).setZero();
   auto g = [&](int i) { return Eigen::Map<Eigen::Vector3d>(gradient + 3 * i); };

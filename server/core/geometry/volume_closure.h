@@ -21,6 +21,10 @@ class VolumeClosure {
   // gradient[3 i + c] = dV / dx_ic for the first num_vertices rows (overwritten). No allocation.
   void Gradient(const double* xyz, double* gradient) const;
 
+  // The volume along a line, V(xyz + t * direction) = c[0] + c[1] t + c[2] t^2 + c[3] t^3 (a
+  // cubic: the volume is a sum of triple products). No allocation.
+  void VolumeAlong(const double* xyz, const double* direction, double c[4]) const;
+
   int num_vertices() const { return num_vertices_; }
   bool closed() const { return loops_.empty(); }
 

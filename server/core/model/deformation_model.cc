@@ -189,6 +189,7 @@ StatusOr<std::shared_ptr<const MaterialFactorization>> DeformationModel::Factori
   const auto start = Clock::now();
   auto result = std::make_shared<MaterialFactorization>();
   result->model_id_ = id_;
+  result->serial_ = NextModelId();
   DEFORM_ASSIGN_OR_RETURN(const Eigen::VectorXd row_weights, RowWeights(stiffness));
   result->row_weights_squared_ = row_weights.array().square();
   result->rigid_row_sums_ = RigidRowSums(system_, rigid_rows_, result->row_weights_squared_);

@@ -72,6 +72,8 @@ class MaterialFactorization {
   // The bytes of its right-hand side's precomputed parts: the rigid rows' sums (rigid_rows.h: 3
   // doubles per row of L'^T) and, for the quaternion blend, its slots' weights (general_rows.h: 1
   // double per slot).
+  // Unique within the process (never 0), for caches of what depends on one factorization.
+  std::uint64_t serial() const { return serial_; }
   std::size_t right_hand_side_bytes() const {
     return (rigid_row_sums_.size() + slot_weights_.size()) * sizeof(double);
   }
@@ -86,6 +88,7 @@ class MaterialFactorization {
   double factor_seconds_ = 0;
   double float32_probe_error_ = -1;
   std::uint64_t model_id_ = 0;  // the model that made it (DeformationModel::Owns)
+  std::uint64_t serial_ = 0;
 };
 
 // Per-caller buffers for Deform(). Create with DeformationModel::MakeScratch(); one per stream.

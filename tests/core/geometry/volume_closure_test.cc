@@ -28,6 +28,18 @@ TEST(VolumeClosure, MatchesEnclosedVolumeOnClosedAndOpenMeshes) {
   EXPECT_FALSE(VolumeClosure(OpenCapsule().triangles, OpenCapsule().num_vertices()).closed());
 }
 
+TEST(VolumeClosure, TheVolumeAlongALineIsItsCubic) {
+  const TriangleMesh mesh = OpenCapsule();
+  const VolumeClosure closure(mesh.triangles, mesh.num_vertices());
+  Positions direction = Positions::Random(mesh.num_vertices(), 3);
+  double c[4];
+  closure.VolumeAlong(mesh.vertices.data(), direction.data(), c);
+  for (double t : {-0.7, 0.0, 0.3, 1.9}) {
+    const Positions moved = mesh.vertices + t * direction;
+    EXPECT_NEAR(c[0] + t * (c[1] + t * (c[2] + t * c[3])), closure.Volume(moved.data()), 1e-12);
+  }
+}
+
 TEST(VolumeClosure, GradientMatchesFiniteDifferences) {
   TriangleMesh mesh = OpenCapsule();
   const VolumeClosure closure(mesh.triangles, mesh.num_vertices());
