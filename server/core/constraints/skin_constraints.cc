@@ -92,7 +92,6 @@ StatusOr<std::shared_ptr<const SkinConstraints>> SkinConstraints::Create(
   }
   const double cube = std::pow(model.bounding_box_diagonal(), 3);
   if (constraints->bones_ != nullptr) {
-    constraints->adjacency_ = BuildVertexAdjacency(mesh.triangles, mesh.num_vertices());
     model.default_factorization()->factor().LongestUnitSolvePath(&constraints->path_columns_,
                                                                  &constraints->path_supernodes_);
   }
@@ -328,21 +327,8 @@ bool SkinConstraints::Apply(const MaterialFactorization& factorization, DeformSc
       }
     }
     if ((found == 0 && refreshed == 0 && volume_kept) || round == options_.max_rounds) break;
-    // Deepest first, skipping the neighbours of the vertices held from this round on: a held
-    // vertex pulls its one-ring out with it, and the next round holds what is still inside.
-    const char mark = static_cast<char>(round + 1);
-    int kept = 0;
-    for (int c = 0; c < found; ++c) {
-      const int vertex = s->found[c].vertex;
-      bool beside = false;
-      for (int e = adjacency_.offsets[vertex]; e < adjacency_.offsets[vertex + 1] && !beside; ++e) {
-        beside = s->in_set[adjacency_.neighbors[e]] == mark;
-      }
-      if (beside) continue;
-      s->in_set[vertex] = mark;
-      s->found[kept++] = s->found[c];
-    }
-    if (kept > 0) AddContacts(factor, kept, s, report);
+    for (int c = 0; c < found; ++c) s->in_set[s->found[c].vertex] = 1;
+    if (found > 0) AddContacts(factor, found, s, report);
 
     // The volume row: its gradient as the frame's bones turn the rest gradient, its direction
     // in the solve's metric, and its target relative to x*.

@@ -33,7 +33,6 @@
 
 #include "core/base/status.h"
 #include "core/constraints/bone_contacts.h"
-#include "core/geometry/mesh_topology.h"
 #include "core/geometry/volume_closure.h"
 #include "core/model/deformation_model.h"
 
@@ -92,7 +91,7 @@ struct ConstraintScratch {
   std::vector<double> inverse_block;  // (M^-1)_{i_l i_j}, max_contacts square
   std::vector<double> system;         // the (k + 1)-square system, then its Cholesky factor
   std::vector<double> multipliers;    // its right-hand side, then lambda and mu
-  std::vector<char> in_set;  // per vertex: 0, or 1 + the round from which a contact holds it
+  std::vector<char> in_set;  // per vertex: a contact holds it
   const void* owner = nullptr;
 };
 
@@ -145,7 +144,6 @@ class SkinConstraints {
   std::vector<double> rest_gradient_;  // the rest volume's gradient, zero off the free vertices
   std::vector<int> direction_bones_;   // bones that weigh a free vertex
   std::vector<int> free_vertices_;     // the vertices outside the rigid zones
-  VertexAdjacency adjacency_;          // the skin's one-rings (with bones)
   double rest_volume_ = 0;
   bool keeps_volume_ = false;
   double margin_ = 0;  // model units
