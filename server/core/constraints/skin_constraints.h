@@ -91,7 +91,7 @@ struct ConstraintScratch {
   std::vector<double> inverse_block;  // (M^-1)_{i_l i_j}, max_contacts square
   std::vector<double> system;         // the (k + 1)-square system, then its Cholesky factor
   std::vector<double> multipliers;    // its right-hand side, then lambda and mu
-  std::vector<char> in_set;  // per vertex: a contact holds it
+  std::vector<char> in_set;           // per vertex: a contact holds it
   const void* owner = nullptr;
 };
 
