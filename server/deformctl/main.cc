@@ -50,7 +50,7 @@ struct DeformArgs {
   bool contacts = true;
   bool volume = true;
   std::string out_bones_dir;
-  int bone_surface_count = 0;  // set once they are loaded
+  int bone_surface_count = 0;      // set once they are loaded
   std::string joint_nodes = "on";  // off: ModelOptions::use_joint_nodes = false
   std::string material = "on";     // off: ModelOptions::uniform_material = true
   std::string laplacian = "uniform";
