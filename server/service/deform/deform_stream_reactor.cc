@@ -269,6 +269,9 @@ void DeformStreamReactor::HandleStart() {
   const int transform_floats = codec::kFloatsPerBoneTransform * model_->skeleton().num_bones();
   const SkinConstraints* constraints = entry_->constraints.constraints.get();
   const std::size_t bone_surface_bytes = BoneSurfaceTransformBytes(entry_->bones());
+  const std::size_t constraint_bytes =
+      constraints != nullptr ? FrameSolver::ConstraintBytes(*constraints) : 0;
+  std::size_t held_bytes = 0;
   {
     // The buffers are counted in the memory budgets before they are allocated: the solve's
     // scratch, the constraints' scratch, the frames (FrameSlots: three) and a compact encoder's
@@ -279,13 +282,13 @@ void DeformStreamReactor::HandleStart() {
                            : vertices * 3 * sizeof(float)) +
         bone_surface_bytes;
     MutexLock lock(&mutex_);
-    buffer_bytes_ = model_->ScratchBytes() + 3 * frame_bytes +
-                    (constraints != nullptr ? FrameSolver::ConstraintBytes(*constraints) : 0) +
+    buffer_bytes_ = model_->ScratchBytes() + 3 * frame_bytes + constraint_bytes +
                     (encoded_bytes > 0 ? encoded_bytes + vertices * 8 : 0) +
                     (entry_->solve.parallel_plan != nullptr
                          ? FrameSolver::ParallelWorkBytes(*model_, *entry_->solve.parallel_plan)
                          : 0);
     memory_ = context_->admission().HoldMemory(caller_.tenant);
+    held_bytes = buffer_bytes_;
     const Status held = memory_.Resize(buffer_bytes_, "a Deform stream's buffers");
     if (!held.ok()) {
       FailLocked(ToGrpcCode(held.code()), held.message());
@@ -301,7 +304,8 @@ void DeformStreamReactor::HandleStart() {
     splits_batches_.store(true, std::memory_order_relaxed);
   }
   if (constraints != nullptr) solver_->EnableConstraints(constraints);
-  spdlog::info("{} opened", log_context_);
+  spdlog::info("{} opened: buffers of about {} KiB ({} KiB for the constraints)", log_context_,
+               held_bytes >> 10, constraint_bytes >> 10);
 
   MutexLock lock(&mutex_);
   stiffness_.Reset(model_->default_factorization());

@@ -48,8 +48,8 @@ Status CheckBoneSurfaces(const v1::LoadMeshHeader& header, const ServiceLimits& 
   }
   const std::uint64_t bytes = BoneSurfaceBytes(header);
   if (bytes > limits.max_bone_surface_bytes) {
-    return Status::ResourceExhausted(std::to_string(bones.size()) + " bone surfaces of " +
-                                     std::to_string(bytes) + " bytes exceed the limit of " +
+    return Status::ResourceExhausted("bone surfaces of " + std::to_string(bytes) + " bytes (" +
+                                     std::to_string(bones.size()) + " files) exceed the limit of " +
                                      std::to_string(limits.max_bone_surface_bytes) +
                                      " bytes (--max-bone-surface-mb)");
   }
