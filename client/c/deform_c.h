@@ -284,7 +284,8 @@ typedef struct deform_frame_info {
                                 * frame */
   uint32_t clamped_angles;     /* angles clamped to their range of motion in this pose */
   uint64_t stiffness_version;  /* 0 = the model's default stiffness */
-  double server_ms;            /* the server's share: queue + kinematics + solve + encode */
+  double server_ms;            /* the server's share: queue + kinematics + solve + constraints
+                                * + encode */
   uint32_t vertex_count;       /* the frame's vertices: 3 * vertex_count floats were written */
   int mesh_unloaded;           /* non-zero: the mesh was unloaded; this stream keeps its copy */
 } deform_frame_info;

@@ -318,7 +318,8 @@ deform_status deform_stream_next_frame(deform_stream* stream, float* positions,
         info->clamped_angles = frame.clamped_angles();
         info->stiffness_version = frame.stiffness_version();
         const deform::v1::FrameTimings& t = frame.timings();
-        info->server_ms = t.queue_ms() + t.rhs_ms() + t.solve_ms() + t.encode_ms();
+        info->server_ms =
+            t.queue_ms() + t.rhs_ms() + t.solve_ms() + t.constraint_ms() + t.encode_ms();
         info->vertex_count = static_cast<uint32_t>(floats / 3);
         info->mesh_unloaded = frame.mesh_unloaded() ? 1 : 0;
       }
