@@ -11,9 +11,12 @@
 
 #include "core/base/pose_spec.h"
 #include "core/geometry/pose.h"
+#include "core/io/mesh_io.h"
 #include "core/io/phantom.h"
+#include "core/io/skeleton_io.h"
 #include "core/model/deformation_model.h"
 #include "tests/service/support/service_fixture.h"
+#include "tests/service/support/temp_dir.h"
 
 namespace deform::test_support {
 namespace {
@@ -39,6 +42,36 @@ ModelFrame UnconstrainedFrame(double knee_degrees) {
   DeformScratch scratch = (*model)->MakeScratch();
   (*model)->Deform(*(*model)->default_factorization(), pose, &scratch);
   return {scratch.positions(), (*model)->bounding_box_diagonal()};
+}
+
+// The phantom as files with its femur and tibia twice as thick (about their centroids, across the
+// bone): still inside the rest skin, but the bent knee's skin enters them.
+struct ThickBoneFiles {
+  std::string mesh;
+  std::string skeleton;
+  std::vector<std::string> bones;  // "FILE:BONE"
+};
+
+ThickBoneFiles WriteThickBones(const TempDir& dir) {
+  ThickBoneFiles files;
+  auto phantom = MakeKneePhantom(kVertices);
+  EXPECT_TRUE(phantom.ok());
+  files.mesh = dir.Path("leg.obj");
+  EXPECT_TRUE(WriteMeshFile(phantom->mesh, files.mesh).ok());
+  files.skeleton = dir.Write("leg.json", SkeletonToJson(phantom->skeleton));
+  for (int b = 0; b < 2; ++b) {
+    TriangleMesh bone = phantom->bones[b].mesh;
+    const Eigen::RowVector3d centroid = bone.vertices.colwise().mean();
+    for (Eigen::Index i = 0; i < bone.vertices.rows(); ++i) {
+      for (const int axis : {0, 2}) {
+        bone.vertices(i, axis) = centroid[axis] + 2 * (bone.vertices(i, axis) - centroid[axis]);
+      }
+    }
+    const std::string path = dir.Path(phantom->bones[b].name + ".obj");
+    EXPECT_TRUE(WriteMeshFile(bone, path).ok());
+    files.bones.push_back(path + ":" + std::to_string(phantom->bones[b].bone));
+  }
+  return files;
 }
 
 class BoneConstraintsStreamTest : public ServiceTest,
@@ -85,6 +118,31 @@ TEST_P(BoneConstraintsStreamTest, AtKneeFlexion120NoSkinIsLeftInsideABone) {
   EXPECT_NEAR(femur[0] + femur[4] + femur[8], 3.0, 1e-5);
   const float* tibia = motions[1].rotation;
   EXPECT_NEAR(tibia[0] + tibia[4] + tibia[8], 0.0, 1e-5);
+  ExpectBackgroundStreamAlive();
+}
+
+TEST_P(BoneConstraintsStreamTest, SkinThatEntersABoneIsPushedOutByContacts) {
+  StartServer();
+  TempDir dir;
+  const ThickBoneFiles files = WriteThickBones(dir);
+  v1::MethodOptions off;
+  off.mutable_constraints()->set_contacts(false);
+  v1::MeshSummary summary;
+  ASSERT_TRUE(
+      client_->LoadMeshFiles(files.mesh, files.skeleton, off, &summary, {}, "", files.bones).ok());
+  const v1::FrameConstraints free = FrameAt(summary.mesh_id(), 120).constraints();
+  ASSERT_GT(free.penetrating_after(), 0u) << "the thick bones no longer reach the bent skin";
+  EXPECT_TRUE(free.unresolved());
+  EXPECT_EQ(free.contacts(), 0u);
+
+  const grpc::Status loaded =
+      client_->LoadMeshFiles(files.mesh, files.skeleton, {}, &summary, {}, "", files.bones);
+  ASSERT_TRUE(loaded.ok()) << loaded.error_message();
+  const v1::FrameConstraints held = FrameAt(summary.mesh_id(), 120).constraints();
+  EXPECT_EQ(held.penetrating_before(), free.penetrating_before());
+  EXPECT_GT(held.contacts(), 0u);
+  EXPECT_LT(held.penetrating_after(), free.penetrating_after());
+  EXPECT_LE(held.max_depth_after(), free.max_depth_after());
   ExpectBackgroundStreamAlive();
 }
 
