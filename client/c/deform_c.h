@@ -284,7 +284,8 @@ typedef struct deform_frame_info {
                                 * frame */
   uint32_t clamped_angles;     /* angles clamped to their range of motion in this pose */
   uint64_t stiffness_version;  /* 0 = the model's default stiffness */
-  double server_ms;            /* the server's share: queue + kinematics + solve + encode */
+  double server_ms;            /* the server's share: queue + kinematics + solve + constraints
+                                * + encode */
   uint32_t vertex_count;       /* the frame's vertices: 3 * vertex_count floats were written */
   int mesh_unloaded;           /* non-zero: the mesh was unloaded; this stream keeps its copy */
 } deform_frame_info;
@@ -304,6 +305,30 @@ typedef struct deform_frame_info {
 DEFORM_C_API deform_status deform_stream_next_frame(deform_stream* stream, float* positions,
                                                     size_t capacity_floats, int timeout_ms,
                                                     deform_frame_info* info);
+
+/* What a frame's constraints did (the server's FrameConstraints), on a mesh with bone surfaces or
+ * its volume kept. Vertices are the solved mesh's. */
+typedef struct deform_frame_constraints {
+  int constrained;             /* non-zero: the frame carried a report (the fields below) */
+  uint32_t penetrating_before; /* skin vertices inside a bone surface as the model solved them */
+  uint32_t penetrating_after;  /* ... in the frame handed out */
+  double max_depth_after;      /* the deepest of those, model units (0 when none) */
+  int unresolved;              /* non-zero: skin was left inside a bone */
+  uint32_t contacts;           /* contact constraints in the frame's last solve */
+  double volume_change;        /* (V - V_rest) / V_rest */
+  double constraint_ms;        /* the server's time for them */
+  uint32_t bone_surface_count; /* bone surfaces: 12 floats each in `transforms` */
+} deform_frame_constraints;
+
+/* The bone surfaces and constraint report of the frame the last deform_stream_next_frame handed
+ * out: each surface's rigid motion as 12 floats, the row-major 3 x 3 rotation then the
+ * translation (a rest point v is posed at R v + t), into `transforms` (may be NULL when
+ * capacity_floats is 0), and the report into *constraints. Never waits. DEFORM_NO_DATA before
+ * any frame was handed out; DEFORM_INVALID_ARGUMENT (nothing written but
+ * constraints->bone_surface_count) when capacity_floats < 12 * bone_surface_count. */
+DEFORM_C_API deform_status deform_stream_frame_bones(deform_stream* stream, float* transforms,
+                                                     size_t capacity_floats,
+                                                     deform_frame_constraints* constraints);
 
 typedef enum deform_notice_kind {
   DEFORM_NOTICE_POSE_REJECTED = 1,      /* `sequence` names the pose; the message says why */

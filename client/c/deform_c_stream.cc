@@ -9,6 +9,7 @@
 #include <mutex>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "c_api_errors.h"
 #include "c_api_handles.h"
@@ -41,7 +42,13 @@ struct StreamInbox {
   v1::DeformFrame frame;             // its fields, positions cleared
   std::int64_t arrival_ns = 0;       // when it arrived (client::MonotonicNanos)
   std::uint64_t frames_dropped = 0;  // replaced before being handed out, since the last one
-  std::deque<Notice> notices;        // oldest first, at most kMaxNotices
+  // The last frame handed out: its bone surface transforms and constraint report.
+  bool handed_out = false;
+  std::string handed_out_bones;
+  v1::FrameConstraints handed_out_constraints;
+  double handed_out_constraint_ms = 0;
+  bool handed_out_constrained = false;
+  std::deque<Notice> notices;  // oldest first, at most kMaxNotices
   bool ended = false;
   grpc::Status final_status;
 
@@ -318,10 +325,16 @@ deform_status deform_stream_next_frame(deform_stream* stream, float* positions,
         info->clamped_angles = frame.clamped_angles();
         info->stiffness_version = frame.stiffness_version();
         const deform::v1::FrameTimings& t = frame.timings();
-        info->server_ms = t.queue_ms() + t.rhs_ms() + t.solve_ms() + t.encode_ms();
+        info->server_ms =
+            t.queue_ms() + t.rhs_ms() + t.solve_ms() + t.constraint_ms() + t.encode_ms();
         info->vertex_count = static_cast<uint32_t>(floats / 3);
         info->mesh_unloaded = frame.mesh_unloaded() ? 1 : 0;
       }
+      inbox.handed_out = true;
+      inbox.handed_out_bones.assign(inbox.frame.bone_transforms());
+      inbox.handed_out_constrained = inbox.frame.has_constraints();
+      inbox.handed_out_constraints.CopyFrom(inbox.frame.constraints());
+      inbox.handed_out_constraint_ms = inbox.frame.timings().constraint_ms();
       inbox.has_frame = false;
       inbox.frames_dropped = 0;
       return Succeed();
@@ -331,6 +344,44 @@ deform_status deform_stream_next_frame(deform_stream* stream, float* positions,
     }
     return Fail(DEFORM_NO_DATA,
                 "deform_stream_next_frame: no frame within " + std::to_string(timeout_ms) + " ms");
+  });
+}
+
+deform_status deform_stream_frame_bones(deform_stream* stream, float* transforms,
+                                        size_t capacity_floats,
+                                        deform_frame_constraints* constraints) {
+  return Guarded(__func__, {{stream, "stream"}, {constraints, "constraints"}}, [&] {
+    deform::c_api::StreamInbox& inbox = *stream->inbox;
+    std::lock_guard<std::mutex> lock(inbox.mutex);
+    if (!inbox.handed_out) {
+      return Fail(DEFORM_NO_DATA, "deform_stream_frame_bones: no frame was handed out yet");
+    }
+    const std::vector<deform::client::BoneSurfaceMotion> motions =
+        deform::client::DecodeBoneTransforms(inbox.handed_out_bones);
+    *constraints = {};
+    constraints->bone_surface_count = static_cast<uint32_t>(motions.size());
+    if (capacity_floats < 12 * motions.size()) {
+      return Fail(DEFORM_INVALID_ARGUMENT,
+                  "deform_stream_frame_bones: the buffer holds " + std::to_string(capacity_floats) +
+                      " floats; the frame's bones need " + std::to_string(12 * motions.size()));
+    }
+    if (!motions.empty() && transforms == nullptr) {
+      return Fail(DEFORM_INVALID_ARGUMENT, "deform_stream_frame_bones: transforms is NULL");
+    }
+    for (std::size_t s = 0; s < motions.size(); ++s) {
+      std::memcpy(transforms + 12 * s, motions[s].rotation, sizeof(motions[s].rotation));
+      std::memcpy(transforms + 12 * s + 9, motions[s].translation, sizeof(motions[s].translation));
+    }
+    const deform::v1::FrameConstraints& c = inbox.handed_out_constraints;
+    constraints->constrained = inbox.handed_out_constrained ? 1 : 0;
+    constraints->penetrating_before = c.penetrating_before();
+    constraints->penetrating_after = c.penetrating_after();
+    constraints->max_depth_after = c.max_depth_after();
+    constraints->unresolved = c.unresolved() ? 1 : 0;
+    constraints->contacts = c.contacts();
+    constraints->volume_change = c.volume_change();
+    constraints->constraint_ms = inbox.handed_out_constraint_ms;
+    return Succeed();
   });
 }
 

@@ -81,6 +81,23 @@ MeshSourceOptions AddMeshSourceFlags(CLI::App& app, MeshSource* source) {
   });
   options.mesh->excludes(options.phantom_vertices);
   options.rotation_blend = AddRotationBlendFlag(app, &source->rotation_blend);
+  options.bone_surfaces =
+      app.add_option("--bone-surface", source->bone_surfaces,
+                     "A bone surface FILE:BONE to upload with --mesh (a closed mesh file, .obj "
+                     ".ply .stl .off, carried by BONE: an index, HEAD-TAIL, or the joint it "
+                     "starts at); repeatable")
+          ->needs(options.mesh);
+  app.add_flag("--phantom-without-bones", source->phantom_without_bones,
+               "Load the phantom without its femur, tibia and patella")
+      ->excludes(options.mesh);
+  const auto on_off = [&app](const char* name, std::optional<bool>* value, const char* what) {
+    app.add_option_function<std::string>(
+           name, [value](const std::string& text) { *value = text == "on"; },
+           std::string("on | off: ") + what + " (default: the server's, on)")
+        ->check(CLI::IsMember({"on", "off"}));
+  };
+  on_off("--contacts", &source->contacts, "keep the skin outside the bone surfaces");
+  on_off("--keep-volume", &source->keep_volume, "keep the skin's enclosed volume");
   return options;
 }
 

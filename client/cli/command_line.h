@@ -48,10 +48,13 @@ struct MeshSourceOptions {
   CLI::Option* weights = nullptr;
   CLI::Option* phantom_vertices = nullptr;
   CLI::Option* rotation_blend = nullptr;
+  CLI::Option* bone_surfaces = nullptr;
 };
 
 // --mesh and --skeleton (each needs the other, except that a .gltf/.glb rig takes no skeleton),
-// --weights (needs --mesh), --phantom-vertices (excludes --mesh) and --rotation-blend, filling
+// --weights (needs --mesh), --phantom-vertices (excludes --mesh), --rotation-blend,
+// --bone-surface FILE:BONE (repeatable, needs --mesh), --phantom-without-bones (excludes --mesh),
+// --contacts on|off and --keep-volume on|off (MethodOptions.constraints), filling
 // `source` (which must outlive the parse). The skeleton rule is checked once parsing completes
 // (app's parse_complete_callback: a usage error).
 MeshSourceOptions AddMeshSourceFlags(CLI::App& app, MeshSource* source);

@@ -18,11 +18,22 @@ grpc::Status AcquireMesh(client::DeformClient& client, const MeshSource& source,
   }
   deform::v1::MethodOptions options;
   options.set_rotation_blend(source.rotation_blend);
-  grpc::Status status =
-      source.mesh_path.empty()
-          ? client.LoadPhantom(source.phantom_vertices, options, summary)
-          : client.LoadMeshFiles(source.mesh_path, source.skeleton_path, options, summary,
-                                 /*progress=*/{}, source.weights_path);
+  if (source.contacts.has_value()) options.mutable_constraints()->set_contacts(*source.contacts);
+  if (source.keep_volume.has_value()) {
+    options.mutable_constraints()->set_keep_volume(*source.keep_volume);
+  }
+  grpc::Status status;
+  if (source.mesh_path.empty()) {
+    deform::v1::LoadMeshHeader header;
+    header.set_name("phantom");
+    header.mutable_phantom()->set_vertices(source.phantom_vertices);
+    header.mutable_phantom()->set_without_bones(source.phantom_without_bones);
+    *header.mutable_options() = options;
+    status = client.LoadMesh(std::move(header), {}, summary);
+  } else {
+    status = client.LoadMeshFiles(source.mesh_path, source.skeleton_path, options, summary,
+                                  /*progress=*/{}, source.weights_path, source.bone_surfaces);
+  }
   *loaded = status.ok();
   return status;
 }

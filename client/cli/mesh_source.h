@@ -2,7 +2,9 @@
 // the server already holds.
 #pragma once
 
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "lib/deform_client.h"
 
@@ -13,9 +15,15 @@ struct MeshSource {
   std::string mesh_path;  // non-empty: upload this file with `skeleton_path` (none for a glTF rig)
   std::string skeleton_path;
   std::string weights_path;  // optional with `mesh_path`: the rig's skinning weights (.dmat, .csv)
+  // With `mesh_path`: bone surfaces "FILE:BONE" (client::AddBoneSurfaceFile).
+  std::vector<std::string> bone_surfaces;
+  bool phantom_without_bones = false;  // the phantom without its femur, tibia and patella
   int phantom_vertices = 0;  // otherwise: load the phantom at this resolution (0 = default)
   // When loading: how the server blends bone rotations near a joint.
   deform::v1::RotationBlend rotation_blend = deform::v1::ROTATION_BLEND_UNSPECIFIED;
+  // When loading: MethodOptions.constraints (unset: the server's defaults, both on).
+  std::optional<bool> contacts;
+  std::optional<bool> keep_volume;
 
   // "phantom", the mesh file, or the mesh id: for reports.
   std::string Description() const;

@@ -40,6 +40,18 @@ std::vector<float> DecodePositions(const std::string& bytes) {
   return values;
 }
 
+std::vector<BoneSurfaceMotion> DecodeBoneTransforms(const std::string& bytes) {
+  constexpr std::size_t kBytes = 12 * sizeof(float);
+  if (bytes.size() % kBytes != 0) return {};
+  const std::vector<float> values = DecodePositions(bytes);
+  std::vector<BoneSurfaceMotion> motions(bytes.size() / kBytes);
+  for (std::size_t s = 0; s < motions.size(); ++s) {
+    std::copy_n(values.begin() + 12 * s, 9, motions[s].rotation);
+    std::copy_n(values.begin() + 12 * s + 9, 3, motions[s].translation);
+  }
+  return motions;
+}
+
 std::int64_t MonotonicNanos() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(
              std::chrono::steady_clock::now().time_since_epoch())

@@ -34,6 +34,13 @@ std::string BaseName(const std::string& path) {
   return slash == std::string::npos ? path : path.substr(slash + 1);
 }
 
+// The file name without its folder and extension.
+std::string StemName(const std::string& path) {
+  const std::string base = BaseName(path);
+  const std::size_t dot = base.find_last_of('.');
+  return dot == std::string::npos || dot == 0 ? base : base.substr(0, dot);
+}
+
 void SetUnaryDeadline(const ClientOptions& options, grpc::ClientContext* context) {
   context->set_deadline(std::chrono::system_clock::now() +
                         std::chrono::milliseconds(options.unary_deadline_ms));
@@ -144,7 +151,8 @@ grpc::Status DeformClient::LoadMeshFiles(const std::string& mesh_path,
                                          const deform::v1::MethodOptions& options,
                                          deform::v1::MeshSummary* summary,
                                          const ProgressCallback& progress,
-                                         const std::string& weights_path) {
+                                         const std::string& weights_path,
+                                         const std::vector<std::string>& bone_surfaces) {
   deform::v1::LoadMeshHeader header;
   header.set_name(BaseName(mesh_path));
   *header.mutable_options() = options;
@@ -172,12 +180,42 @@ grpc::Status DeformClient::LoadMeshFiles(const std::string& mesh_path,
     upload->set_weights_format(csv ? deform::v1::SKIN_WEIGHTS_FORMAT_CSV
                                    : deform::v1::SKIN_WEIGHTS_FORMAT_DMAT);
   }
+  for (const std::string& spec : bone_surfaces) {
+    status = AddBoneSurfaceFile(spec, upload);
+    if (!status.ok()) return status;
+  }
   return LoadMesh(header, mesh_bytes, summary, progress);
+}
+
+grpc::Status AddBoneSurfaceFile(const std::string& spec, deform::v1::UploadSource* upload) {
+  const std::size_t colon = spec.find(':');
+  if (colon == std::string::npos || colon == 0 || colon + 1 == spec.size()) {
+    return grpc::Status(
+        grpc::StatusCode::INVALID_ARGUMENT,
+        "bone surface '" + spec + "' is not FILE:BONE (BONE a bone index, HEAD-TAIL or a joint)");
+  }
+  const std::string path = spec.substr(0, colon);
+  const deform::v1::MeshFormat format = MeshFormatFromPath(path);
+  if (format == deform::v1::MESH_FORMAT_UNSPECIFIED || format == deform::v1::MESH_FORMAT_GLTF) {
+    return grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
+                        "unknown bone surface format for '" + path + "' (.obj .ply .stl .off)");
+  }
+  deform::v1::BoneSurfaceUpload surface;
+  const grpc::Status read = ReadWholeFile(path, surface.mutable_mesh());
+  if (!read.ok()) return read;
+  surface.set_name(StemName(path));
+  surface.set_format(format);
+  surface.set_bone(spec.substr(colon + 1));
+  *upload->add_bone_surfaces() = std::move(surface);
+  return grpc::Status::OK;
 }
 
 grpc::Status DeformClient::LoadMesh(deform::v1::LoadMeshHeader header,
                                     const std::string& mesh_bytes, deform::v1::MeshSummary* summary,
                                     const ProgressCallback& progress) {
+  if (header.has_phantom()) {
+    return RunLoadMesh(stub_.get(), options_, header, nullptr, summary, progress);
+  }
   header.mutable_upload()->set_mesh_size_bytes(mesh_bytes.size());
   return RunLoadMesh(stub_.get(), options_, header, &mesh_bytes, summary, progress);
 }

@@ -83,15 +83,18 @@ class DeformClient {
                            const std::string& name = "phantom");
   // Uploads a mesh file and a skeleton file (formats from the extensions: .obj .ply .stl .off;
   // .tgf or JSON), and optionally the rig's skinning weights (.dmat, or .csv). A .gltf/.glb rig
-  // carries skeleton and weights itself: give neither. Reading a file that does not exist gives
-  // NOT_FOUND without contacting the server.
+  // carries skeleton and weights itself: give neither. `bone_surfaces`: "FILE:BONE" specs
+  // (AddBoneSurfaceFile). Reading a file that does not exist gives NOT_FOUND without contacting
+  // the server.
   grpc::Status LoadMeshFiles(const std::string& mesh_path, const std::string& skeleton_path,
                              const deform::v1::MethodOptions& options,
                              deform::v1::MeshSummary* summary,
                              const ProgressCallback& progress = {},
-                             const std::string& weights_path = "");
-  // Any upload: `header`'s upload (format, skeleton, weights) and options as the caller sets them;
-  // upload.mesh_size_bytes is set here from `mesh_bytes`.
+                             const std::string& weights_path = "",
+                             const std::vector<std::string>& bone_surfaces = {});
+  // Any upload: `header`'s upload (format, skeleton, weights, bone surfaces) and options as the
+  // caller sets them; upload.mesh_size_bytes is set here from `mesh_bytes`. A header with a
+  // phantom source (PhantomSource.without_bones, say) is sent as it is, `mesh_bytes` unused.
   grpc::Status LoadMesh(deform::v1::LoadMeshHeader header, const std::string& mesh_bytes,
                         deform::v1::MeshSummary* summary, const ProgressCallback& progress = {});
   // Uploads mesh bytes already in memory.
@@ -159,6 +162,21 @@ class DeformStream {
 };
 
 // Client-side helpers.
+
+// Adds the bone surface "FILE:BONE" to `upload` (the first ':' splits, so BONE may hold colons):
+// the mesh file (.obj .ply .stl .off) carried by BONE (a bone index, HEAD-TAIL, or the joint it
+// starts at; the server resolves it), named after the file. NOT_FOUND for an unreadable file,
+// INVALID_ARGUMENT for a spec without both parts or an unknown extension.
+grpc::Status AddBoneSurfaceFile(const std::string& spec, deform::v1::UploadSource* upload);
+
+// A bone surface's rigid motion in a frame (DeformFrame.bone_transforms): posed = R rest + t.
+struct BoneSurfaceMotion {
+  float rotation[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};  // row-major 3 x 3
+  float translation[3] = {0, 0, 0};
+};
+// DeformFrame.bone_transforms decoded, one per bone surface (MeshSummary.bone_surfaces order);
+// empty for a frame without bones or bytes that are not a whole number of transforms.
+std::vector<BoneSurfaceMotion> DecodeBoneTransforms(const std::string& bytes);
 
 // "JOINT:AXIS:DEGREES[,...]" (deformctl's syntax) into JointAngle terms; INVALID_ARGUMENT status
 // in `error` (and false) for malformed text. Joint and axis names are checked by the server.

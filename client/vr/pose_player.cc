@@ -1,5 +1,6 @@
 #include "vr/pose_player.h"
 
+#include <algorithm>
 #include <chrono>
 #include <condition_variable>
 #include <mutex>
@@ -27,6 +28,15 @@ class PlaybackState {
     result_.skipped_by_server += frame.skipped_poses();
     result_.latency_ms.push_back(static_cast<double>(now_ns - frame.client_timestamp_ns()) * 1e-6);
     result_.solve_ms.push_back(frame.timings().solve_ms());
+    if (frame.has_constraints()) {
+      const deform::v1::FrameConstraints& c = frame.constraints();
+      ++result_.constrained_frames;
+      result_.penetrating_after_max =
+          std::max(result_.penetrating_after_max, c.penetrating_after());
+      result_.max_depth_after = std::max(result_.max_depth_after, c.max_depth_after());
+      if (c.unresolved()) ++result_.frames_unresolved;
+      result_.constraint_ms.push_back(frame.timings().constraint_ms());
+    }
     result_.payload_bytes += cli::FramePayloadBytes(frame);
     if (frame.sequence() == last_sequence_) {
       result_.last_frame = frame;

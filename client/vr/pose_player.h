@@ -34,6 +34,12 @@ struct PlaybackResult {
   std::vector<double> solve_ms;         // per frame: timings.solve_ms
   std::uint64_t payload_bytes = 0;      // all frames' positions as they travelled
   double send_lag_max_ms = 0;           // worst lateness of a send against its schedule
+  // The frames' constraints (a mesh with bone surfaces or its volume kept: FrameConstraints).
+  int constrained_frames = 0;               // frames that carried a constraint report
+  std::uint32_t penetrating_after_max = 0;  // most skin vertices inside a bone in one frame
+  double max_depth_after = 0;               // the deepest penetration of any frame, model units
+  int frames_unresolved = 0;                // frames that left skin inside a bone
+  std::vector<double> constraint_ms;        // per constrained frame: timings.constraint_ms
   bool last_pose_answered = false;
   deform::v1::DeformFrame last_frame;  // the frame answering the last pose, when answered
   // The stream's final status; DEADLINE_EXCEEDED when the last pose was neither answered nor

@@ -65,6 +65,13 @@ nlohmann::ordered_json ReportJson(const RunDescription& run, const PlaybackResul
                        {"max", Round3(Max(result.latency_ms))}};
   out["server_solve_ms_p50"] = Round3(Percentile(result.solve_ms, 0.50));
   out["send_lag_max_ms"] = Round3(result.send_lag_max_ms);
+  if (result.constrained_frames > 0) {
+    out["constraints"] = {{"frames", result.constrained_frames},
+                          {"penetrating_after_max", result.penetrating_after_max},
+                          {"max_depth_after", result.max_depth_after},
+                          {"frames_unresolved", result.frames_unresolved},
+                          {"constraint_ms_p50", Round3(Percentile(result.constraint_ms, 0.50))}};
+  }
   out["encoding"] = run.encoding;
   out["bytes_per_frame"] = Round3(BytesPerFrame(result));
   if (!run.out_path.empty()) out["out"] = run.out_path;
@@ -99,6 +106,14 @@ std::string ReportText(const RunDescription& run, const PlaybackResult& result) 
   std::snprintf(buffer, sizeof(buffer), "server solve: median %.3f ms; worst send lag %.3f ms\n",
                 Percentile(result.solve_ms, 0.50), result.send_lag_max_ms);
   text += buffer;
+  if (result.constrained_frames > 0) {
+    std::snprintf(buffer, sizeof(buffer),
+                  "bones: skin inside a bone after the constraints at most %u vertices, deepest "
+                  "%.3g; %d unresolved frames; constraints median %.3f ms\n",
+                  result.penetrating_after_max, result.max_depth_after, result.frames_unresolved,
+                  Percentile(result.constraint_ms, 0.50));
+    text += buffer;
+  }
   std::snprintf(buffer, sizeof(buffer), "frames %s: %.0f bytes per frame, %.3f bytes per vertex\n",
                 run.encoding.c_str(), BytesPerFrame(result),
                 BytesPerFrame(result) / std::max(run.vertices, 1u));

@@ -2,7 +2,7 @@
 //
 //   deformd [--listen ADDR] [--workers N] [--batch-frames N] [--parallel-solve-min-mb N]
 //           [--max-vertices N] [--max-meshes N] [--max-memory-mb N] [--max-message-mb N]
-//           [--max-upload-mb N] [--log-level LEVEL]
+//           [--max-upload-mb N] [--max-bone-surface-mb N] [--log-level LEVEL]
 //           [--preload MESH:SKELETON]... [--preload-phantom N]... [--shutdown-grace-s S]
 //           [--keepalive-s S] [--keepalive-timeout-s S] [--idle-timeout-s S]
 //           [--tls-cert PEM --tls-key PEM [--tls-client-ca PEM]] [--plaintext]
@@ -68,6 +68,7 @@ struct Args {
   double float32_factor_min_mb = 64;
   int max_message_mb = 64;
   std::size_t max_upload_mb = 256;
+  std::size_t max_bone_surface_mb = 16;
   double upload_idle_timeout_s = 30;
   double upload_time_limit_s = 300;
   std::string log_level = "info";
@@ -220,6 +221,10 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 2047));
   app.add_option("--max-upload-mb", args.max_upload_mb, "Largest LoadMesh upload, MiB")
       ->capture_default_str();
+  app.add_option("--max-bone-surface-mb", args.max_bone_surface_mb,
+                 "Largest total of an upload's bone surface files (sent in its header), MiB")
+      ->capture_default_str()
+      ->check(CLI::Range(std::size_t{0}, std::size_t{1} << 20));
   app.add_option("--max-streams", args.server.limits.max_streams,
                  "Open Deform streams on the server, all tenants; 0 = no limit")
       ->capture_default_str()
@@ -323,6 +328,7 @@ int main(int argc, char** argv) {
           ? -1
           : static_cast<std::int64_t>(args.float32_factor_min_mb * 1024 * 1024);
   args.server.limits.max_upload_bytes = args.max_upload_mb << 20;
+  args.server.limits.max_bone_surface_bytes = args.max_bone_surface_mb << 20;
   args.server.limits.upload_idle_timeout_ms =
       static_cast<long long>(args.upload_idle_timeout_s * 1000);
   args.server.limits.upload_time_limit_ms = static_cast<long long>(args.upload_time_limit_s * 1000);

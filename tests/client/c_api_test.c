@@ -340,9 +340,20 @@ static void test_phantom_session(const char* target) {
   float* frame = malloc(sizeof(float) * (floats + 16));
   CHECK(bent != NULL && frame != NULL);
   deform_frame_info info;
+  deform_frame_constraints constraints;
+  float bones[36];
+  CHECK(deform_stream_frame_bones(stream, bones, 36, &constraints) == DEFORM_NO_DATA);
   frame_for(stream, sequence, bent, floats, &info);
   CHECK(info.vertex_count == n && info.clamped_angles == 0 && info.latency_ms > 0);
   CHECK(info.server_ms > 0 && info.server_ms <= info.latency_ms);
+  /* The phantom's femur, tibia and patella: the femur stays, the tibia turns by 90 degrees (its
+   * rotation's trace 1 + 2 cos 90 = 1); the skin stays out of them. */
+  CHECK(deform_stream_frame_bones(stream, bones, 35, &constraints) == DEFORM_INVALID_ARGUMENT);
+  CHECK(constraints.bone_surface_count == 3);
+  CHECK(deform_stream_frame_bones(stream, bones, 36, &constraints) == DEFORM_OK);
+  CHECK(constraints.constrained && constraints.penetrating_after == 0 && !constraints.unresolved);
+  CHECK(fabs(bones[0] + bones[4] + bones[8] - 3.0) < 1e-5);
+  CHECK(fabs(bones[12] + bones[16] + bones[20] - 1.0) < 1e-5);
 
   /* The thigh's far part (beyond 60% of the way from the knee to the hip) does not move; the shin
    * below its middle swings: each vertex moves by more than its distance below the knee (a 90-

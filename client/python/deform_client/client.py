@@ -18,6 +18,7 @@ The Python counterpart of the C++ client library (client/lib/deform_client.h):
 Thread safety: one DeformClient may be used from several threads (gRPC channels are).
 """
 
+import dataclasses
 import os
 import pathlib
 
@@ -34,10 +35,24 @@ _MESH_FORMATS = {".obj": pb.MESH_FORMAT_OBJ, ".ply": pb.MESH_FORMAT_PLY,
                  ".gltf": pb.MESH_FORMAT_GLTF, ".glb": pb.MESH_FORMAT_GLTF}
 
 
+@dataclasses.dataclass
+class BoneSurface:
+    """A bone surface of a loaded mesh (MeshSummary.bone_surfaces) and, with geometry, its rest
+    positions ((N, 3) float32) and triangles ((T, 3) uint32)."""
+    name: str
+    bone: int
+    blend_bone: int  # -1: none
+    blend: float
+    rest_positions: np.ndarray = dataclasses.field(default=None, repr=False)
+    triangles: np.ndarray = dataclasses.field(default=None, repr=False)
+
+
 class MeshInfo:
-    """GetMeshInfo's answer: `summary` (MeshSummary), and when asked for, `rest_positions`
-    ((V, 3) float32), `triangles` ((T, 3) uint32) and `prediction_weights` (PredictionWeights);
-    None when not asked for. `response` is the GetMeshInfoResponse as received."""
+    """GetMeshInfo's answer: `summary` (MeshSummary), `bone_surfaces` (BoneSurface, in the order
+    frames carry their transforms), and when asked for, `rest_positions` ((V, 3) float32),
+    `triangles` ((T, 3) uint32), each bone surface's geometry and `prediction_weights`
+    (PredictionWeights); None when not asked for. `response` is the GetMeshInfoResponse as
+    received."""
 
     def __init__(self, response, geometry, prediction_weights):
         self.response = response
@@ -45,11 +60,18 @@ class MeshInfo:
         self.rest_positions = None
         self.triangles = None
         self.prediction_weights = None
+        self.bone_surfaces = [BoneSurface(s.name, s.bone, s.blend_bone, s.blend)
+                              for s in response.summary.bone_surfaces]
         if geometry:
             self.rest_positions = codec.decode_float32(response.rest_positions,
                                                        response.summary.vertex_count)
             self.triangles = np.frombuffer(response.triangles, dtype="<u4").astype(
                 np.uint32).reshape(-1, 3)
+            for surface, shape in zip(self.bone_surfaces, response.bone_surfaces):
+                surface.rest_positions = codec.decode_float32(
+                    shape.rest_positions, len(shape.rest_positions) // 12)
+                surface.triangles = np.frombuffer(shape.triangles, dtype="<u4").astype(
+                    np.uint32).reshape(-1, 3)
         if prediction_weights:
             self.prediction_weights = response.prediction_weights
 
@@ -60,6 +82,22 @@ def _pem(value):
     if isinstance(value, bytes):
         return value
     return pathlib.Path(value).read_bytes()
+
+
+def _bone_surface_upload(surface):
+    """A BoneSurfaceUpload from "FILE:BONE" (the first ':' splits) or a (file, bone) pair."""
+    if isinstance(surface, str):
+        path, colon, bone = surface.partition(":")
+        if not colon or not path or not bone:
+            raise ValueError(f"bone surface '{surface}' is not FILE:BONE")
+    else:
+        path, bone = surface
+    path = pathlib.Path(path)
+    mesh_format = _MESH_FORMATS.get(path.suffix.lower())
+    if mesh_format is None or mesh_format == pb.MESH_FORMAT_GLTF:
+        raise ValueError(f"unknown bone surface format for '{path}' (.obj .ply .stl .off)")
+    return pb.BoneSurfaceUpload(name=path.stem, format=mesh_format, mesh=path.read_bytes(),
+                                bone=str(bone))
 
 
 def _stage_name(stage):
@@ -113,20 +151,27 @@ class DeformClient:
 
     # Loading.
 
-    def load_phantom(self, vertices=0, *, name="phantom", options=None, progress=None):
+    def load_phantom(self, vertices=0, *, name="phantom", options=None, progress=None,
+                     bones=True):
         """Loads the built-in knee phantom of about `vertices` vertices (0: the default, about
-        2,000). `options`: a MethodOptions message. `progress(stage, elapsed_ms)` is called for
-        every stage (RECEIVED, VALIDATED, WEIGHTS, FACTORISED, READY). Returns the MeshSummary."""
-        header = pb.LoadMeshHeader(name=name, phantom=pb.PhantomSource(vertices=int(vertices)))
+        2,000), with its femur, tibia and patella unless `bones` is False. `options`: a
+        MethodOptions message (its `constraints`: pb.Constraints(contacts=..., keep_volume=...,
+        contact_margin=...)). `progress(stage, elapsed_ms)` is called for every stage (RECEIVED,
+        VALIDATED, WEIGHTS, FACTORISED, READY). Returns the MeshSummary."""
+        header = pb.LoadMeshHeader(name=name, phantom=pb.PhantomSource(
+            vertices=int(vertices), without_bones=not bones))
         if options is not None:
             header.options.CopyFrom(options)
         return self._load(header, None, progress)
 
     def load_files(self, mesh, skeleton=None, weights=None, *, name=None, options=None,
-                   progress=None):
+                   progress=None, bone_surfaces=()):
         """Uploads a mesh file (.obj .ply .stl .off, or a .gltf/.glb rig that carries skeleton and
         weights: then neither is given) with its skeleton (.tgf, else the project's JSON) and
-        optionally the rig's skinning weights (.csv, else DMAT). Returns the MeshSummary."""
+        optionally the rig's skinning weights (.csv, else DMAT). `bone_surfaces`: closed meshes
+        inside the skin (.obj .ply .stl .off), each "FILE:BONE" or a (file, bone) pair, BONE a
+        bone index, "HEAD-TAIL" or the joint the bone starts at; named after their files.
+        Returns the MeshSummary."""
         mesh = pathlib.Path(mesh)
         mesh_format = _MESH_FORMATS.get(mesh.suffix.lower())
         if mesh_format is None:
@@ -144,6 +189,8 @@ class DeformClient:
             upload.weights = weights.read_bytes()
             upload.weights_format = (pb.SKIN_WEIGHTS_FORMAT_CSV if weights.suffix.lower() == ".csv"
                                      else pb.SKIN_WEIGHTS_FORMAT_DMAT)
+        for surface in bone_surfaces:
+            upload.bone_surfaces.append(_bone_surface_upload(surface))
         header = pb.LoadMeshHeader(name=name or mesh.name, upload=upload)
         if options is not None:
             header.options.CopyFrom(options)

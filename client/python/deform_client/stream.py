@@ -45,6 +45,12 @@ class Frame:
     stiffness_version: int
     client_timestamp_ns: int
     message: object = dataclasses.field(repr=False)  # the DeformFrame as received
+    # The bone surfaces' rigid motions, (S, 3, 4) float32 [R | t] (posed = R rest + t), in the
+    # order of MeshInfo.bone_surfaces; (0, 3, 4) for a mesh without bones.
+    bone_transforms: np.ndarray = dataclasses.field(default=None, repr=False)
+    # What the constraints did (FrameConstraints: penetrating_before, penetrating_after,
+    # max_depth_after, unresolved, contacts, volume_change), or None for a mesh without them.
+    constraints: object = None
 
 
 def _frame_from(message, decoder):
@@ -61,7 +67,17 @@ def _frame_from(message, decoder):
                  max_error=max_error, wire_bytes=wire_bytes, decode_ms=decode_ms,
                  skipped_poses=message.skipped_poses, clamped_angles=message.clamped_angles,
                  mesh_unloaded=message.mesh_unloaded, stiffness_version=message.stiffness_version,
-                 client_timestamp_ns=message.client_timestamp_ns, message=message)
+                 client_timestamp_ns=message.client_timestamp_ns, message=message,
+                 bone_transforms=decode_bone_transforms(message.bone_transforms),
+                 constraints=message.constraints if message.HasField("constraints") else None)
+
+
+def decode_bone_transforms(data):
+    """DeformFrame.bone_transforms (12 float32 per surface: row-major R, then t) as an (S, 3, 4)
+    float32 array [R | t]."""
+    values = np.frombuffer(data, dtype="<f4").astype(np.float32).reshape(-1, 12)
+    return np.concatenate([values[:, :9].reshape(-1, 3, 3), values[:, 9:].reshape(-1, 3, 1)],
+                          axis=2)
 
 
 class DeformStream:

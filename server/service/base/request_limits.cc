@@ -77,6 +77,14 @@ Status CheckMethodOptionStrings(const v1::MethodOptions& options) {
 
 Status CheckLoadHeaderStrings(const v1::LoadMeshHeader& header) {
   DEFORM_RETURN_IF_ERROR(CheckLength(header.name(), kMaxMeshNameBytes, "name"));
+  const auto& bones = header.upload().bone_surfaces();
+  for (int i = 0; i < bones.size(); ++i) {
+    const std::string field = "upload.bone_surfaces[" + std::to_string(i) + "]";
+    DEFORM_RETURN_IF_ERROR(CheckLength(bones[i].name(), kMaxMeshNameBytes, field + ".name"));
+    DEFORM_RETURN_IF_ERROR(CheckLength(bones[i].bone(), kMaxJointNameBytes, field + ".bone"));
+    DEFORM_RETURN_IF_ERROR(
+        CheckLength(bones[i].blend_bone(), kMaxJointNameBytes, field + ".blend_bone"));
+  }
   return CheckMethodOptionStrings(header.options());
 }
 

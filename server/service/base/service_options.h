@@ -16,6 +16,9 @@ struct ServiceLimits {
   std::size_t max_memory_bytes = std::size_t{4} << 30;
   // Largest upload (mesh file plus skeleton file) accepted by LoadMesh. Default: 256 MiB.
   std::size_t max_upload_bytes = std::size_t{256} << 20;
+  // Largest total of an upload's bone surface files (UploadSource.bone_surfaces, sent in the
+  // header, so within the gRPC message limit too). Default: 16 MiB.
+  std::size_t max_bone_surface_bytes = std::size_t{16} << 20;
   // Open Deform streams on the server, all tenants together (each holds a scratch and frame slots
   // of its mesh's size); 0 means no limit. Default: 256.
   int max_streams = 256;

@@ -48,8 +48,10 @@ class DeformOutbox {
   void set_backlog_gauge(std::atomic<std::int64_t>* gauge) { gauge_ = gauge; }
 
   // Sizes the frames (FrameSlots::Allocate).
-  void AllocateFrames(int num_vertices, std::size_t encoded_bytes = 0, int transform_floats = 0) {
-    frames_.Allocate(num_vertices, encoded_bytes, transform_floats);
+  void AllocateFrames(int num_vertices, std::size_t encoded_bytes = 0, int transform_floats = 0,
+                      std::size_t bone_surface_bytes = 0, bool constraints = false) {
+    frames_.Allocate(num_vertices, encoded_bytes, transform_floats, bone_surface_bytes,
+                     constraints);
   }
   // The frame the next solve fills (FrameSlots::working).
   v1::DeformResponse* working_frame() { return frames_.working(); }

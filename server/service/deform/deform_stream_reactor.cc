@@ -44,10 +44,14 @@ void CountWritten(const v1::DeformResponse& message, ServiceMetrics* metrics) {
   if (!message.has_frame()) return;
   const v1::DeformFrame& frame = message.frame();
   const v1::FrameTimings& t = frame.timings();
-  const double server_ms = t.queue_ms() + t.rhs_ms() + t.solve_ms() + t.encode_ms();
+  const double server_ms =
+      t.queue_ms() + t.rhs_ms() + t.solve_ms() + t.constraint_ms() + t.encode_ms();
   const int encoding =
       frame.has_encoded() ? frame.encoded().encoding() : v1::FRAME_ENCODING_FLOAT32;
   metrics->FrameWritten(encoding, message.ByteSizeLong(), server_ms * 1e-3, frame.skipped_poses());
+  if (frame.has_constraints()) {
+    metrics->ConstrainedFrameWritten(t.constraint_ms() * 1e-3, frame.constraints().unresolved());
+  }
 }
 
 // The reactor coordinates the stream's parts; each part states its own contract:
@@ -173,6 +177,8 @@ class DeformStreamReactor final : public StreamHandler,
   // The message being written (DeformOutbox keeps it untouched until the next TakeNextWrite).
   const v1::DeformResponse* in_flight_ DEFORM_GUARDED_BY(mutex_) = nullptr;
   std::uint64_t frames_written_ DEFORM_GUARDED_BY(mutex_) = 0;
+  // Written frames whose constraints left skin inside a bone (the first is logged).
+  std::uint64_t frames_unresolved_ DEFORM_GUARDED_BY(mutex_) = 0;
   // The stream's memory beyond its mesh in the budgets: its buffers (buffer_bytes_, set by
   // HandleStart before they are allocated) and its own factorizations (HoldFactorizationsLocked).
   Admission::MemoryHold memory_ DEFORM_GUARDED_BY(mutex_);
@@ -261,20 +267,28 @@ void DeformStreamReactor::HandleStart() {
   }
   const std::size_t encoded_bytes = *encoder ? (*encoder)->max_encoded_bytes() : 0;
   const int transform_floats = codec::kFloatsPerBoneTransform * model_->skeleton().num_bones();
+  const SkinConstraints* constraints = entry_->constraints.constraints.get();
+  const std::size_t bone_surface_bytes = BoneSurfaceTransformBytes(entry_->bones());
+  const std::size_t constraint_bytes =
+      constraints != nullptr ? FrameSolver::ConstraintBytes(*constraints) : 0;
+  std::size_t held_bytes = 0;
   {
     // The buffers are counted in the memory budgets before they are allocated: the solve's
-    // scratch, the frames (FrameSlots: three) and a compact encoder's records and output.
+    // scratch, the constraints' scratch, the frames (FrameSlots: three) and a compact encoder's
+    // records and output.
     const auto vertices = static_cast<std::size_t>(entry_->client_vertex_count());
-    const std::size_t frame_bytes = encoded_bytes > 0
-                                        ? encoded_bytes + sizeof(float) * transform_floats
-                                        : vertices * 3 * sizeof(float);
+    const std::size_t frame_bytes =
+        (encoded_bytes > 0 ? encoded_bytes + sizeof(float) * transform_floats
+                           : vertices * 3 * sizeof(float)) +
+        bone_surface_bytes;
     MutexLock lock(&mutex_);
-    buffer_bytes_ = model_->ScratchBytes() + 3 * frame_bytes +
+    buffer_bytes_ = model_->ScratchBytes() + 3 * frame_bytes + constraint_bytes +
                     (encoded_bytes > 0 ? encoded_bytes + vertices * 8 : 0) +
                     (entry_->solve.parallel_plan != nullptr
                          ? FrameSolver::ParallelWorkBytes(*model_, *entry_->solve.parallel_plan)
                          : 0);
     memory_ = context_->admission().HoldMemory(caller_.tenant);
+    held_bytes = buffer_bytes_;
     const Status held = memory_.Resize(buffer_bytes_, "a Deform stream's buffers");
     if (!held.ok()) {
       FailLocked(ToGrpcCode(held.code()), held.message());
@@ -289,12 +303,15 @@ void DeformStreamReactor::HandleStart() {
                             &context_->registry().open_streams());
     splits_batches_.store(true, std::memory_order_relaxed);
   }
-  spdlog::info("{} opened", log_context_);
+  if (constraints != nullptr) solver_->EnableConstraints(constraints);
+  spdlog::info("{} opened: buffers of about {} KiB ({} KiB for the constraints)", log_context_,
+               held_bytes >> 10, constraint_bytes >> 10);
 
   MutexLock lock(&mutex_);
   stiffness_.Reset(model_->default_factorization());
   UpdateBatchKeyLocked();
-  outbox_.AllocateFrames(entry_->client_vertex_count(), encoded_bytes, transform_floats);
+  outbox_.AllocateFrames(entry_->client_vertex_count(), encoded_bytes, transform_floats,
+                         bone_surface_bytes, constraints != nullptr);
   if (!pump_.finish_requested()) StartRead(&request_);
 }
 
@@ -532,7 +549,16 @@ const v1::DeformResponse* DeformStreamReactor::TakeNextWrite() {
 void DeformStreamReactor::WriteCompleted(bool ok) {
   mutex_.AssertHeld();
   if (ok && in_flight_ != nullptr) CountWritten(*in_flight_, &context_->metrics());
-  if (ok && outbox_.frame_in_flight()) ++frames_written_;
+  if (ok && outbox_.frame_in_flight()) {
+    ++frames_written_;
+    const v1::DeformFrame& frame =
+        in_flight_ != nullptr ? in_flight_->frame() : v1::DeformFrame::default_instance();
+    if (frame.constraints().unresolved() && frames_unresolved_++ == 0) {
+      spdlog::warn("{} frame of pose {} left {} skin vertices inside a bone (deepest {:g})",
+                   log_context_, frame.sequence(), frame.constraints().penetrating_after(),
+                   frame.constraints().max_depth_after());
+    }
+  }
   if (ok && reading_paused_ && outbox_.notice_backlog_drained() && !pump_.finish_requested()) {
     reading_paused_ = false;
     StartRead(&request_);
@@ -568,9 +594,10 @@ void DeformStreamReactor::OnDone() {
   {
     MutexLock lock(&mutex_);
     const grpc::Status& status = pump_.finish_status();
-    spdlog::info("{} closed ({}): {} frames written, {} poses rejected, {} notices dropped",
-                 log_context_, status.ok() ? std::string("OK") : status.error_message(),
-                 frames_written_, poses_rejected_, outbox_.notices_dropped());
+    spdlog::info(
+        "{} closed ({}): {} frames written ({} unresolved), {} poses rejected, {} notices dropped",
+        log_context_, status.ok() ? std::string("OK") : status.error_message(), frames_written_,
+        frames_unresolved_, poses_rejected_, outbox_.notices_dropped());
   }
   ReleaseTransportReference();  // last: may free the reactor
 }

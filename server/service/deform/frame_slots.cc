@@ -8,7 +8,8 @@ namespace deform::service {
 
 FrameSlots::FrameSlots() : working_(&frames_[0]), ready_(&frames_[1]), writing_(&frames_[2]) {}
 
-void FrameSlots::Allocate(int num_vertices, std::size_t encoded_bytes, int transform_floats) {
+void FrameSlots::Allocate(int num_vertices, std::size_t encoded_bytes, int transform_floats,
+                          std::size_t bone_surface_bytes, bool constraints) {
   const std::size_t position_bytes = static_cast<std::size_t>(num_vertices) * 12;
   for (v1::DeformResponse& response : frames_) {
     v1::DeformFrame* frame = response.mutable_frame();
@@ -21,6 +22,8 @@ void FrameSlots::Allocate(int num_vertices, std::size_t encoded_bytes, int trans
       frame->mutable_positions()->resize(position_bytes);
     }
     frame->mutable_timings();
+    if (bone_surface_bytes > 0) frame->mutable_bone_transforms()->resize(bone_surface_bytes);
+    if (constraints) frame->mutable_constraints();
   }
 }
 

@@ -26,8 +26,10 @@ class FrameSlots {
 
   // Sizes every frame for `num_vertices` (12 bytes of positions per vertex), or with
   // `encoded_bytes` > 0 its encoded positions for that many bytes and `transform_floats` bone
-  // transform floats, and creates its timings: the only allocation.
-  void Allocate(int num_vertices, std::size_t encoded_bytes = 0, int transform_floats = 0);
+  // transform floats, its bone surfaces' transforms for `bone_surface_bytes`, and creates its
+  // timings and, with `constraints`, its constraint report: the only allocation.
+  void Allocate(int num_vertices, std::size_t encoded_bytes = 0, int transform_floats = 0,
+                std::size_t bone_surface_bytes = 0, bool constraints = false);
 
   // The frame the next solve fills. Its pointer changes only in Publish().
   v1::DeformResponse* working() { return working_; }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cassert>
 #include <chrono>
 #include <cstddef>
 #include <string>
@@ -34,6 +35,33 @@ FrameSolver::FrameSolver(const DeformationModel& model, const std::vector<int>& 
       encoder_(std::move(encoder)),
       bone_transforms_(static_cast<std::size_t>(codec::kFloatsPerBoneTransform) *
                        model.skeleton().num_bones()) {}
+
+void FrameSolver::EnableConstraints(const SkinConstraints* constraints) {
+  constraints_ = constraints;
+  constraint_scratch_ = constraints->MakeScratch();
+}
+
+double FrameSolver::Constrain(const MaterialFactorization& factorization, v1::DeformFrame* frame) {
+  const auto start = Clock::now();
+  ConstraintReport report;
+  const bool applied = constraints_->Apply(factorization, &scratch_, &constraint_scratch_, &report);
+  assert(applied && "the constraints, the factorization and the scratch are of one model");
+  (void)applied;
+  v1::FrameConstraints* out = frame->mutable_constraints();
+  out->set_penetrating_before(static_cast<std::uint32_t>(report.before.vertices));
+  out->set_penetrating_after(static_cast<std::uint32_t>(report.after.vertices));
+  out->set_max_depth_after(report.after.max_depth);
+  out->set_unresolved(report.unresolved);
+  out->set_contacts(static_cast<std::uint32_t>(report.contacts));
+  out->set_volume_change(report.volume_change_after);
+  if (const BoneContacts* bones = constraints_->bones()) {
+    std::string* transforms = frame->mutable_bone_transforms();
+    transforms->resize(BoneSurfaceTransformBytes(bones));  // no-op when sized by FrameSlots
+    EncodeBoneSurfaceTransforms(*bones, model_.skeleton(), scratch_.bone_transforms,
+                                transforms->data());
+  }
+  return Milliseconds(Clock::now() - start);
+}
 
 void FrameSolver::EnableParallel(const ParallelSolvePlan* plan, ParallelRunner* runner,
                                  const std::atomic<int>* open_streams) {
@@ -95,6 +123,7 @@ FrameSolver::Deformed FrameSolver::DeformPrepared(const MaterialFactorization& f
                                                   FrameSolver* const* solvers, int count,
                                                   const BatchScratchPool* scratches) {
   Deformed deformed;
+  deformed.factorization = &factorization;
   deformed.start = Clock::now();
   if (count > 0) DeformTogether(factorization, solvers, count, scratches, &deformed);
   deformed.end = Clock::now();
@@ -153,6 +182,8 @@ void FrameSolver::Finish(const PoseInput& input, const Deformed& deformed, const
   const std::size_t client_vertices = client_order_.empty()
                                           ? static_cast<std::size_t>(scratch_.num_vertices)
                                           : client_order_.size();
+  const double constraint_ms =
+      constraints_ != nullptr ? Constrain(*deformed.factorization, frame) : 0.0;
   if (encoder_) {
     Encode(frame);
   } else {
@@ -170,7 +201,9 @@ void FrameSolver::Finish(const PoseInput& input, const Deformed& deformed, const
   frame_timings->set_queue_ms(Milliseconds(deformed.start - input.arrival));
   frame_timings->set_rhs_ms(deformed.timings.right_hand_side * 1e3);
   frame_timings->set_solve_ms(deformed.timings.solve * 1e3);
-  frame_timings->set_encode_ms(Milliseconds(Clock::now() - deformed.end));
+  frame_timings->set_constraint_ms(constraint_ms);
+  frame_timings->set_encode_ms(
+      std::max(0.0, Milliseconds(Clock::now() - deformed.end) - constraint_ms));
   frame_timings->set_batch_frames(static_cast<std::uint32_t>(deformed.batch_frames));
   frame_timings->set_solve_parts(static_cast<std::uint32_t>(deformed.solve_parts));
 }

@@ -3,7 +3,9 @@
 // Owns the per-stream buffers a solve needs (the core Pose, the DeformScratch), sized once for the
 // model, so a solve allocates nothing. Fills a DeformFrame in place: positions as packed
 // little-endian float32, the pose's sequence and timestamp, the stamp (stiffness version, skipped
-// poses, mesh_unloaded), the clamped angles and the timings (queue time from the pose's arrival).
+// poses, mesh_unloaded), the clamped angles and the timings (queue time from the pose's arrival);
+// with constraints (EnableConstraints), the frame is constrained after its solve, on whichever
+// path solved it, and carries its bone surfaces' transforms and its constraint report.
 //
 // A solve is Prepare (the pose), the deformation (alone, or batched with other streams' solvers on
 // the same factorization: DeformPrepared), then Finish (the frame); Solve does all three alone.
@@ -19,6 +21,7 @@
 
 #include "core/base/status.h"
 #include "core/codec/frame_codec.h"
+#include "core/constraints/skin_constraints.h"
 #include "core/geometry/pose.h"
 #include "core/model/deformation_model.h"
 #include "deform/v1/deform.pb.h"
@@ -60,6 +63,15 @@ class FrameSolver {
   static std::size_t ParallelWorkBytes(const DeformationModel& model,
                                        const ParallelSolvePlan& plan);
 
+  // Constrains every frame with `constraints` (made for the model; must outlive the solver):
+  // Finish applies them to the solution before encoding it (SkinConstraints::Apply, on the
+  // factorization that solved it), and fills the frame's bone_transforms and constraints.
+  // Allocates the constraints' scratch: ConstraintBytes.
+  void EnableConstraints(const SkinConstraints* constraints);
+  static std::size_t ConstraintBytes(const SkinConstraints& constraints) {
+    return constraints.ScratchBytes();
+  }
+
   // Solves `input` with `factorization` (one of the model's) into `frame`: its positions, or with
   // an encoder its `encoded` positions. Sized by FrameSlots::Allocate, a frame allocates nothing;
   // otherwise it is resized (allocating).
@@ -74,19 +86,21 @@ class FrameSolver {
   // `scratches` lends a batch scratch and count > 1, a lone frame or a batch on several threads
   // when the first solver has EnableParallel and splits now, else one by one. No allocation.
   struct Deformed {
-    std::chrono::steady_clock::time_point start;  // when the deformation began
-    std::chrono::steady_clock::time_point end;    // when it ended
-    DeformTimings timings;                        // all of the solvers' together
-    int batch_frames = 1;                         // the largest pass's frames
-    int solve_parts = 1;                          // a lone frame split for several threads
+    std::chrono::steady_clock::time_point start;           // when the deformation began
+    std::chrono::steady_clock::time_point end;             // when it ended
+    const MaterialFactorization* factorization = nullptr;  // the one that solved it
+    DeformTimings timings;                                 // all of the solvers' together
+    int batch_frames = 1;                                  // the largest pass's frames
+    int solve_parts = 1;                                   // a lone frame split for several threads
   };
   static Deformed DeformPrepared(const MaterialFactorization& factorization,
                                  FrameSolver* const* solvers, int count,
                                  const BatchScratchPool* scratches);
   // Solve's last step, after DeformPrepared: the frame of `input` from this solver's solution.
   // Its timings: queue_ms up to `deformed.start`, rhs_ms and solve_ms the deformation's (a
-  // batch's, for each of its frames), encode_ms from the deformation's end to this frame's
-  // encoding's end (a batch encodes its frames one after the other).
+  // batch's, for each of its frames), constraint_ms this frame's constraints, encode_ms from the
+  // deformation's end to this frame's encoding's end without its constraint_ms (a batch
+  // constrains and encodes its frames one after the other).
   void Finish(const PoseInput& input, const Deformed& deformed, const FrameStamp& stamp,
               v1::DeformFrame* frame);
 
@@ -94,6 +108,9 @@ class FrameSolver {
   const DeformationModel& model_;
   const std::vector<int>& client_order_;
   void Encode(v1::DeformFrame* frame);
+  // The constraints applied to the solution, their report and the bone transforms in `frame`;
+  // their milliseconds.
+  double Constrain(const MaterialFactorization& factorization, v1::DeformFrame* frame);
   // Whether this solver's frame (`frames` 1), or a batch of `frames` it leads, is split now
   // (EnableParallel).
   bool SplitsNow(int frames) const;
@@ -111,6 +128,8 @@ class FrameSolver {
   ParallelRunner* parallel_runner_ = nullptr;
   const std::atomic<int>* open_streams_ = nullptr;
   std::vector<double> parallel_work_;
+  const SkinConstraints* constraints_ = nullptr;
+  ConstraintScratch constraint_scratch_;
 };
 
 }  // namespace deform::service

@@ -31,7 +31,40 @@ Status CheckUploadParts(const v1::UploadSource& upload) {
   return Status::Ok();
 }
 
+// The header checks of an upload's bone surfaces: each names its mesh's format and its bone, and
+// all their bytes together stay within the limit.
+Status CheckBoneSurfaces(const v1::LoadMeshHeader& header, const ServiceLimits& limits) {
+  const auto& bones = header.upload().bone_surfaces();
+  for (int i = 0; i < bones.size(); ++i) {
+    const std::string field = "upload.bone_surfaces[" + std::to_string(i) + "]";
+    if (bones[i].mesh().empty()) return Status::InvalidArgument(field + ".mesh is empty");
+    if (bones[i].bone().empty()) {
+      return Status::InvalidArgument(field + ".bone is empty: name the bone that carries it");
+    }
+    if (!CoreMeshFormat(bones[i].format()).ok()) {
+      return Status::InvalidArgument(field + ".format must be OBJ, PLY, STL or OFF, got " +
+                                     std::to_string(static_cast<int>(bones[i].format())));
+    }
+  }
+  const std::uint64_t bytes = BoneSurfaceBytes(header);
+  if (bytes > limits.max_bone_surface_bytes) {
+    return Status::ResourceExhausted("bone surfaces of " + std::to_string(bytes) + " bytes (" +
+                                     std::to_string(bones.size()) + " files) exceed the limit of " +
+                                     std::to_string(limits.max_bone_surface_bytes) +
+                                     " bytes (--max-bone-surface-mb)");
+  }
+  return Status::Ok();
+}
+
 }  // namespace
+
+std::uint64_t BoneSurfaceBytes(const v1::LoadMeshHeader& header) {
+  std::uint64_t bytes = 0;
+  for (const v1::BoneSurfaceUpload& bone : header.upload().bone_surfaces()) {
+    bytes += bone.mesh().size();
+  }
+  return bytes;
+}
 
 StatusOr<MeshFormat> CoreMeshFormat(v1::MeshFormat format) {
   switch (format) {
@@ -81,6 +114,7 @@ Status CheckLoadHeader(const v1::LoadMeshHeader& header, const ServiceLimits& li
     case v1::LoadMeshHeader::kUpload: {
       const v1::UploadSource& upload = header.upload();
       DEFORM_RETURN_IF_ERROR(CheckUploadParts(upload));
+      DEFORM_RETURN_IF_ERROR(CheckBoneSurfaces(header, limits));
       if (upload.mesh_size_bytes() == 0) {
         return Status::InvalidArgument(
             "upload.mesh_size_bytes is 0: the mesh file size is required");

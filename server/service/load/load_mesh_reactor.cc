@@ -35,7 +35,8 @@ constexpr std::size_t kMaxInitialReserve = std::size_t{64} << 20;
 
 // What a load's header lets the server know of the memory it will need: a phantom's model
 // (DeformationModel::EstimateBytesBeforeBuild, the phantom's triangles about twice its vertices);
-// an upload's bytes as announced (mesh, skeleton and weights), held while they arrive.
+// an upload's bytes as announced (mesh, skeleton, weights and bone surfaces), held while they
+// arrive and are parsed.
 std::size_t AdmissionBytes(const v1::LoadMeshHeader& header) {
   if (header.has_phantom()) {
     const int vertices =
@@ -43,7 +44,8 @@ std::size_t AdmissionBytes(const v1::LoadMeshHeader& header) {
     return DeformationModel::EstimateBytesBeforeBuild(vertices, 2 * vertices);
   }
   const v1::UploadSource& upload = header.upload();
-  return upload.mesh_size_bytes() + upload.skeleton().size() + upload.weights().size();
+  return upload.mesh_size_bytes() + upload.skeleton().size() + upload.weights().size() +
+         BoneSurfaceBytes(header);
 }
 
 std::string AdmissionSubject(const v1::LoadMeshHeader& header) {

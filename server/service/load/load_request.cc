@@ -4,12 +4,16 @@
 #include <climits>
 #include <utility>
 
+#include "core/geometry/bone_surface.h"
 #include "core/geometry/skeleton.h"
+#include "core/io/bone_surface_io.h"
 #include "core/io/declared_mesh_size.h"
 #include "core/io/phantom.h"
 #include "core/io/rig_import.h"
 #include "core/io/skeleton_io.h"
 #include "core/model/deformation_model.h"
+#include "service/base/log_text.h"
+#include "service/base/request_limits.h"
 #include "service/load/load_header.h"
 #include "service/messages/proto_conversion.h"
 
@@ -73,6 +77,48 @@ Status ParseUpload(const v1::UploadSource& upload, std::string* mesh_bytes,
   return Status::Ok();
 }
 
+// The bone `name` means (BoneFromName), its error prefixed by `field`; a name that is not
+// printable ASCII is repeated only escaped and cut.
+StatusOr<int> BoneOf(const Skeleton& skeleton, const std::string& name, const std::string& field) {
+  StatusOr<int> bone = BoneFromName(skeleton, name);
+  if (bone.ok()) return bone;
+  if (EscapeForLog(name) != name) {
+    return Status::InvalidArgument(field + ": no bone named " + EchoForClient(name));
+  }
+  return Status::InvalidArgument(field + ": " + bone.status().message());
+}
+
+// An upload's bone surfaces: each mesh parsed (its reader validates it), its bones resolved, all
+// of them checked against the skeleton. Names default to "bone_surfaces[i]" and are kept escaped
+// (printable ASCII as given), as summaries and errors repeat them.
+StatusOr<std::vector<BoneSurface>> ParseBoneSurfaces(const v1::UploadSource& upload,
+                                                     const Skeleton& skeleton,
+                                                     const MeshLimits& limits) {
+  std::vector<BoneSurface> surfaces;
+  for (int i = 0; i < upload.bone_surfaces_size(); ++i) {
+    const v1::BoneSurfaceUpload& proto = upload.bone_surfaces(i);
+    BoneSurface surface;
+    surface.name = proto.name().empty() ? "bone_surfaces[" + std::to_string(i) + "]"
+                                        : EscapeForLog(proto.name(), kMaxMeshNameBytes);
+    const std::string field = "bone surface '" + surface.name + "'";
+    DEFORM_ASSIGN_OR_RETURN(surface.bone, BoneOf(skeleton, proto.bone(), field + " bone"));
+    if (!proto.blend_bone().empty()) {
+      DEFORM_ASSIGN_OR_RETURN(surface.blend_bone,
+                              BoneOf(skeleton, proto.blend_bone(), field + " blend_bone"));
+      surface.blend = proto.blend();
+    } else if (proto.blend() != 0) {
+      return Status::InvalidArgument(field + ": blend is given without a blend_bone");
+    }
+    DEFORM_ASSIGN_OR_RETURN(const MeshFormat format, CoreMeshFormat(proto.format()));
+    auto mesh = ReadMesh(proto.mesh(), format, limits);
+    if (!mesh.ok()) return mesh.status().WithContext(field + " mesh");
+    surface.mesh = std::move(*mesh);
+    surfaces.push_back(std::move(surface));
+  }
+  DEFORM_RETURN_IF_ERROR(ValidateBoneSurfaces(surfaces, skeleton, limits));
+  return surfaces;
+}
+
 }  // namespace
 
 StatusOr<LoadJob> LoadJobFromRequest(const v1::LoadMeshHeader& header, std::string* mesh_bytes,
@@ -85,14 +131,22 @@ StatusOr<LoadJob> LoadJobFromRequest(const v1::LoadMeshHeader& header, std::stri
     DEFORM_ASSIGN_OR_RETURN(KneePhantom phantom, MakeKneePhantom(vertices));
     job.mesh = std::move(phantom.mesh);
     job.skeleton = std::move(phantom.skeleton);
+    if (!header.phantom().without_bones()) job.bone_surfaces = std::move(phantom.bones);
     if (job.name.empty()) job.name = "phantom:" + std::to_string(vertices);
   } else {
     DEFORM_RETURN_IF_ERROR(ParseUpload(header.upload(), mesh_bytes, limits, &job));
     if (job.name.empty()) job.name = "upload";
+    MeshLimits mesh_limits;
+    mesh_limits.max_vertices = limits.max_vertices;
+    DEFORM_ASSIGN_OR_RETURN(job.bone_surfaces,
+                            ParseBoneSurfaces(header.upload(), job.skeleton, mesh_limits));
   }
   auto options = ModelOptionsFromProto(header.options(), job.skeleton);
   if (!options.ok()) return options.status().WithContext("options");
   job.options = std::move(*options);
+  auto constraints = ConstraintOptionsFromProto(header.options().constraints());
+  if (!constraints.ok()) return constraints.status().WithContext("options.constraints");
+  job.constraints = *constraints;
   return job;
 }
 

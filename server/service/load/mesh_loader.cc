@@ -28,12 +28,54 @@ std::string FactorPrecisionText(const DeformationModel& model) {
   return "double";
 }
 
+// An estimate of what the constraints of a skin of `skin_vertices` hold with `surfaces`: per skin
+// vertex its volume flags and a candidate entry per surface, per surface its mesh (24 bytes a
+// vertex, 12 a triangle) and its search tree (a node and a copy of its triangle, about 150 bytes a
+// triangle).
+std::size_t EstimateConstraintBytes(int skin_vertices, const std::vector<BoneSurface>& surfaces) {
+  const auto n = static_cast<std::size_t>(skin_vertices);
+  std::size_t bytes = 4 * n;
+  for (const BoneSurface& surface : surfaces) {
+    bytes += 4 * n + 24 * static_cast<std::size_t>(surface.mesh.num_vertices()) +
+             162 * static_cast<std::size_t>(surface.mesh.num_triangles());
+  }
+  return bytes;
+}
+
+// The constraints of `model`: its bone contacts (refusing a surface the rest skin enters, naming
+// it) and the skin constraints over them. None when there is nothing to keep.
+StatusOr<MeshConstraints> MakeConstraints(const DeformationModel& model,
+                                          std::vector<BoneSurface> surfaces,
+                                          const ConstraintOptions& options,
+                                          const MeshLimits& limits) {
+  MeshConstraints made;
+  made.options = options;
+  if (surfaces.empty() && !options.keep_volume) return made;
+  made.bytes = EstimateConstraintBytes(model.mesh().num_vertices(), surfaces);
+  std::shared_ptr<const BoneContacts> bones;
+  if (!surfaces.empty()) {
+    auto contacts = BoneContacts::Create(std::move(surfaces), model.skeleton(), model.mesh(),
+                                         model.rigid_bones(), limits);
+    if (!contacts.ok()) return contacts.status().WithContext("bone surfaces");
+    bones = std::move(*contacts);
+  }
+  auto constraints = SkinConstraints::Create(model, std::move(bones), options);
+  if (!constraints.ok()) return constraints.status().WithContext("options.constraints");
+  made.constraints = std::move(*constraints);
+  if (!made.constraints->active()) made.constraints = nullptr;  // an open skin without bones
+  return made;
+}
+
+std::string OnOff(bool on) { return on ? "on" : "off"; }
+
 StatusOr<std::shared_ptr<const MeshEntry>> Build(ServiceContext* context, Admission::MeshSlot slot,
                                                  LoadJob job, const LoadProgress& progress) {
   job.options.limits.max_vertices = context->limits().max_vertices;
   job.options.float32_factor_min_bytes = context->solve_settings().float32_factor_min_bytes;
   const std::size_t bytes_before_build =
-      DeformationModel::EstimateBytesBeforeBuild(job.mesh.num_vertices(), job.mesh.num_triangles());
+      DeformationModel::EstimateBytesBeforeBuild(job.mesh.num_vertices(),
+                                                 job.mesh.num_triangles()) +
+      EstimateConstraintBytes(job.mesh.num_vertices(), job.bone_surfaces);
   const int vertices = job.mesh.num_vertices();
   BuildHooks hooks;
   hooks.validated = [&] {
@@ -50,12 +92,18 @@ StatusOr<std::shared_ptr<const MeshEntry>> Build(ServiceContext* context, Admiss
       std::shared_ptr<const DeformationModel> model,
       DeformationModel::Build(std::move(job.mesh), std::move(job.skeleton), job.options,
                               job.weights.has_value() ? &*job.weights : nullptr, hooks));
+  MeshLimits mesh_limits;
+  mesh_limits.max_vertices = context->limits().max_vertices;
+  DEFORM_ASSIGN_OR_RETURN(
+      MeshConstraints constraints,
+      MakeConstraints(*model, std::move(job.bone_surfaces), job.constraints, mesh_limits));
   if (progress) progress(LoadStage::kFactorized, MillisecondsSince(job.start));
   MeshSolvePlan solve = PlanMeshSolve(*model, context->solve_settings());
-  DEFORM_ASSIGN_OR_RETURN(std::shared_ptr<const MeshEntry> entry,
-                          context->registry().Register(std::move(slot), job.name, std::move(model),
-                                                       std::move(job.file_metadata),
-                                                       std::move(solve), std::move(job.id)));
+  DEFORM_ASSIGN_OR_RETURN(
+      std::shared_ptr<const MeshEntry> entry,
+      context->registry().Register(std::move(slot), job.name, std::move(model),
+                                   std::move(job.file_metadata), std::move(solve),
+                                   std::move(job.id), std::move(constraints)));
   spdlog::info(
       "mesh={} tenant={} name='{}' loaded: {} vertices, precompute {:.1f} ms, factor {:.1f} ms "
       "({}), about {} KiB",
@@ -68,6 +116,19 @@ StatusOr<std::shared_ptr<const MeshEntry>> Build(ServiceContext* context, Admiss
         fmt::format("{}{} {:.0f} ms", phases.empty() ? "" : ", ", phase.name, phase.seconds * 1e3);
   }
   spdlog::debug("mesh={} build phases: {}", entry->id, phases);
+  std::string bones;
+  if (const BoneContacts* contacts = entry->bones()) {
+    for (int s = 0; s < contacts->num_surfaces(); ++s) {
+      const BoneSurface& surface = contacts->surface(s);
+      bones += fmt::format("{}'{}' on bone {} ({} triangles)", s > 0 ? ", " : "",
+                           EscapeForLog(surface.name), surface.bone, surface.mesh.num_triangles());
+    }
+  }
+  const ConstraintOptions& constraint_options = entry->constraints.options;
+  spdlog::info("mesh={} constraints: contacts {}, volume {}, margin {:g}; bone surfaces: {}",
+               entry->id, OnOff(constraint_options.max_contacts > 0),
+               OnOff(constraint_options.keep_volume), constraint_options.contact_margin,
+               bones.empty() ? "none" : bones);
   for (const std::string& warning : entry->model->binding_report().warnings) {
     spdlog::warn("mesh={} binding: {}", entry->id, EscapeForLog(warning));
   }

@@ -14,6 +14,8 @@
 
 #include "core/base/cancel_token.h"
 #include "core/base/status.h"
+#include "core/constraints/skin_constraints.h"
+#include "core/geometry/bone_surface.h"
 #include "core/geometry/mesh.h"
 #include "core/geometry/skeleton.h"
 #include "core/geometry/skin_weights.h"
@@ -42,6 +44,11 @@ struct LoadJob {
   ModelOptions options;  // options.limits.max_vertices is set from the context's limits
   std::optional<SkinWeights> weights;  // a rig's own weights: binding from them (Build)
   MeshFileMetadata file_metadata;      // from a glTF rig: the file's vertex order, units, up axis
+  // Bone surfaces (the phantom's, an upload's) in the solved mesh's frame, bones resolved and
+  // checked against the skeleton (ValidateBoneSurfaces); the build refuses one the rest skin
+  // enters (BoneContacts::Create).
+  std::vector<BoneSurface> bone_surfaces;
+  ConstraintOptions constraints;  // MethodOptions.constraints
   std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
   // Stops the build between its phases once cancelled (BuildHooks::cancel); null: never. Must
   // outlive BuildAndRegister.

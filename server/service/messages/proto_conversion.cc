@@ -99,6 +99,27 @@ StatusOr<ModelOptions> ModelOptionsFromProto(const v1::MethodOptions& proto,
   return options;
 }
 
+StatusOr<ConstraintOptions> ConstraintOptionsFromProto(const v1::Constraints& proto) {
+  ConstraintOptions options;
+  if (proto.has_contacts() && !proto.contacts()) options.max_contacts = 0;
+  if (proto.has_keep_volume()) options.keep_volume = proto.keep_volume();
+  if (proto.has_contact_margin()) {
+    const double margin = proto.contact_margin();
+    if (!std::isfinite(margin) || margin < 0 || margin > 0.1) {
+      return Status::InvalidArgument("contact_margin must be in [0, 0.1] of the diagonal, got " +
+                                     std::to_string(margin));
+    }
+    options.contact_margin = margin;
+  }
+  return options;
+}
+
+void ConstraintOptionsToProto(const ConstraintOptions& options, v1::Constraints* proto) {
+  proto->set_contacts(options.max_contacts > 0);
+  proto->set_keep_volume(options.keep_volume);
+  proto->set_contact_margin(options.contact_margin);
+}
+
 StatusOr<Stiffness> StiffnessFromProto(const v1::StiffnessUpdate& proto,
                                        const DeformationModel& model,
                                        const std::vector<int>& client_order) {
@@ -195,6 +216,20 @@ void FillMeshSummary(const MeshEntry& entry, v1::MeshSummary* summary) {
   }
   summary->set_units(entry.file_metadata.units);
   summary->set_up_axis(entry.file_metadata.up_axis);
+  summary->clear_bone_surfaces();
+  if (const BoneContacts* bones = entry.bones()) {
+    for (int s = 0; s < bones->num_surfaces(); ++s) {
+      const BoneSurface& surface = bones->surface(s);
+      v1::BoneSurfaceInfo* info = summary->add_bone_surfaces();
+      info->set_name(surface.name);
+      info->set_bone(static_cast<std::uint32_t>(surface.bone));
+      info->set_blend_bone(surface.blend_bone);
+      info->set_blend(surface.blend);
+      info->set_vertex_count(static_cast<std::uint32_t>(surface.mesh.num_vertices()));
+      info->set_triangle_count(static_cast<std::uint32_t>(surface.mesh.num_triangles()));
+    }
+  }
+  ConstraintOptionsToProto(entry.constraints.options, summary->mutable_constraints());
 }
 
 void FillMeshGeometry(const MeshEntry& entry, v1::GetMeshInfoResponse* info) {
@@ -220,6 +255,42 @@ void FillMeshGeometry(const MeshEntry& entry, v1::GetMeshInfoResponse* info) {
   for (std::size_t k = 0; k < indices; ++k) {
     const int vertex = order.empty() ? source[k] : client_of[source[k]];
     PutUint32(static_cast<std::uint32_t>(vertex), triangles->data() + 4 * k);
+  }
+  info->clear_bone_surfaces();
+  if (const BoneContacts* bones = entry.bones()) {
+    for (int s = 0; s < bones->num_surfaces(); ++s) {
+      const TriangleMesh& surface = bones->surface(s).mesh;
+      v1::BoneSurfaceGeometry* geometry = info->add_bone_surfaces();
+      std::string* rest = geometry->mutable_rest_positions();
+      rest->resize(static_cast<std::size_t>(surface.num_vertices()) * 12);
+      EncodeFloat32(surface.vertices.data(), static_cast<std::size_t>(surface.num_vertices()) * 3,
+                    rest->data());
+      std::string* faces = geometry->mutable_triangles();
+      const std::size_t count = static_cast<std::size_t>(surface.num_triangles()) * 3;
+      faces->resize(count * 4);
+      for (std::size_t k = 0; k < count; ++k) {
+        PutUint32(static_cast<std::uint32_t>(surface.triangles.data()[k]), faces->data() + 4 * k);
+      }
+    }
+  }
+}
+
+std::size_t BoneSurfaceTransformBytes(const BoneContacts* bones) {
+  return bones != nullptr ? static_cast<std::size_t>(bones->num_surfaces()) * 12 * sizeof(float)
+                          : 0;
+}
+
+void EncodeBoneSurfaceTransforms(const BoneContacts& bones, const Skeleton& skeleton,
+                                 const std::vector<RigidTransform>& bone_transforms, char* out) {
+  for (int s = 0; s < bones.num_surfaces(); ++s) {
+    const RigidTransform motion = BoneSurfaceTransform(bones.surface(s), skeleton, bone_transforms);
+    const Eigen::Matrix3d rotation = motion.rotation.toRotationMatrix();
+    double values[12];
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) values[3 * r + c] = rotation(r, c);
+    }
+    for (int c = 0; c < 3; ++c) values[9 + c] = motion.translation[c];
+    EncodeFloat32(values, 12, out + 48 * static_cast<std::size_t>(s));
   }
 }
 

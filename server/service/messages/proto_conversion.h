@@ -7,6 +7,7 @@
 #include <cstddef>
 
 #include "core/base/status.h"
+#include "core/constraints/skin_constraints.h"
 #include "core/geometry/skeleton.h"
 #include "core/model/deformation_model.h"
 #include "core/model/stiffness.h"
@@ -21,6 +22,13 @@ namespace deform::service {
 StatusOr<ModelOptions> ModelOptionsFromProto(const v1::MethodOptions& proto,
                                              const Skeleton& skeleton);
 
+// MethodOptions.constraints into the constraints' options: unset fields are on, on and 1e-3;
+// contacts off is max_contacts 0 (penetrations are measured, never corrected). INVALID_ARGUMENT
+// for a contact_margin that is not finite and in [0, 0.1].
+StatusOr<ConstraintOptions> ConstraintOptionsFromProto(const v1::Constraints& proto);
+// The options back as the proto states them, every field set.
+void ConstraintOptionsToProto(const ConstraintOptions& options, v1::Constraints* proto);
+
 // A StiffnessUpdate into the core's Stiffness for `model`. Zero fields of a joint material mean
 // the model's default profile. INVALID_ARGUMENT naming the problem for unknown joints, joints
 // without a region, vertex lists of different lengths or out of range, and weights that are not
@@ -33,8 +41,16 @@ StatusOr<Stiffness> StiffnessFromProto(const v1::StiffnessUpdate& proto,
 // The summary of a registered mesh.
 void FillMeshSummary(const MeshEntry& entry, v1::MeshSummary* summary);
 // Rest positions (float32 xyz) and triangles (uint32, 3 per triangle), little-endian, in the
-// client's vertex order (the file's: MeshFileMetadata).
+// client's vertex order (the file's: MeshFileMetadata), and each bone surface's the same way.
 void FillMeshGeometry(const MeshEntry& entry, v1::GetMeshInfoResponse* info);
+
+// The bytes of DeformFrame.bone_transforms for `bones`' surfaces (12 float32 each).
+std::size_t BoneSurfaceTransformBytes(const BoneContacts* bones);
+// DeformFrame.bone_transforms of a frame whose bones moved by `bone_transforms`: per surface
+// (BoneSurfaceTransform) its rotation as a row-major 3 x 3 matrix, then its translation, float32
+// little-endian, at `out` (BoneSurfaceTransformBytes). Allocation-free.
+void EncodeBoneSurfaceTransforms(const BoneContacts& bones, const Skeleton& skeleton,
+                                 const std::vector<RigidTransform>& bone_transforms, char* out);
 
 // `count` doubles into `count` float32 little-endian values at `out` (4 * count bytes).
 // Allocation-free.

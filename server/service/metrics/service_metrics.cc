@@ -66,6 +66,17 @@ ServiceMetrics::ServiceMetrics() : registry_(std::make_shared<prometheus::Regist
            .Help("Server time of a written frame: queue, right-hand side, solve and encode")
            .Register(*registry_)
            .Add({}, Exponential(0.000125, 2, 14));
+  frame_constraint_seconds_ =
+      &BuildHistogram()
+           .Name("deformd_frame_constraint_seconds")
+           .Help("Constraint time of a written constrained frame (bone contacts, volume)")
+           .Register(*registry_)
+           .Add({}, Exponential(0.00003125, 2, 14));
+  frames_unresolved_ = &BuildCounter()
+                            .Name("deformd_frames_unresolved_total")
+                            .Help("Written frames whose constraints left skin inside a bone")
+                            .Register(*registry_)
+                            .Add({});
   poses_skipped_ = &BuildCounter()
                         .Name("deformd_poses_skipped_total")
                         .Help("Poses replaced by a newer pose before they were solved")
@@ -132,6 +143,11 @@ void ServiceMetrics::FrameWritten(int encoding, std::size_t bytes, double server
   frame_bytes_sent_[encoding]->Increment(static_cast<double>(bytes));
   frame_server_seconds_->Observe(server_seconds);
   if (skipped_poses > 0) poses_skipped_->Increment(static_cast<double>(skipped_poses));
+}
+
+void ServiceMetrics::ConstrainedFrameWritten(double constraint_seconds, bool unresolved) {
+  frame_constraint_seconds_->Observe(constraint_seconds);
+  if (unresolved) frames_unresolved_->Increment();
 }
 
 void ServiceMetrics::NoticeWritten(int kind) {

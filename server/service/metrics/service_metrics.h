@@ -6,6 +6,9 @@
 //    encoding is float32, quantized or predicted.
 //  - deformd_frame_server_seconds: histogram of a written frame's server time (queue, right-hand
 //    side, solve and encode: DeformFrame.timings).
+//  - deformd_frame_constraint_seconds: histogram of a written constrained frame's constraint time
+//    (FrameTimings.constraint_ms); deformd_frames_unresolved_total: written frames whose skin
+//    was left inside a bone (FrameConstraints.unresolved).
 //  - deformd_poses_skipped_total: poses replaced by a newer one before they were solved (the sum
 //    of written frames' skipped_poses).
 //  - deformd_notices_sent_total{kind}: notices written (pose_rejected, stiffness_applied,
@@ -65,6 +68,9 @@ class ServiceMetrics {
   // `bytes` its serialized size, `server_seconds` its server time, `skipped_poses` its count.
   void FrameWritten(int encoding, std::size_t bytes, double server_seconds,
                     std::uint64_t skipped_poses);
+  // A written frame's constraints (a mesh with constraints): their time, and whether they left
+  // skin inside a bone.
+  void ConstrainedFrameWritten(double constraint_seconds, bool unresolved);
   // A notice's write completed; `kind` as in Notice.Kind (out of range: ignored).
   void NoticeWritten(int kind);
   // An RPC finished: `method` is the full name ("/deform.v1.DeformService/Deform"), `code` the
@@ -95,6 +101,8 @@ class ServiceMetrics {
   std::array<prometheus::Counter*, kEncodings> frame_bytes_sent_{};
   prometheus::Histogram* frame_server_seconds_ = nullptr;
   prometheus::Counter* poses_skipped_ = nullptr;
+  prometheus::Histogram* frame_constraint_seconds_ = nullptr;
+  prometheus::Counter* frames_unresolved_ = nullptr;
   std::array<prometheus::Counter*, kNoticeKinds> notices_sent_{};
   std::array<std::array<prometheus::Counter*, kStatusCodes>, kMethods> rpcs_{};
   prometheus::Histogram* build_ok_seconds_ = nullptr;

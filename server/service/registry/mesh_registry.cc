@@ -20,7 +20,8 @@ const Identity& Unscoped() {
 
 StatusOr<std::shared_ptr<const MeshEntry>> MeshRegistry::Register(
     Admission::MeshSlot slot, std::string name, std::shared_ptr<const DeformationModel> model,
-    MeshFileMetadata file_metadata, MeshSolvePlan solve, std::string id) {
+    MeshFileMetadata file_metadata, MeshSolvePlan solve, std::string id,
+    MeshConstraints constraints) {
   auto entry = std::make_shared<MeshEntry>();
   entry->name = std::move(name);
   entry->tenant = slot.tenant();
@@ -29,14 +30,15 @@ StatusOr<std::shared_ptr<const MeshEntry>> MeshRegistry::Register(
   entry->factor_bytes = model->default_factorization()->factor().bytes();
   // The solve plan's buffers were allocated before the budget check below (which then counts
   // them): for a moment the mesh's memory may exceed its slot's by these, a few right-hand sides
-  // per worker. The file-order maps (4 bytes per file vertex, and per unused one) are the mesh's
-  // too.
-  entry->memory_bytes = model->EstimatedBytes() + solve.bytes +
+  // per worker. The file-order maps (4 bytes per file vertex, and per unused one) and the
+  // constraints are the mesh's too.
+  entry->memory_bytes = model->EstimatedBytes() + solve.bytes + constraints.bytes +
                         sizeof(int) * (file_metadata.file_vertex_to_mesh.size() +
                                        file_metadata.unused_file_vertices.size());
   entry->model = std::move(model);
   entry->file_metadata = std::move(file_metadata);
   entry->solve = std::move(solve);
+  entry->constraints = std::move(constraints);
 
   MutexLock lock(&mutex_);
   if (!id.empty() && order_of_id_.count(id) != 0) {

@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "core/base/status.h"
+#include "core/constraints/skin_constraints.h"
 #include "core/model/deformation_model.h"
 #include "service/access/admission.h"
 #include "service/access/identity.h"
@@ -49,6 +50,18 @@ struct MeshFileMetadata {
   std::string up_axis;
 };
 
+// What a mesh's frames keep beyond the method's energy (core/constraints/skin_constraints.h).
+struct MeshConstraints {
+  // Made for the entry's model (it keeps a pointer to it: the entry holds both, this one
+  // released first). Null when there are neither bone surfaces nor a volume to keep: frames are
+  // then the model's own and carry no FrameConstraints.
+  std::shared_ptr<const SkinConstraints> constraints;
+  // What the load asked for (MethodOptions.constraints): contacts on is max_contacts > 0.
+  ConstraintOptions options;
+  // The estimate of what the bone surfaces, their search trees and the constraints hold.
+  std::size_t bytes = 0;
+};
+
 struct MeshEntry {
   std::string id;      // NewMeshId(): "mesh-" and 128 random bits in hex (mesh_id.h)
   std::string name;    // the client's label
@@ -61,6 +74,12 @@ struct MeshEntry {
   MeshFileMetadata file_metadata;
   // How its frames are solved on the workers (batch scratches, parallel plan; in memory_bytes).
   MeshSolvePlan solve;
+  // Declared after `model`, whose lifetime the constraints share (in memory_bytes).
+  MeshConstraints constraints;
+  // The bone surfaces frames carry transforms for (constraints' bones), or null.
+  const BoneContacts* bones() const {
+    return constraints.constraints != nullptr ? constraints.constraints->bones() : nullptr;
+  }
 
   // Vertices of frames and rest positions as clients see them (the file's).
   int client_vertex_count() const {
@@ -82,14 +101,14 @@ class MeshRegistry {
 
   // Registers a built model using `slot` (valid), owned by the slot's tenant and solved with
   // `solve` (PlanMeshSolve), under `id` if given (a mesh restored from a store keeps its id; an id
-  // already loaded is INVALID_ARGUMENT), else under a new NewMeshId(). RESOURCE_EXHAUSTED when
-  // the mesh does not fit in the memory budget (Admission::AdmitMesh). The slot is released on
-  // every error.
+  // already loaded is INVALID_ARGUMENT), else under a new NewMeshId(), with `constraints` made
+  // for `model`. RESOURCE_EXHAUSTED when the mesh does not fit in the memory budget
+  // (Admission::AdmitMesh). The slot is released on every error.
   StatusOr<std::shared_ptr<const MeshEntry>> Register(Admission::MeshSlot slot, std::string name,
                                                       std::shared_ptr<const DeformationModel> model,
                                                       MeshFileMetadata file_metadata = {},
-                                                      MeshSolvePlan solve = {},
-                                                      std::string id = {});
+                                                      MeshSolvePlan solve = {}, std::string id = {},
+                                                      MeshConstraints constraints = {});
 
   // The mesh `caller` may access; NOT_FOUND for an unknown (or unloaded) id and, with the same
   // message, for another tenant's mesh.

@@ -12,6 +12,8 @@
 #include <thread>
 #include <vector>
 
+#include "core/constraints/bone_contacts.h"
+#include "core/constraints/skin_constraints.h"
 #include "core/geometry/pose.h"
 #include "core/io/phantom.h"
 #include "core/model/deformation_model.h"
@@ -22,7 +24,9 @@ namespace {
 
 using ::testing::HasSubstr;
 
-// The core's result for `spec` on the default phantom model of `vertices`, and its diagonal.
+// The core's result for `spec` on the default phantom model of `vertices`, and its diagonal:
+// constrained as the service's default constraints do (the phantom's bones, contacts and volume),
+// or with `constrained` false the model's own frame.
 struct CoreResult {
   Positions positions;
   double diagonal = 0;
@@ -30,7 +34,8 @@ struct CoreResult {
 };
 
 CoreResult CoreDeform(int vertices, const std::string& spec,
-                      const ModelOptions& options = ModelOptions::Paper()) {
+                      const ModelOptions& options = ModelOptions::Paper(),
+                      bool constrained = true) {
   CoreResult result;
   auto phantom = MakeKneePhantom(vertices);
   EXPECT_TRUE(phantom.ok());
@@ -44,6 +49,18 @@ CoreResult CoreDeform(int vertices, const std::string& spec,
   result.clamped = *clamped;
   DeformScratch scratch = (*model)->MakeScratch();
   (*model)->Deform(*(*model)->default_factorization(), pose, &scratch);
+  if (constrained) {
+    auto bones = BoneContacts::Create(phantom->bones, (*model)->skeleton(), (*model)->mesh(),
+                                      (*model)->rigid_bones());
+    EXPECT_TRUE(bones.ok()) << bones.status().ToString();
+    auto constraints = SkinConstraints::Create(**model, *bones);
+    EXPECT_TRUE(constraints.ok()) << constraints.status().ToString();
+    ConstraintScratch constraint_scratch = (*constraints)->MakeScratch();
+    ConstraintReport report;
+    EXPECT_TRUE(
+        (*constraints)
+            ->Apply(*(*model)->default_factorization(), &scratch, &constraint_scratch, &report));
+  }
   result.positions = scratch.positions();
   result.diagonal = (*model)->bounding_box_diagonal();
   return result;
@@ -422,7 +439,9 @@ TEST_P(DeformStreamTest, UnloadedMeshKeepsItsStreamsButRefusesNewOnes) {
 
 TEST_P(DeformStreamTest, AnUnloadedMeshKeptAliveByAStreamStillCountsAgainstTheBudget) {
   service::ServerOptions options = TestServerOptions();
-  options.limits.max_memory_bytes = std::size_t{16} << 20;  // one 5000-vertex phantom, not two
+  // One 5000-vertex phantom (about 14 MiB) and its stream (about 2 MiB with its constraints'
+  // scratch), not two phantoms.
+  options.limits.max_memory_bytes = std::size_t{20} << 20;
   StartServer(options);
   const std::string mesh_id = LoadPhantom(5000);
   StreamRecorder recorder;

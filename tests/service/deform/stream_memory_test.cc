@@ -36,7 +36,11 @@ class StreamMemoryTest : public ::testing::Test {
     mesh_bytes_ = probe.server().context().admission().memory_bytes_used();
     auto entry = probe.server().context().registry().Find(id);
     ASSERT_TRUE(entry.ok());
-    scratch_bytes_ = (*entry)->model->ScratchBytes();
+    // The solve's scratch, the constraints' and each frame's bone surface transforms.
+    const SkinConstraints* constraints = (*entry)->constraints.constraints.get();
+    ASSERT_NE(constraints, nullptr);
+    scratch_bytes_ = (*entry)->model->ScratchBytes() + constraints->ScratchBytes() +
+                     3 * 48 * static_cast<std::size_t>(constraints->bones()->num_surfaces());
     factorization_bytes_ = (*entry)->model->FactorizationBytes();
   }
 

@@ -150,6 +150,56 @@ TEST_F(MeshStoreTest, MeshesComeBackWithTheirIdsAndOwnersAndUnloadDeletesThem) {
   EXPECT_EQ(EntryFiles(store_), std::vector<std::string>{phantom_id + ".mesh"});
 }
 
+TEST_F(MeshStoreTest, BoneSurfacesAndConstraintOptionsComeBack) {
+  auto phantom = MakeKneePhantom(600);
+  ASSERT_TRUE(phantom.ok());
+  const std::string mesh_path = dir_.Path("leg.obj");
+  ASSERT_TRUE(WriteMeshFile(phantom->mesh, mesh_path).ok());
+  const std::string skeleton_path = dir_.Write("leg.json", SkeletonToJson(phantom->skeleton));
+  const std::string femur_path = dir_.Path("femur.obj");
+  ASSERT_TRUE(WriteMeshFile(phantom->bones[0].mesh, femur_path).ok());
+  v1::MethodOptions options;
+  options.mutable_constraints()->set_contacts(false);
+  options.mutable_constraints()->set_contact_margin(0.002);
+  std::string upload_id, phantom_id;
+  v1::GetMeshInfoResponse before;
+  {
+    StoredServer server(store_, tokens_);
+    auto ward_a = server.NewClient("token-a");
+    v1::MeshSummary summary;
+    const grpc::Status status = ward_a->LoadMeshFiles(mesh_path, skeleton_path, options, &summary,
+                                                      {}, "", {femur_path + ":hip"});
+    ASSERT_TRUE(status.ok()) << status.error_message();
+    upload_id = summary.mesh_id();
+    ASSERT_TRUE(ward_a->GetMeshInfo(upload_id, true, &before).ok());
+    v1::LoadMeshHeader header;
+    header.mutable_phantom()->set_vertices(300);
+    header.mutable_phantom()->set_without_bones(true);
+    ASSERT_TRUE(ward_a->LoadMesh(header, {}, &summary).ok());
+    phantom_id = summary.mesh_id();
+  }
+  ASSERT_EQ(before.summary().bone_surfaces_size(), 1);
+
+  StoredServer restarted(store_, tokens_);
+  EXPECT_EQ(restarted.restored(), 2);
+  auto ward_a = restarted.NewClient("token-a");
+  v1::GetMeshInfoResponse after;
+  ASSERT_TRUE(ward_a->GetMeshInfo(upload_id, true, &after).ok());
+  ASSERT_EQ(after.summary().bone_surfaces_size(), 1);
+  EXPECT_EQ(after.summary().bone_surfaces(0).name(), "femur");
+  EXPECT_EQ(after.summary().bone_surfaces(0).bone(), 0u);
+  EXPECT_EQ(after.summary().bone_surfaces(0).triangle_count(),
+            before.summary().bone_surfaces(0).triangle_count());
+  ASSERT_EQ(after.bone_surfaces_size(), 1);
+  EXPECT_EQ(after.bone_surfaces(0).rest_positions(), before.bone_surfaces(0).rest_positions());
+  EXPECT_EQ(after.bone_surfaces(0).triangles(), before.bone_surfaces(0).triangles());
+  EXPECT_FALSE(after.summary().constraints().contacts());
+  EXPECT_TRUE(after.summary().constraints().keep_volume());
+  EXPECT_DOUBLE_EQ(after.summary().constraints().contact_margin(), 0.002);
+  ASSERT_TRUE(ward_a->GetMeshInfo(phantom_id, false, &after).ok());
+  EXPECT_EQ(after.summary().bone_surfaces_size(), 0);  // without_bones kept
+}
+
 TEST_F(MeshStoreTest, ACorruptEntryIsSkippedAndTheRestRestored) {
   std::string good_id;
   {
