@@ -8,7 +8,8 @@
 //           [--tls-cert PEM --tls-key PEM [--tls-client-ca PEM]] [--plaintext]
 //           [--token-file FILE] [--tenant-max-meshes N] [--tenant-max-streams N]
 //           [--tenant-max-memory-mb N] [--preload-tenant NAME] [--store DIR] [--metrics ADDR]
-//           [--http ADDR [--http-root DIR] [--http-max-connections N]]
+//           [--http ADDR [--http-root DIR] [--http-max-connections N]
+//            [--http-allowed-host NAME]...]
 //   deformd --version   prints "deformd VERSION (commit COMMIT)" (core/base/build_info.h)
 //
 // --metrics ADDR serves GET /metrics in Prometheus' format on its own port: plain HTTP, on a
@@ -52,6 +53,7 @@
 #include "core/base/build_info.h"
 #include "core/io/model_input.h"
 #include "service/access/identity.h"
+#include "service/base/log_text.h"
 #include "service/base/service_options.h"
 #include "service/rpc/deform_server.h"
 #include "service/rpc/web_server.h"
@@ -85,6 +87,7 @@ struct Args {
   std::string http_address;
   std::string http_root;
   int http_max_connections = 64;
+  std::vector<std::string> http_allowed_hosts;
 };
 
 // The viewer's files when --http-root is not given: `web` beside the executable, else

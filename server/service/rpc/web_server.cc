@@ -11,6 +11,7 @@
 #include <fstream>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <sstream>
 #include <thread>
 #include <vector>
@@ -20,6 +21,7 @@
 #include "service/load/load_mesh_reactor.h"
 #include "service/rpc/static_files.h"
 #include "service/rpc/unary_calls.h"
+#include "service/transport/http_host_policy.h"
 #include "service/transport/status_mapping.h"
 #include "service/transport/transport_security.h"
 #include "service/transport/web_auth.h"
@@ -85,6 +87,7 @@ struct Shared {
   service::ServiceContext* context;
   WebOptions options;
   Connections connections;
+  HttpHostPolicy hosts;
 };
 
 int HttpStatusFor(grpc::StatusCode code) {
@@ -138,14 +141,20 @@ Response ErrorResponse(const Request& request, grpc::StatusCode code, const std:
   return response;
 }
 
-// A page of another origin may not use the port: the Origin header, when sent, must name the host
-// the request was sent to (a browser sends it on WebSocket upgrades and cross-origin POSTs).
-bool SameOrigin(const Request& request) {
+std::string_view HeaderOf(const Request& request, http::field field) {
+  const auto value = request[field];
+  return std::string_view(value.data(), value.size());
+}
+
+// The Host must be one the port is for and the Origin, when sent, that host's own (DNS
+// rebinding and pages of other origins: http_host_policy.h).
+bool HostAndOriginAllowed(const Shared& shared, const Request& request) {
   const auto origin = request.find(http::field::origin);
-  if (origin == request.end()) return true;
-  const std::string_view value(origin->value().data(), origin->value().size());
-  const std::string_view host(request[http::field::host].data(), request[http::field::host].size());
-  return !host.empty() && (value == "http://" + std::string(host));
+  return shared.hosts.AllowsRequest(HeaderOf(request, http::field::host),
+                                    origin == request.end()
+                                        ? std::nullopt
+                                        : std::optional<std::string_view>(std::string_view(
+                                              origin->value().data(), origin->value().size())));
 }
 
 // `method` is the full gRPC name the call is counted under (ServiceMetrics::RpcFinished).
@@ -264,13 +273,28 @@ class HttpSession final : public Abortable, public std::enable_shared_from_this<
     Respond(Handle(request));
   }
 
+  // 403 with a body for a Host the port is not for or another origin; nullopt when allowed.
+  std::optional<Response> RefuseHostOrOrigin(const Request& request) {
+    if (HostAndOriginAllowed(*shared_, request)) return std::nullopt;
+    spdlog::warn(
+        "{} request refused: Host '{}' Origin '{}' (not an allowed host, or another "
+        "origin; --http-allowed-host)",
+        log_context_, service::EscapeForLog(HeaderOf(request, http::field::host), 64),
+        service::EscapeForLog(HeaderOf(request, http::field::origin), 64));
+    Response response =
+        ErrorResponse(request, grpc::StatusCode::PERMISSION_DENIED,
+                      shared_->hosts.AllowsHost(HeaderOf(request, http::field::host))
+                          ? "cross-origin request"
+                          : "this port does not serve that Host name (see --http-allowed-host)");
+    response.keep_alive(false);
+    return response;
+  }
+
   Response Handle(const Request& request) {
+    if (auto refused = RefuseHostOrOrigin(request)) return std::move(*refused);
     const std::string_view target(request.target().data(), request.target().size());
     constexpr std::string_view kApi = "/api/";
     if (target.substr(0, kApi.size()) == kApi) {
-      if (!SameOrigin(request)) {
-        return ErrorResponse(request, grpc::StatusCode::PERMISSION_DENIED, "cross-origin call");
-      }
       return ApiCall(*shared_, request, target.substr(kApi.size()));
     }
     return StaticFile(*shared_, request);
@@ -294,12 +318,8 @@ class HttpSession final : public Abortable, public std::enable_shared_from_this<
   void Upgrade(Request request) {
     const std::string_view target(request.target().data(), request.target().size());
     const std::string_view path = target.substr(0, target.find('?'));
-    if (!SameOrigin(request)) {
-      spdlog::warn("{} websocket refused: cross-origin upgrade from '{}'", log_context_,
-                   service::EscapeForLog(std::string_view(request[http::field::origin].data(),
-                                                          request[http::field::origin].size()),
-                                         64));
-      Respond(ErrorResponse(request, grpc::StatusCode::PERMISSION_DENIED, "cross-origin upgrade"));
+    if (auto refused = RefuseHostOrOrigin(request)) {
+      Respond(std::move(*refused));
       return;
     }
     const bool deform = path == "/ws/Deform";
@@ -394,7 +414,8 @@ StatusOr<tcp::endpoint> ParseEndpoint(const std::string& address) {
 
 struct WebServer::Impl {
   Impl(service::ServiceContext* context, WebOptions options)
-      : shared{context, options, Connections(options.max_connections)},
+      : shared{context, options, Connections(options.max_connections),
+               HttpHostPolicy(options.address, options.allowed_hosts)},
         io(options.threads),
         acceptor(asio::make_strand(io)) {}
 

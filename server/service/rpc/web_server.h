@@ -22,9 +22,9 @@
 // max_message_bytes (refused before it is read: the stream ends RESOURCE_EXHAUSTED), messages per
 // second per WebSocket (max_messages_per_second: reading pauses until the next second), a
 // request or handshake must arrive within 30 s, an idle WebSocket is pinged and closed when its
-// peer stops answering (60 s). A page from another origin is refused (403: the Origin header,
-// when present, must name the Host the request was sent to). Logs through spdlog, client strings
-// escaped (log_text.h).
+// peer stops answering (60 s). A request whose Host is not one the port is for (DNS rebinding) or
+// from a page of another origin is refused with 403 and a body before it is handled
+// (http_host_policy.h). Logs through spdlog, client strings escaped (log_text.h).
 //
 // Life cycle: Start() binds and serves on its own threads; Stop() (DeformServer's shutdown, after
 // the streams were drained, before the worker pool stops) stops accepting, waits up to `grace`
@@ -37,6 +37,7 @@
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "core/base/status.h"
 #include "service/context/service_context.h"
@@ -53,6 +54,9 @@ struct WebOptions {
   // Largest WebSocket message from a client (a LoadMesh chunk is the largest); default 4 MiB.
   std::size_t max_message_bytes = std::size_t{4} << 20;
   int max_messages_per_second = 2000;
+  // Host names served beside the loopback names and the listen address's host
+  // (--http-allowed-host; http_host_policy.h).
+  std::vector<std::string> allowed_hosts;
   // Serve plaintext on a non-loopback address (there is no TLS on this port).
   bool allow_plaintext = false;
   int threads = 1;

@@ -26,16 +26,18 @@ inline service::ServerOptions TestServerOptions() {
 class TestServer {
  public:
   // `token_file`: authenticate calls with it (DeformServer::UseTokenFile); empty: no tokens.
-  // `with_web`: serve the HTTP port as well (its static root: the viewer's sources).
+  // `with_web`: serve the HTTP port as well (its static root: the viewer's sources) with
+  // `web_options` (their address and static root are the test's).
   explicit TestServer(service::ServerOptions options = TestServerOptions(),
-                      const std::string& token_file = "", bool with_web = false)
+                      const std::string& token_file = "", bool with_web = false,
+                      web::WebOptions web_options = {})
       : server_(std::make_unique<service::DeformServer>(options)) {
     if (!token_file.empty()) {
       const Status tokens = server_->UseTokenFile(token_file);
       EXPECT_TRUE(tokens.ok()) << tokens.ToString();
     }
     if (with_web) {
-      web::WebOptions web_options;
+      web_options.address = "127.0.0.1:0";
       web_options.static_root = std::string(DEFORM_SOURCE_DIR) + "/client/web";
       web_ = std::make_unique<web::WebServer>(&server_->context(), web_options);
       server_->AddTransportStop([this](std::chrono::milliseconds grace) { web_->Stop(grace); });
