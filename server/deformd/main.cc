@@ -314,6 +314,10 @@ int main(int argc, char** argv) {
                  "Open HTTP and WebSocket connections at once")
       ->capture_default_str()
       ->check(CLI::Range(1, 65536));
+  app.add_option("--http-allowed-host", args.http_allowed_hosts,
+                 "A Host name the HTTP port answers beside localhost, 127.0.0.1, [::1] and the "
+                 "--http host (repeatable; any other Host is refused 403: DNS rebinding)")
+      ->allow_extra_args(false);
   app.set_version_flag("--version", deform::VersionLine("deformd"));
   try {
     app.parse(argc, argv);
@@ -321,6 +325,7 @@ int main(int argc, char** argv) {
     return app.exit(e);
   }
 
+  deform::service::InstallEscapingDefaultLogger();  // no control byte reaches the log
   spdlog::set_level(spdlog::level::from_str(args.log_level));
   spdlog::set_pattern("[%Y-%m-%d %H:%M:%S.%e] [%^%l%$] %v");
   args.server.limits.max_memory_bytes = args.max_memory_mb << 20;
@@ -363,6 +368,7 @@ int main(int argc, char** argv) {
     web_options.address = args.http_address;
     web_options.static_root = args.http_root.empty() ? DefaultHttpRoot() : args.http_root;
     web_options.max_connections = args.http_max_connections;
+    web_options.allowed_hosts = args.http_allowed_hosts;
     web_options.allow_plaintext = args.server.security.allow_plaintext;
     if (web_options.static_root.empty()) {
       spdlog::error("--http: no viewer files beside the executable; give --http-root DIR");

@@ -1,6 +1,5 @@
 #include "service/access/audit_log.h"
 
-#include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
 #include <memory>
@@ -14,7 +13,7 @@ spdlog::logger& AuditLogger() {
   static const std::shared_ptr<spdlog::logger> logger = [] {
     std::shared_ptr<spdlog::logger> existing = spdlog::get("audit");
     if (existing != nullptr) return existing;
-    std::shared_ptr<spdlog::logger> created = spdlog::stdout_color_mt("audit");
+    std::shared_ptr<spdlog::logger> created = NewEscapingStdoutLogger("audit");
     // deformd's pattern with the logger's name, so that audit lines can be told apart.
     created->set_pattern("[%Y-%m-%d %H:%M:%S.%e] [%^%l%$] [%n] %v");
     // An audit trail, not diagnostics: written whatever --log-level says.

@@ -1,5 +1,7 @@
 #include "service/context/service_context.h"
 
+#include "service/base/log_text.h"
+
 namespace deform::service {
 
 bool ActiveStreams::Add(Drainable* stream) {
@@ -32,6 +34,8 @@ ServiceContext::ServiceContext(const ServerOptions& options)
       registry_(&admission_),
       pool_(options.workers, options.batch_frames),
       uploads_(std::chrono::milliseconds(options.limits.upload_idle_timeout_ms),
-               std::chrono::milliseconds(options.limits.upload_time_limit_ms)) {}
+               std::chrono::milliseconds(options.limits.upload_time_limit_ms)) {
+  InstallEscapingDefaultLogger();  // every line safe, in-process servers included (log_text.h)
+}
 
 }  // namespace deform::service

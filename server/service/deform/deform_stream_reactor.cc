@@ -217,7 +217,7 @@ void DeformStreamReactor::Fail(grpc::StatusCode code, const std::string& message
 }
 
 void DeformStreamReactor::FailLocked(grpc::StatusCode code, const std::string& message) {
-  spdlog::warn("{} ending: {}", log_context_, message);
+  spdlog::warn("{} ending: {}", log_context_, EscapeControlBytes(BoundStatusMessage(message)));
   pump_.RequestFinish(grpc::Status(code, BoundStatusMessage(message)));
   pump_.Pump();
 }
@@ -366,7 +366,8 @@ void DeformStreamReactor::HandleStiffness() {
 }
 
 void DeformStreamReactor::RejectStiffnessLocked(std::uint64_t version, const std::string& why) {
-  spdlog::info("{} stiffness version {} rejected: {}", log_context_, version, why);
+  spdlog::info("{} stiffness version {} rejected: {}", log_context_, version,
+               EscapeControlBytes(BoundStatusMessage(why)));
   outbox_.AddNotice(v1::Notice::KIND_STIFFNESS_REJECTED, 0, version,
                     "stiffness version " + std::to_string(version) + ": " + why);
 }
@@ -596,8 +597,8 @@ void DeformStreamReactor::OnDone() {
     const grpc::Status& status = pump_.finish_status();
     spdlog::info(
         "{} closed ({}): {} frames written ({} unresolved), {} poses rejected, {} notices dropped",
-        log_context_, status.ok() ? std::string("OK") : status.error_message(), frames_written_,
-        frames_unresolved_, poses_rejected_, outbox_.notices_dropped());
+        log_context_, status.ok() ? std::string("OK") : EscapeControlBytes(status.error_message()),
+        frames_written_, frames_unresolved_, poses_rejected_, outbox_.notices_dropped());
   }
   ReleaseTransportReference();  // last: may free the reactor
 }
