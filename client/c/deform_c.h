@@ -333,7 +333,8 @@ DEFORM_C_API deform_status deform_stream_frame_bones(deform_stream* stream, floa
 typedef enum deform_notice_kind {
   DEFORM_NOTICE_POSE_REJECTED = 1,      /* `sequence` names the pose; the message says why */
   DEFORM_NOTICE_STIFFNESS_REJECTED = 2, /* `stiffness_version` names the update */
-  DEFORM_NOTICE_STIFFNESS_APPLIED = 3   /* frames from now on use `stiffness_version` */
+  DEFORM_NOTICE_STIFFNESS_APPLIED = 3,  /* frames from now on use `stiffness_version` */
+  DEFORM_NOTICE_CREDENTIALS_REVOKED = 4 /* the token was revoked: the stream ends next */
 } deform_notice_kind;
 
 typedef struct deform_notice_info {

@@ -18,6 +18,7 @@ enum class StatusCode {
   kOk = 0,
   kInvalidArgument = 3,     // the input (mesh, skeleton, pose, request) is malformed
   kNotFound = 5,            // a named thing (file, joint, mesh id) does not exist
+  kPermissionDenied = 7,    // the caller is known but its role may not do this (the service's)
   kResourceExhausted = 8,   // a configured limit would be exceeded
   kFailedPrecondition = 9,  // the operation does not apply in the current state
   kOutOfRange = 11,         // a value lies outside its allowed range
@@ -46,6 +47,9 @@ class [[nodiscard]] Status {
     return {StatusCode::kInvalidArgument, std::move(msg)};
   }
   static Status NotFound(std::string msg) { return {StatusCode::kNotFound, std::move(msg)}; }
+  static Status PermissionDenied(std::string msg) {
+    return {StatusCode::kPermissionDenied, std::move(msg)};
+  }
   static Status OutOfRange(std::string msg) { return {StatusCode::kOutOfRange, std::move(msg)}; }
   static Status ResourceExhausted(std::string msg) {
     return {StatusCode::kResourceExhausted, std::move(msg)};

@@ -32,4 +32,12 @@ void Audit(std::string_view tenant, std::string_view action, std::string_view me
                      EscapeForLog(result));
 }
 
+void AuditCrossTenant(const Identity& caller, std::string_view owner, std::string_view mesh_id,
+                      std::string_view what) {
+  if (caller.role != Role::kOperator || caller.tenant.empty() || owner == caller.tenant) return;
+  AuditLogger().info("tenant={} action=cross_tenant mesh={} result=owner={} role=operator op={}",
+                     EscapeForLog(caller.tenant), EscapeForLog(mesh_id, 80), EscapeForLog(owner),
+                     EscapeForLog(what));
+}
+
 }  // namespace deform::service

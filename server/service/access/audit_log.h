@@ -12,9 +12,17 @@
 
 #include <string_view>
 
+#include "service/access/identity.h"
+
 namespace deform::service {
 
 void Audit(std::string_view tenant, std::string_view action, std::string_view mesh_id,
            std::string_view result);
+
+// An operator's access to a mesh another tenant owns (`what`: find, list, unload):
+//     tenant=OPERATOR action=cross_tenant mesh=ID result=owner=OWNER role=operator op=WHAT
+// Nothing for a caller's own meshes or for the server's own lookups (an empty tenant).
+void AuditCrossTenant(const Identity& caller, std::string_view owner, std::string_view mesh_id,
+                      std::string_view what);
 
 }  // namespace deform::service

@@ -94,9 +94,13 @@ StatusOr<TokenTable> TokenTable::Parse(std::string_view text) {
       identity.role = Role::kTenant;
     } else if (fields[2] == "operator") {
       identity.role = Role::kOperator;
+    } else if (fields[2] == "metrics") {
+      identity.role = Role::kMetrics;
     } else {
-      return Status::InvalidArgument(where + ": the role must be 'tenant' or 'operator'");
+      return Status::InvalidArgument(where +
+                                     ": the role must be 'tenant', 'operator' or 'metrics'");
     }
+    identity.token_sha256 = hash;
     if (!table.identities_.emplace(hash, std::move(identity)).second) {
       return Status::InvalidArgument(where + ": this token hash is listed twice");
     }
@@ -170,6 +174,29 @@ StatusOr<Identity> Authenticator::Authenticate(std::string_view authorization) c
   const Identity* identity = table->Find(Sha256Hex(token));
   if (identity == nullptr) return Status::Unauthenticated("unknown or revoked bearer token");
   return *identity;
+}
+
+bool Authenticator::StillValid(const Identity& caller) const {
+  std::shared_ptr<const TokenTable> table;
+  {
+    MutexLock lock(&mutex_);
+    table = table_;
+  }
+  if (table == nullptr) return caller.token_sha256.empty();
+  const Identity* now = table->Find(caller.token_sha256);
+  return now != nullptr && now->tenant == caller.tenant && now->role == caller.role;
+}
+
+const char* RoleName(Role role) {
+  switch (role) {
+    case Role::kTenant:
+      return "tenant";
+    case Role::kOperator:
+      return "operator";
+    case Role::kMetrics:
+      return "metrics";
+  }
+  return "tenant";
 }
 
 }  // namespace deform::service

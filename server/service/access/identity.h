@@ -6,7 +6,9 @@
 //     <sha256 of the token, 64 hex digits>  <tenant>  <role>
 //
 // tenant: 1 to 64 characters of [A-Za-z0-9._-]; role: `tenant` (sees and changes only its own
-// tenant's meshes) or `operator` (sees and changes every tenant's meshes). The file holds hashes
+// tenant's meshes), `operator` (sees and changes every tenant's meshes; each access to another
+// tenant's mesh leaves an audit line, action=cross_tenant) or `metrics` (scrapes the metrics port
+// and nothing else: every call and HTTP API request is PERMISSION_DENIED). The file holds hashes
 // only, so reading it does not reveal a token (`printf %s "$TOKEN" | sha256sum`). The same hash
 // twice, a malformed line or an unknown role is an error naming the line.
 //
@@ -31,17 +33,23 @@
 
 namespace deform::service {
 
-enum class Role { kTenant, kOperator };
+enum class Role { kTenant, kOperator, kMetrics };
+
+// The token file's name of `role` ("tenant", "operator", "metrics").
+const char* RoleName(Role role);
 
 struct Identity {
   std::string tenant;
   Role role = Role::kTenant;
+  // The SHA-256 of the token the caller presented; empty without a token file. A stream keeps
+  // it, so that a reload can tell whether its token still stands (Authenticator::StillValid).
+  std::string token_sha256;
 
   // The tenant every caller is when the server has no token file.
-  static Identity Implicit() { return {"default", Role::kTenant}; }
+  static Identity Implicit() { return {"default", Role::kTenant, ""}; }
   // May this caller see (and stream, unload) a mesh owned by `owner`?
   bool CanAccess(const std::string& owner) const {
-    return role == Role::kOperator || owner == tenant;
+    return role == Role::kOperator || (role == Role::kTenant && owner == tenant);
   }
 };
 
@@ -82,6 +90,9 @@ class Authenticator {
   // case-insensitive). UNAUTHENTICATED without a header, with another scheme, or with an unknown
   // token (the message never echoes the token). Without a token file: Identity::Implicit().
   StatusOr<Identity> Authenticate(std::string_view authorization) const DEFORM_EXCLUDES(mutex_);
+  // Whether `caller` (from Authenticate) would still be the same identity: its token is still
+  // listed with the same tenant and role. Always true without a token file.
+  bool StillValid(const Identity& caller) const DEFORM_EXCLUDES(mutex_);
 
  private:
   mutable Mutex mutex_;

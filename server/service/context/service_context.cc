@@ -22,6 +22,17 @@ void ActiveStreams::DrainAll() {
   for (Drainable* stream : streams_) stream->Drain();
 }
 
+int ActiveStreams::RevokeInvalid(const Authenticator& auth) {
+  MutexLock lock(&mutex_);
+  int revoked = 0;
+  for (Drainable* stream : streams_) {
+    if (auth.StillValid(stream->caller())) continue;
+    stream->Revoke();
+    ++revoked;
+  }
+  return revoked;
+}
+
 int ActiveStreams::count() const {
   MutexLock lock(&mutex_);
   return static_cast<int>(streams_.size());

@@ -29,12 +29,18 @@
 
 namespace deform::service {
 
-// Something that can be asked to end early because the server is shutting down.
+// Something that can be asked to end early: because the server is shutting down, or because
+// the token it was opened with no longer stands.
 class Drainable {
  public:
   // Ends the stream soon (with UNAVAILABLE). Must not block; must not call back into
   // ActiveStreams (it is called with the ActiveStreams lock held).
   virtual void Drain() = 0;
+  // Who opened the stream.
+  virtual const Identity& caller() const = 0;
+  // Ends the stream soon with UNAUTHENTICATED, after a KIND_CREDENTIALS_REVOKED notice. Same
+  // rules as Drain().
+  virtual void Revoke() = 0;
 
  protected:
   ~Drainable() = default;
@@ -49,6 +55,9 @@ class ActiveStreams {
   void Remove(Drainable* stream) DEFORM_EXCLUDES(mutex_);
   // Calls Drain() on every registered stream; later Add() calls fail.
   void DrainAll() DEFORM_EXCLUDES(mutex_);
+  // Calls Revoke() on every registered stream whose caller `auth` no longer accepts
+  // (Authenticator::StillValid); how many.
+  int RevokeInvalid(const Authenticator& auth) DEFORM_EXCLUDES(mutex_);
   int count() const DEFORM_EXCLUDES(mutex_);
 
  private:

@@ -118,6 +118,10 @@ class DeformStreamReactor final : public StreamHandler,
   void UpdateBatchKeyLocked() DEFORM_REQUIRES(mutex_);
   // Drainable.
   void Drain() DEFORM_EXCLUDES(mutex_) override;
+  const Identity& caller() const override { return caller_; }
+  void Revoke() DEFORM_EXCLUDES(mutex_) override;
+  // The end of a revoked stream: UNAUTHENTICATED (after its notice, or at once without one).
+  void FinishRevokedLocked() DEFORM_REQUIRES(mutex_);
 
   // Posts the background refactorization of `update`, once the memory budgets hold its
   // factorization (else KIND_STIFFNESS_REJECTED naming the budget).
@@ -185,6 +189,7 @@ class DeformStreamReactor final : public StreamHandler,
   std::size_t buffer_bytes_ DEFORM_GUARDED_BY(mutex_) = 0;
   std::uint64_t poses_rejected_ DEFORM_GUARDED_BY(mutex_) = 0;
   bool reading_paused_ DEFORM_GUARDED_BY(mutex_) = false;
+  bool revoked_ DEFORM_GUARDED_BY(mutex_) = false;  // its token was revoked or changed
 };
 
 void DeformStreamReactor::OnReadDone(bool ok) {
@@ -258,6 +263,11 @@ void DeformStreamReactor::HandleStart() {
     return;
   }
   registered_ = true;
+  // After Add: a reload that swapped the tokens before it is seen here, one after it revokes us.
+  if (!context_->auth().StillValid(caller_)) {
+    Fail(grpc::StatusCode::UNAUTHENTICATED, "unknown or revoked bearer token");
+    return;
+  }
   model_ = entry_->model.get();
   log_context_ += " mesh=" + entry_->id;
   auto encoder = MakeFrameEncoder(request_.start(), *entry_);
@@ -513,7 +523,7 @@ void DeformStreamReactor::RunUrgentBatch(FrameTask* const* others, int count) {
 bool DeformStreamReactor::BeginSolveRun() {
   MutexLock lock(&mutex_);
   poses_.BeginRun();
-  if (pump_.failing()) return false;
+  if (pump_.failing() || revoked_) return false;
   const std::optional<std::uint64_t> skipped = poses_.Take(&solving_);
   if (!skipped.has_value()) return false;
   // The factorization cannot change until EndRun(): ApplyNext waits for the end of the run.
@@ -549,6 +559,11 @@ const v1::DeformResponse* DeformStreamReactor::TakeNextWrite() {
 
 void DeformStreamReactor::WriteCompleted(bool ok) {
   mutex_.AssertHeld();
+  if (ok && revoked_ && in_flight_ != nullptr && in_flight_->has_notice() &&
+      in_flight_->notice().kind() == v1::Notice::KIND_CREDENTIALS_REVOKED) {
+    FinishRevokedLocked();  // the pump finishes right after this hook
+    return;
+  }
   if (ok && in_flight_ != nullptr) CountWritten(*in_flight_, &context_->metrics());
   if (ok && outbox_.frame_in_flight()) {
     ++frames_written_;
@@ -586,6 +601,26 @@ void DeformStreamReactor::Drain() {
   MutexLock lock(&mutex_);
   pump_.RequestFinish(grpc::Status(grpc::StatusCode::UNAVAILABLE, "the server is shutting down"));
   pump_.Pump();
+}
+
+void DeformStreamReactor::Revoke() {
+  MutexLock lock(&mutex_);
+  if (revoked_ || pump_.finish_requested()) return;
+  revoked_ = true;
+  spdlog::warn("{} ending: its token was revoked or changed (token file reloaded)", log_context_);
+  Audit(caller_.tenant, "deform", entry_ != nullptr ? entry_->id : "", "UNAUTHENTICATED: revoked");
+  // The notice first; the finish when it is written (WriteCompleted), or now if it was dropped.
+  if (!outbox_.AddNotice(v1::Notice::KIND_CREDENTIALS_REVOKED, 0, 0,
+                         "the stream's token was revoked or changed; the stream ends "
+                         "UNAUTHENTICATED")) {
+    FinishRevokedLocked();
+  }
+  pump_.Pump();
+}
+
+void DeformStreamReactor::FinishRevokedLocked() {
+  pump_.RequestFinish(
+      grpc::Status(grpc::StatusCode::UNAUTHENTICATED, "the stream's token was revoked or changed"));
 }
 
 void DeformStreamReactor::OnDone() {

@@ -15,7 +15,8 @@ namespace {
 constexpr std::array<const char*, ServiceMetrics::kEncodings> kEncodingNames = {
     "float32", "float32", "quantized", "predicted"};
 constexpr std::array<const char*, ServiceMetrics::kNoticeKinds> kNoticeKindNames = {
-    "unspecified", "pose_rejected", "stiffness_rejected", "stiffness_applied"};
+    "unspecified", "pose_rejected", "stiffness_rejected", "stiffness_applied",
+    "credentials_revoked"};
 // The methods labelled by name; any other (health, reflection, unknown) is "other", so a client
 // cannot grow the number of series.
 constexpr std::array<const char*, ServiceMetrics::kMethods - 1> kMethodNames = {

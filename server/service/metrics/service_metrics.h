@@ -55,7 +55,7 @@ class ServiceMetrics {
  public:
   // The encodings and notice kinds as the proto numbers them (FrameEncoding, Notice.Kind).
   static constexpr int kEncodings = 4;    // index 0 (unspecified) counts as float32
-  static constexpr int kNoticeKinds = 4;  // index 0 (unspecified) is never written
+  static constexpr int kNoticeKinds = 5;  // index 0 (unspecified) is never written
   static constexpr int kStatusCodes = kCanonicalStatusCodes;  // grpc::StatusCode 0..16
   static constexpr int kMethods = 6;  // five DeformService methods and "other"
 

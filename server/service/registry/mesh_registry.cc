@@ -2,6 +2,7 @@
 
 #include <utility>
 
+#include "service/access/audit_log.h"
 #include "service/registry/mesh_id.h"
 
 namespace deform::service {
@@ -12,7 +13,7 @@ Status NotLoaded(const std::string& mesh_id) {
 }
 
 const Identity& Unscoped() {
-  static const Identity kOperator{"", Role::kOperator};
+  static const Identity kOperator{"", Role::kOperator, ""};
   return kOperator;
 }
 
@@ -63,6 +64,7 @@ StatusOr<std::shared_ptr<const MeshEntry>> MeshRegistry::Find(const std::string&
   if (order == order_of_id_.end()) return NotLoaded(mesh_id);
   const std::shared_ptr<MeshEntry>& entry = meshes_.at(order->second);
   if (!caller.CanAccess(entry->tenant)) return NotLoaded(mesh_id);
+  AuditCrossTenant(caller, entry->tenant, mesh_id, "find");
   return std::shared_ptr<const MeshEntry>(entry);
 }
 
@@ -71,7 +73,9 @@ std::vector<std::shared_ptr<const MeshEntry>> MeshRegistry::List(const Identity&
   std::vector<std::shared_ptr<const MeshEntry>> list;
   list.reserve(meshes_.size());
   for (const auto& [order, entry] : meshes_) {
-    if (caller.CanAccess(entry->tenant)) list.push_back(entry);
+    if (!caller.CanAccess(entry->tenant)) continue;
+    AuditCrossTenant(caller, entry->tenant, entry->id, "list");
+    list.push_back(entry);
   }
   return list;
 }
@@ -83,6 +87,7 @@ Status MeshRegistry::Unload(const std::string& mesh_id, const Identity& caller) 
   const auto it = meshes_.find(order->second);
   MeshEntry& entry = *it->second;
   if (!caller.CanAccess(entry.tenant)) return NotLoaded(mesh_id);
+  AuditCrossTenant(caller, entry.tenant, mesh_id, "unload");
   entry.unloaded.store(true);
   // Its memory stays counted until its last stream detaches.
   admission_->MeshUnloaded(entry.tenant, entry.memory_bytes, entry.open_streams.load() != 0);

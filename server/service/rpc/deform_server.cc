@@ -163,7 +163,10 @@ Status DeformServer::UseTokenFile(const std::string& path) {
 Status DeformServer::ReloadTokens() {
   const Status reloaded = impl_->context.auth().Reload();
   if (reloaded.ok()) {
-    spdlog::info("token file reloaded");
+    // Streams opened with a token that is gone or now names another tenant or role end now.
+    const int revoked = impl_->context.streams().RevokeInvalid(impl_->context.auth());
+    spdlog::info("token file reloaded; {} open streams ended (their token was revoked or changed)",
+                 revoked);
   } else {
     spdlog::error("token file reload failed, the previous tokens stay in force: {}",
                   reloaded.ToString());

@@ -50,10 +50,10 @@ int HandleMetrics(mg_connection* connection, void* data) {
             "WWW-Authenticate: Bearer realm=\"deformd metrics\"\r\n");
       return 401;
     }
-    if (caller->role != Role::kOperator) {
-      spdlog::warn("metrics: scrape by tenant={} refused: not an operator",
+    if (caller->role != Role::kOperator && caller->role != Role::kMetrics) {
+      spdlog::warn("metrics: scrape by tenant={} refused: not an operator or metrics token",
                    EscapeForLog(caller->tenant));
-      Reply(connection, 403, "Forbidden", "the metrics need an operator's token\n");
+      Reply(connection, 403, "Forbidden", "the metrics need a metrics or operator token\n");
       return 403;
     }
   }

@@ -17,7 +17,16 @@ std::string ResultText(const Status& status) { return status.ok() ? "OK" : statu
 StatusOr<Identity> AuthenticateCall(const ServiceContext& context, std::string_view authorization,
                                     std::string_view action, std::string_view mesh_id) {
   StatusOr<Identity> caller = context.auth().Authenticate(authorization);
-  if (!caller.ok()) Audit("-", action, mesh_id, caller.status().ToString());
+  if (!caller.ok()) {
+    Audit("-", action, mesh_id, caller.status().ToString());
+    return caller;
+  }
+  if (caller->role == Role::kMetrics) {
+    const Status refused =
+        Status::PermissionDenied("this token has the metrics role: it may only scrape /metrics");
+    Audit(caller->tenant, action, mesh_id, refused.ToString());
+    return refused;
+  }
   return caller;
 }
 

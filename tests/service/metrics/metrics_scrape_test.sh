@@ -107,7 +107,8 @@ auth)
   python3 - "$WORK/tokens" <<'PY'
 import hashlib, sys
 with open(sys.argv[1], "w") as f:
-    for token, tenant, role in (("op-secret", "ops", "operator"), ("ward-secret", "ward", "tenant")):
+    for token, tenant, role in (("op-secret", "ops", "operator"), ("ward-secret", "ward", "tenant"),
+                                ("scrape-secret", "prometheus", "metrics")):
         f.write(f"{hashlib.sha256(token.encode()).hexdigest()} {tenant} {role}\n")
 PY
   start_server --token-file "$WORK/tokens"
@@ -118,6 +119,8 @@ PY
     fail "a tenant's token is not 403"
   [ "$(code -H 'Authorization: Bearer op-secret' "$METRICS")" = 200 ] ||
     fail "an operator's token is not 200"
+  [ "$(code -H 'Authorization: Bearer scrape-secret' "$METRICS")" = 200 ] ||
+    fail "a metrics token is not 200"
   curl -sf -H 'Authorization: Bearer op-secret' "$METRICS" >"$WORK/page.txt" ||
     fail "the operator's scrape failed"
   grep -q '^deformd_streams_open ' "$WORK/page.txt" || fail "the operator's page has no gauge"
