@@ -5,6 +5,7 @@
 #include <grpcpp/health_check_service_interface.h>
 #include <spdlog/spdlog.h>
 
+#include <cstdlib>
 #include <vector>
 
 #include "health.pb.h"
@@ -17,6 +18,7 @@
 #include "service/registry/mesh_store.h"
 #include "service/rpc/deform_service.h"
 #include "service/rpc/metrics_endpoint.h"
+#include "service/transport/loopback_port_guard.h"
 #include "service/transport/transport_security.h"
 
 namespace deform::service {
@@ -76,6 +78,7 @@ struct DeformServer::Impl {
   std::unique_ptr<grpc::Server> server;
   std::unique_ptr<MetricsEndpoint> metrics;  // null without options.metrics_address
   int port = 0;
+  LoopbackPortGuard port_guard;  // the other loopback family's address on `port`
   std::vector<std::function<void(std::chrono::milliseconds)>> transport_stops;
   Mutex shutdown_mutex;  // serializes Shutdown()
   bool shut_down DEFORM_GUARDED_BY(shutdown_mutex) = false;
@@ -96,6 +99,15 @@ Status DeformServer::Start() {
   DEFORM_ASSIGN_OR_RETURN(
       std::shared_ptr<grpc::ServerCredentials> credentials,
       MakeServerCredentials(impl_->options.security, impl_->options.listen_address, &transport));
+  // A fixed port: the other loopback family's address first (loopback_port_guard.h).
+  const std::string& address = impl_->options.listen_address;
+  const std::size_t colon = address.rfind(':');
+  const int fixed_port = colon == std::string::npos ? 0 : std::atoi(address.c_str() + colon + 1);
+  if (fixed_port > 0) {
+    auto guard = LoopbackPortGuard::Hold(address, fixed_port);
+    if (!guard.ok()) return guard.status();
+    impl_->port_guard = std::move(*guard);
+  }
   grpc::ServerBuilder builder;
   builder.AddListeningPort(impl_->options.listen_address, credentials, &impl_->port);
   builder.RegisterService(&impl_->service);
@@ -116,7 +128,18 @@ Status DeformServer::Start() {
   if (impl_->server == nullptr || impl_->port == 0) {
     impl_->server.reset();
     impl_->metrics.reset();
+    impl_->port_guard = LoopbackPortGuard();
     return Status::FailedPrecondition("cannot listen on '" + impl_->options.listen_address + "'");
+  }
+  if (fixed_port == 0) {  // the kernel's port: its other loopback family's address now
+    auto guard = LoopbackPortGuard::Hold(address, impl_->port);
+    if (!guard.ok()) {
+      impl_->server->Shutdown();
+      impl_->server.reset();
+      impl_->metrics.reset();
+      return guard.status();
+    }
+    impl_->port_guard = std::move(*guard);
   }
   if (grpc::HealthCheckServiceInterface* health = impl_->server->GetHealthCheckService()) {
     health->SetServingStatus(v1::DeformService::service_full_name(), true);

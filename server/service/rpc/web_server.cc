@@ -22,6 +22,7 @@
 #include "service/rpc/static_files.h"
 #include "service/rpc/unary_calls.h"
 #include "service/transport/http_host_policy.h"
+#include "service/transport/loopback_port_guard.h"
 #include "service/transport/status_mapping.h"
 #include "service/transport/transport_security.h"
 #include "service/transport/web_auth.h"
@@ -444,6 +445,7 @@ struct WebServer::Impl {
   tcp::acceptor acceptor;
   std::vector<std::thread> threads;
   int port = 0;
+  service::LoopbackPortGuard port_guard;
   bool stopped = false;
 };
 
@@ -475,6 +477,13 @@ Status WebServer::Start() {
                                       "' (--http): " + error.message());
   }
   impl_->port = impl_->acceptor.local_endpoint().port();
+  // The other loopback family's address on the same port (loopback_port_guard.h).
+  auto guard = service::LoopbackPortGuard::Hold(options.address, impl_->port);
+  if (!guard.ok()) {
+    impl_->acceptor.close(error);
+    return Status::FailedPrecondition(guard.status().message() + " (--http)");
+  }
+  impl_->port_guard = std::move(*guard);
   impl_->Accept();
   for (int i = 0; i < std::max(1, options.threads); ++i) {
     impl_->threads.emplace_back([this] { impl_->io.run(); });

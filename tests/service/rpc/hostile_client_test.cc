@@ -311,6 +311,29 @@ TEST(HostileDeployment, SecondServerOnATakenAddressExitsNonZero) {
   EXPECT_EQ(first.Wait(std::chrono::seconds(10)), std::optional<int>(0));
 }
 
+// A second deformd on the same port in the other loopback family (or on `localhost`) took the
+// clients that dial localhost:P: every pairing is refused, naming the address, exit code 1.
+TEST(HostileDeployment, OneServerPerPortOnEveryLoopbackFamily) {
+  for (const std::string first_host : {"127.0.0.1", "[::1]"}) {
+    SCOPED_TRACE("first on " + first_host);
+    DeformdProcess first({"--listen", first_host + ":0", "--workers", "1"});
+    const int port = first.WaitForListeningPort();
+    ASSERT_GT(port, 0) << first.output();
+    for (const std::string second_host : {"127.0.0.1", "[::1]", "localhost"}) {
+      const std::string address = second_host + ":" + std::to_string(port);
+      DeformdProcess second({"--listen", address, "--workers", "1"});
+      const std::optional<int> code = second.Wait(std::chrono::seconds(30));
+      ASSERT_TRUE(code.has_value())
+          << "a second server started on " << address << ": " << second.output();
+      EXPECT_EQ(*code, 1) << address;
+      EXPECT_THAT(second.output(), HasSubstr(std::to_string(port))) << address;
+    }
+    EXPECT_TRUE(first.running());
+    first.Signal(SIGTERM);
+    EXPECT_EQ(first.Wait(std::chrono::seconds(10)), std::optional<int>(0));
+  }
+}
+
 // Server reflection over a generic stream: the responses to `requests` (serialized
 // ServerReflectionRequest messages), or an empty vector on failure.
 std::vector<std::string> AskReflection(const std::string& target,
