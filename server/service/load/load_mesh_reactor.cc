@@ -224,7 +224,8 @@ void LoadMeshReactor::Build() {
     if (cancelled_) {
       // Nobody is waiting for it: the mesh would be unreachable.
       (void)context_->registry().Unload((*entry)->id);
-      if (context_->store() != nullptr) context_->store()->Remove((*entry)->id);
+      // An entry that cannot be deleted is logged; the mesh comes back at the next start.
+      if (context_->store() != nullptr) (void)context_->store()->Remove((*entry)->id);
       Audit(caller_.tenant, "load", (*entry)->id, "CANCELLED");
     } else {
       Audit(caller_.tenant, "load", (*entry)->id, "OK");

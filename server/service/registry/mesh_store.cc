@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <openssl/evp.h>
 #include <spdlog/spdlog.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -123,6 +124,41 @@ StatusOr<StoredMesh> ParseEntry(std::string_view data) {
   return stored;
 }
 
+void SyncDirectory(const std::string& dir) {
+  const int dir_fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dir_fd >= 0) {
+    ::fsync(dir_fd);
+    ::close(dir_fd);
+  }
+}
+
+// The whole content of the regular file `path`; an error for anything else (a FIFO, a
+// directory, a device, a symbolic link), without blocking on it.
+StatusOr<std::string> ReadRegularFile(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_NOFOLLOW | O_CLOEXEC);
+  if (fd < 0) return Status::NotFound("cannot open it: " + ErrnoText());
+  struct stat info {};
+  if (::fstat(fd, &info) != 0 || !S_ISREG(info.st_mode)) {
+    ::close(fd);
+    return Status::InvalidArgument("it is not a regular file");
+  }
+  std::string data;
+  char buffer[1 << 16];
+  for (;;) {
+    const ssize_t n = ::read(fd, buffer, sizeof buffer);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) {
+      const std::string why = ErrnoText();
+      ::close(fd);
+      return Status::NotFound("cannot read it: " + why);
+    }
+    if (n == 0) break;
+    data.append(buffer, static_cast<std::size_t>(n));
+  }
+  ::close(fd);
+  return data;
+}
+
 }  // namespace
 
 StatusOr<std::unique_ptr<MeshStore>> MeshStore::Open(const std::string& dir) {
@@ -142,7 +178,30 @@ StatusOr<std::unique_ptr<MeshStore>> MeshStore::Open(const std::string& dir) {
     return Status::FailedPrecondition("cannot make the store directory '" + dir +
                                       "' private (0700): " + ErrnoText());
   }
-  std::unique_ptr<MeshStore> store(new MeshStore(dir));
+  // One server per store: a second one would delete the first's unfinished entries and unload
+  // its meshes' files.
+  const std::string lock_path = dir + "/" + std::string(kLockFileName);
+  const int lock_fd = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0600);
+  if (lock_fd < 0) {
+    return Status::FailedPrecondition("cannot open the store's lock file '" + lock_path +
+                                      "': " + ErrnoText());
+  }
+  if (::flock(lock_fd, LOCK_EX | LOCK_NB) != 0) {
+    const std::string why = errno == EWOULDBLOCK ? "another deformd uses this store" : ErrnoText();
+    ::close(lock_fd);
+    return Status::FailedPrecondition("the store '" + dir + "' is locked (" + lock_path +
+                                      "): " + why);
+  }
+  std::unique_ptr<MeshStore> store(new MeshStore(dir, lock_fd));
+  // Writable now, not at the first load: a read-only store would fail every load.
+  const std::string probe = dir + "/.write-check.pending";
+  const int probe_fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
+  if (probe_fd < 0 || ::fsync(probe_fd) != 0 || ::unlink(probe.c_str()) != 0) {
+    const std::string why = ErrnoText();
+    if (probe_fd >= 0) ::close(probe_fd);
+    return Status::FailedPrecondition("the store '" + dir + "' is not writable: " + why);
+  }
+  ::close(probe_fd);
   std::error_code error;
   for (const auto& file : std::filesystem::directory_iterator(dir, error)) {
     const std::string name = file.path().filename().string();
@@ -190,20 +249,23 @@ void MeshStore::Commit(const std::string& id) const {
     ::unlink(PendingPath(id).c_str());
     return;
   }
-  // The rename is durable once the directory is synced.
-  const int dir_fd = ::open(dir_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (dir_fd >= 0) {
-    ::fsync(dir_fd);
-    ::close(dir_fd);
-  }
+  SyncDirectory(dir_);  // the rename is durable once the directory is synced
 }
 
 void MeshStore::Discard(const std::string& id) const { ::unlink(PendingPath(id).c_str()); }
 
-void MeshStore::Remove(const std::string& id) const {
+MeshStore::~MeshStore() {
+  if (lock_fd_ >= 0) ::close(lock_fd_);  // releases the lock
+}
+
+Status MeshStore::Remove(const std::string& id) const {
   if (::unlink(EntryPath(id).c_str()) != 0 && errno != ENOENT) {
-    spdlog::error("store: mesh={} cannot be deleted: {}", id, ErrnoText());
+    spdlog::error("store: mesh={} cannot be deleted: {}", EscapeForLog(id), ErrnoText());
+    return Status::Internal(
+        "the server cannot delete the mesh's stored entry (see its log); it stays loaded");
   }
+  SyncDirectory(dir_);
+  return Status::Ok();
 }
 
 std::vector<StoredMesh> MeshStore::LoadAll() const {
@@ -219,11 +281,12 @@ std::vector<StoredMesh> MeshStore::LoadAll() const {
   std::sort(files.begin(), files.end());
   std::vector<StoredMesh> meshes;
   for (const std::string& path : files) {
-    std::ifstream in(path, std::ios::binary);
-    std::ostringstream data;
-    data << in.rdbuf();
-    StatusOr<StoredMesh> stored =
-        in ? ParseEntry(data.str()) : StatusOr<StoredMesh>(Status::NotFound("cannot read it"));
+    const StatusOr<std::string> data = ReadRegularFile(path);
+    if (!data.ok()) {
+      spdlog::warn("store: skipping '{}': {}", EscapeForLog(path), data.status().message());
+      continue;
+    }
+    StatusOr<StoredMesh> stored = ParseEntry(*data);
     if (stored.ok() && EntryPath(stored->id) != path) {
       stored = Status::InvalidArgument("its id '" + stored->id + "' does not match its file name");
     }

@@ -14,6 +14,12 @@
 // all that. An entry whose checksum, lengths, id or tenant do not check out is corrupt: LoadAll()
 // logs and skips it (the file stays for inspection); it never stops the server.
 //
+// One server per store: Open() takes an exclusive lock (flock) on DIR/deformd.lock, held while the
+// store lives; a second server on the same directory is refused. Open() also checks that the
+// directory is writable (a read-only store is refused at start, not at the first load). Only
+// regular files are read: anything else named like an entry (a FIFO, a directory, a link) is
+// logged and skipped without being opened for blocking reads.
+//
 // Not encrypted: the host's disk encryption protects the files at rest (docs/operations.md, "Threat
 // model"). Thread-safe (each call works on its own files).
 #pragma once
@@ -40,6 +46,11 @@ class MeshStore {
   // its mode is set to 0700. Deletes leftover pending files. FAILED_PRECONDITION naming the
   // problem otherwise.
   static StatusOr<std::unique_ptr<MeshStore>> Open(const std::string& dir);
+  ~MeshStore();
+  MeshStore(const MeshStore&) = delete;
+  MeshStore& operator=(const MeshStore&) = delete;
+
+  static constexpr const char* kLockFileName = "deformd.lock";
 
   // Writes `mesh` as a pending entry (durably). INTERNAL on an I/O error (the file and the error
   // are logged, not told to the client).
@@ -48,8 +59,9 @@ class MeshStore {
   void Commit(const std::string& id) const;
   // Deletes a pending entry.
   void Discard(const std::string& id) const;
-  // Deletes a mesh's entry (on unload); a missing entry is not an error.
-  void Remove(const std::string& id) const;
+  // Deletes a mesh's entry (on unload) durably; a missing entry is not an error. INTERNAL (logged)
+  // when it cannot be deleted: the caller then keeps the mesh loaded.
+  Status Remove(const std::string& id) const;
 
   // Every readable entry, in file-name order; corrupt entries are logged and skipped.
   std::vector<StoredMesh> LoadAll() const;
@@ -58,10 +70,11 @@ class MeshStore {
   std::string EntryPath(const std::string& id) const { return dir_ + "/" + id + ".mesh"; }
 
  private:
-  explicit MeshStore(std::string dir) : dir_(std::move(dir)) {}
+  MeshStore(std::string dir, int lock_fd) : dir_(std::move(dir)), lock_fd_(lock_fd) {}
   std::string PendingPath(const std::string& id) const { return dir_ + "/." + id + ".pending"; }
 
   std::string dir_;
+  int lock_fd_ = -1;  // holds the flock
 };
 
 }  // namespace deform::service

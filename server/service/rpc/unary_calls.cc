@@ -61,8 +61,12 @@ Status UnloadMeshCall(ServiceContext& context, std::string_view authorization,
   DEFORM_RETURN_IF_ERROR(CheckLength(request.mesh_id(), kMaxMeshIdBytes, "mesh_id"));
   DEFORM_ASSIGN_OR_RETURN(Identity caller,
                           AuthenticateCall(context, authorization, "unload", request.mesh_id()));
-  const Status status = context.registry().Unload(request.mesh_id(), caller);
-  if (status.ok() && context.store() != nullptr) context.store()->Remove(request.mesh_id());
+  // The stored entry first: a mesh whose entry cannot be deleted stays loaded (else it would
+  // come back at the next start), and the caller is told.
+  Status status = context.registry().Find(request.mesh_id(), caller).status();
+  if (status.ok() && context.store() != nullptr)
+    status = context.store()->Remove(request.mesh_id());
+  if (status.ok()) status = context.registry().Unload(request.mesh_id(), caller);
   Audit(caller.tenant, "unload", request.mesh_id(), ResultText(status));
   return status;
 }

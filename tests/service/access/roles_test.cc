@@ -130,12 +130,7 @@ TEST_F(RolesTest, EveryCrossTenantAccessOfAnOperatorIsAudited) {
     EXPECT_THAT(text, HasSubstr("tenant=ops action=cross_tenant mesh=" + mesh_id_ +
                                 " result=owner=ward-a role=operator op=" + op));
   }
-  std::size_t lines = 0;
-  for (std::size_t at = text.find("cross_tenant"); at != std::string::npos;
-       at = text.find("cross_tenant", at + 1)) {
-    ++lines;
-  }
-  EXPECT_EQ(lines, 3u) << text;
+  EXPECT_EQ(text.find("tenant=ward-a action=cross_tenant"), std::string::npos) << text;
 }
 
 }  // namespace

@@ -1,10 +1,16 @@
 // --store: meshes come back after a restart under their ids and owners, built from what was
 // uploaded; unloading deletes them; the files are private; a corrupt entry is skipped.
+#include "service/registry/mesh_store.h"
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <sys/stat.h>
+#include <sys/types.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -36,7 +42,8 @@ client::ClientOptions WithToken(const std::string& token) {
 std::vector<std::string> EntryFiles(const std::string& dir) {
   std::vector<std::string> names;
   for (const auto& file : std::filesystem::directory_iterator(dir)) {
-    names.push_back(file.path().filename().string());
+    const std::string name = file.path().filename().string();
+    if (name != service::MeshStore::kLockFileName) names.push_back(name);
   }
   std::sort(names.begin(), names.end());
   return names;
@@ -240,6 +247,64 @@ TEST_F(MeshStoreTest, AFailedLoadLeavesNothingInTheStore) {
   EXPECT_EQ(ward_a->LoadMesh(header, "v 0 0 0\nf 1 2 3\n", &summary).error_code(),
             grpc::StatusCode::INVALID_ARGUMENT);
   EXPECT_TRUE(EntryFiles(store_).empty());
+}
+
+// A FIFO or a directory named like an entry never blocks the start: logged and skipped (a FIFO
+// used to stop the server before it listened).
+TEST_F(MeshStoreTest, AFifoOrADirectoryNamedLikeAnEntryIsSkippedWithoutBlocking) {
+  std::string good_id;
+  {
+    StoredServer server(store_, tokens_);
+    v1::MeshSummary summary;
+    ASSERT_TRUE(server.NewClient("token-a")->LoadPhantom(300, {}, &summary).ok());
+    good_id = summary.mesh_id();
+  }
+  ASSERT_EQ(::mkfifo((store_ + "/" + service::NewMeshId() + ".mesh").c_str(), 0600), 0);
+  std::filesystem::create_directory(store_ + "/" + service::NewMeshId() + ".mesh");
+  const auto start = std::chrono::steady_clock::now();
+  StoredServer restarted(store_, tokens_);
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(10));
+  EXPECT_EQ(restarted.restored(), 1);
+}
+
+// Two servers on one store destroyed each other's entries: the second is refused while the first
+// holds the store's lock, and may open it once the first is gone.
+TEST_F(MeshStoreTest, ASecondServerOnTheSameStoreIsRefused) {
+  auto first = service::MeshStore::Open(store_);
+  ASSERT_TRUE(first.ok()) << first.status().ToString();
+  auto second = service::MeshStore::Open(store_);
+  ASSERT_FALSE(second.ok());
+  EXPECT_EQ(second.status().code(), StatusCode::kFailedPrecondition);
+  EXPECT_THAT(second.status().message(), ::testing::HasSubstr("another deformd uses this store"));
+  // Another process too (flock is per open file, so a child's own open is refused the same way).
+  const pid_t child = ::fork();
+  if (child == 0) _exit(service::MeshStore::Open(store_).ok() ? 0 : 3);
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  EXPECT_EQ(WEXITSTATUS(status), 3);
+  first->reset();
+  EXPECT_TRUE(service::MeshStore::Open(store_).ok());
+}
+
+// An UnloadMesh whose entry cannot be deleted answered OK and the mesh came back after a restart:
+// now it is INTERNAL and the mesh stays loaded.
+TEST_F(MeshStoreTest, AnUnloadWhoseEntryCannotBeDeletedFailsAndKeepsTheMesh) {
+  StoredServer server(store_, tokens_);
+  auto client = server.NewClient("token-a");
+  v1::MeshSummary summary;
+  ASSERT_TRUE(client->LoadPhantom(300, {}, &summary).ok());
+  const std::string entry = store_ + "/" + summary.mesh_id() + ".mesh";
+  // The entry replaced by a non-empty directory: unlink fails (EISDIR), whoever runs the test.
+  std::filesystem::remove(entry);
+  std::filesystem::create_directory(entry);
+  std::ofstream(entry + "/keep") << "x";
+  const grpc::Status unloaded = client->UnloadMesh(summary.mesh_id());
+  EXPECT_EQ(unloaded.error_code(), grpc::StatusCode::INTERNAL);
+  EXPECT_THAT(unloaded.error_message(), ::testing::HasSubstr("stays loaded"));
+  std::vector<v1::MeshSummary> meshes;
+  ASSERT_TRUE(client->ListMeshes(&meshes).ok());
+  ASSERT_EQ(meshes.size(), 1u);
+  EXPECT_EQ(meshes[0].mesh_id(), summary.mesh_id());
 }
 
 }  // namespace
