@@ -7,7 +7,8 @@
 //           [--keepalive-s S] [--keepalive-timeout-s S] [--idle-timeout-s S]
 //           [--tls-cert PEM --tls-key PEM [--tls-client-ca PEM]] [--plaintext]
 //           [--token-file FILE] [--tenant-max-meshes N] [--tenant-max-streams N]
-//           [--tenant-max-memory-mb N] [--preload-tenant NAME] [--store DIR] [--metrics ADDR]
+//           [--tenant-max-memory-mb N] [--preload-tenant NAME] [--store DIR [--store-key FILE]]
+//           [--metrics ADDR]
 //           [--http ADDR [--http-root DIR] [--http-max-connections N]
 //            [--http-allowed-host NAME]...]
 //   deformd --version   prints "deformd VERSION (commit COMMIT)" (core/base/build_info.h)
@@ -84,6 +85,7 @@ struct Args {
   double keepalive_s = 30;
   double keepalive_timeout_s = 10;
   double idle_timeout_s = 300;
+  std::string store_key;
   std::string http_address;
   std::string http_root;
   int http_max_connections = 64;
@@ -284,6 +286,10 @@ int main(int argc, char** argv) {
   app.add_option("--store", args.store_dir,
                  "Keep loaded meshes in DIR (0700) and restore them at start-up")
       ->envname("DEFORMD_STORE");
+  app.add_option("--store-key", args.store_key,
+                 "The --store entries' HMAC key (32 bytes, created 0600 if missing; outside the "
+                 "store): an entry whose owner was edited is refused at restore")
+      ->envname("DEFORMD_STORE_KEY");
   app.add_option("--preload-tenant", args.preload_tenant,
                  "Tenant that owns the --preload and --preload-phantom meshes")
       ->capture_default_str()
@@ -356,7 +362,7 @@ int main(int argc, char** argv) {
     }
   }
   if (!args.store_dir.empty()) {
-    const deform::Status store = server.UseStore(args.store_dir);
+    const deform::Status store = server.UseStore(args.store_dir, nullptr, args.store_key);
     if (!store.ok()) {
       spdlog::error("--store: {}", store.ToString());
       return 1;

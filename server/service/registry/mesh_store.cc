@@ -1,7 +1,10 @@
 #include "service/registry/mesh_store.h"
 
 #include <fcntl.h>
+#include <openssl/crypto.h>
 #include <openssl/evp.h>
+#include <openssl/hmac.h>
+#include <openssl/rand.h>
 #include <spdlog/spdlog.h>
 #include <sys/file.h>
 #include <sys/stat.h>
@@ -22,7 +25,9 @@
 namespace deform::service {
 namespace {
 
-constexpr std::string_view kMagic = "deformd-store v1\n";
+constexpr std::string_view kMagic = "deformd-store v1\n";       // SHA-256 of the body
+constexpr std::string_view kKeyedMagic = "deformd-store v2\n";  // HMAC-SHA256 of the body
+constexpr std::size_t kKeyBytes = 32;
 constexpr std::size_t kDigestBytes = 32;
 
 std::string ErrnoText() { return std::strerror(errno); }
@@ -36,21 +41,56 @@ std::string LittleEndian(T value) {
   return bytes;
 }
 
-// Writes pieces to a file descriptor while hashing them.
+// The entry's seal: the SHA-256 of `body`, or its HMAC-SHA256 under `key` when there is one.
+std::string SealOf(std::string_view body, const std::string& key) {
+  unsigned char digest[EVP_MAX_MD_SIZE];
+  unsigned int length = 0;
+  if (key.empty()) {
+    EVP_Digest(body.data(), body.size(), digest, &length, EVP_sha256(), nullptr);
+  } else {
+    HMAC(EVP_sha256(), key.data(), static_cast<int>(key.size()),
+         reinterpret_cast<const unsigned char*>(body.data()), body.size(), digest, &length);
+  }
+  return std::string(reinterpret_cast<const char*>(digest), length);
+}
+
+// Writes pieces to a file descriptor, then their seal.
+// Writes pieces to a file descriptor while sealing them (SealOf, incrementally).
 class HashingWriter {
  public:
-  explicit HashingWriter(int fd) : fd_(fd), context_(EVP_MD_CTX_new()) {
-    EVP_DigestInit_ex(context_, EVP_sha256(), nullptr);
+  HashingWriter(int fd, const std::string& key) : fd_(fd), context_(EVP_MD_CTX_new()) {
+    if (key.empty()) {
+      EVP_DigestInit_ex(context_, EVP_sha256(), nullptr);
+    } else {
+      pkey_ = EVP_PKEY_new_raw_private_key(
+          EVP_PKEY_HMAC, nullptr, reinterpret_cast<const unsigned char*>(key.data()), key.size());
+      EVP_DigestSignInit(context_, nullptr, EVP_sha256(), nullptr, pkey_);
+    }
   }
-  ~HashingWriter() { EVP_MD_CTX_free(context_); }
+  ~HashingWriter() {
+    EVP_MD_CTX_free(context_);
+    EVP_PKEY_free(pkey_);
+  }
+  HashingWriter(const HashingWriter&) = delete;
+  HashingWriter& operator=(const HashingWriter&) = delete;
   bool Write(std::string_view bytes) {
-    EVP_DigestUpdate(context_, bytes.data(), bytes.size());
+    if (pkey_ != nullptr) {
+      EVP_DigestSignUpdate(context_, bytes.data(), bytes.size());
+    } else {
+      EVP_DigestUpdate(context_, bytes.data(), bytes.size());
+    }
     return WriteRaw(bytes);
   }
   bool WriteDigest() {
     unsigned char digest[EVP_MAX_MD_SIZE];
-    unsigned int length = 0;
-    EVP_DigestFinal_ex(context_, digest, &length);
+    std::size_t length = sizeof digest;
+    if (pkey_ != nullptr) {
+      if (EVP_DigestSignFinal(context_, digest, &length) != 1) return false;
+    } else {
+      unsigned int digest_length = 0;
+      EVP_DigestFinal_ex(context_, digest, &digest_length);
+      length = digest_length;
+    }
     return WriteRaw(std::string_view(reinterpret_cast<const char*>(digest), length));
   }
 
@@ -68,6 +108,7 @@ class HashingWriter {
   }
   int fd_;
   EVP_MD_CTX* context_;
+  EVP_PKEY* pkey_ = nullptr;
 };
 
 // Reads the little-endian integer of T at *offset; false past the end.
@@ -93,16 +134,26 @@ bool ReadField(std::string_view data, std::size_t* offset, std::string_view* fie
   return true;
 }
 
-StatusOr<StoredMesh> ParseEntry(std::string_view data) {
-  if (data.size() < kMagic.size() + kDigestBytes || data.substr(0, kMagic.size()) != kMagic) {
+StatusOr<StoredMesh> ParseEntry(std::string_view data, const std::string& key) {
+  if (data.size() < kMagic.size() + kDigestBytes ||
+      (data.substr(0, kMagic.size()) != kMagic && data.substr(0, kMagic.size()) != kKeyedMagic)) {
     return Status::InvalidArgument("not a deformd store entry (bad magic or too short)");
   }
+  const bool keyed = data.substr(0, kMagic.size()) == kKeyedMagic;
+  if (keyed && key.empty()) {
+    return Status::InvalidArgument("it is authenticated with a key and no --store-key was given");
+  }
+  if (!keyed && !key.empty()) {
+    return Status::InvalidArgument(
+        "it is not authenticated (written without --store-key): its owner cannot be trusted");
+  }
   const std::string_view body = data.substr(0, data.size() - kDigestBytes);
-  unsigned char digest[EVP_MAX_MD_SIZE];
-  unsigned int length = 0;
-  EVP_Digest(body.data(), body.size(), digest, &length, EVP_sha256(), nullptr);
-  if (length != kDigestBytes || std::memcmp(digest, data.data() + body.size(), kDigestBytes) != 0) {
-    return Status::InvalidArgument("checksum mismatch (truncated or altered)");
+  const std::string seal = SealOf(body, key);
+  if (seal.size() != kDigestBytes ||
+      CRYPTO_memcmp(seal.data(), data.data() + body.size(), kDigestBytes) != 0) {
+    return Status::InvalidArgument(
+        keyed ? "authentication code mismatch (the entry or its owner was edited, or another key)"
+              : "checksum mismatch (truncated or altered)");
   }
   std::size_t offset = kMagic.size();
   std::string_view id, tenant, header, mesh;
@@ -161,7 +212,57 @@ StatusOr<std::string> ReadRegularFile(const std::string& path) {
 
 }  // namespace
 
-StatusOr<std::unique_ptr<MeshStore>> MeshStore::Open(const std::string& dir) {
+StatusOr<std::string> MeshStore::ReadOrCreateKey(const std::string& path, const std::string& dir) {
+  std::error_code error;
+  const auto key_dir =
+      std::filesystem::weakly_canonical(std::filesystem::absolute(path).parent_path(), error);
+  const auto store_dir = std::filesystem::weakly_canonical(std::filesystem::absolute(dir), error);
+  if (key_dir == store_dir) {
+    return Status::FailedPrecondition("--store-key '" + path +
+                                      "' must be outside the store directory (a key beside the "
+                                      "entries authenticates nothing)");
+  }
+  int fd = ::open(path.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
+  if (fd < 0 && errno == ENOENT) {
+    unsigned char fresh[kKeyBytes];
+    if (RAND_bytes(fresh, sizeof fresh) != 1) return Status::Internal("no random bytes for a key");
+    const int out = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+    if (out < 0) {
+      return Status::FailedPrecondition("cannot create the store key '" + path +
+                                        "': " + ErrnoText());
+    }
+    const bool written = ::write(out, fresh, sizeof fresh) == static_cast<ssize_t>(sizeof fresh) &&
+                         ::fsync(out) == 0;
+    ::close(out);
+    if (!written) {
+      ::unlink(path.c_str());
+      return Status::FailedPrecondition("cannot write the store key '" + path + "'");
+    }
+    spdlog::info("store: created the key '{}'", EscapeForLog(path));
+    fd = ::open(path.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
+  }
+  if (fd < 0) {
+    return Status::FailedPrecondition("cannot open the store key '" + path + "': " + ErrnoText());
+  }
+  struct stat info {};
+  std::string key(kKeyBytes + 1, '\0');
+  const ssize_t n =
+      ::fstat(fd, &info) == 0 && S_ISREG(info.st_mode) ? ::read(fd, key.data(), key.size()) : -1;
+  ::close(fd);
+  if (n != static_cast<ssize_t>(kKeyBytes)) {
+    return Status::FailedPrecondition("the store key '" + path + "' is not a file of " +
+                                      std::to_string(kKeyBytes) + " bytes");
+  }
+  if ((info.st_mode & 0077) != 0) {
+    return Status::FailedPrecondition("the store key '" + path +
+                                      "' is readable by others (chmod 600 it)");
+  }
+  key.resize(kKeyBytes);
+  return key;
+}
+
+StatusOr<std::unique_ptr<MeshStore>> MeshStore::Open(const std::string& dir,
+                                                     const std::string& key_file) {
   if (dir.empty()) return Status::FailedPrecondition("the store directory is empty");
   if (::mkdir(dir.c_str(), 0700) != 0 && errno != EEXIST) {
     return Status::FailedPrecondition("cannot create the store directory '" + dir +
@@ -192,7 +293,16 @@ StatusOr<std::unique_ptr<MeshStore>> MeshStore::Open(const std::string& dir) {
     return Status::FailedPrecondition("the store '" + dir + "' is locked (" + lock_path +
                                       "): " + why);
   }
-  std::unique_ptr<MeshStore> store(new MeshStore(dir, lock_fd));
+  std::string key;
+  if (!key_file.empty()) {
+    StatusOr<std::string> read = ReadOrCreateKey(key_file, dir);
+    if (!read.ok()) {
+      ::close(lock_fd);
+      return read.status();
+    }
+    key = std::move(*read);
+  }
+  std::unique_ptr<MeshStore> store(new MeshStore(dir, lock_fd, std::move(key)));
   // Writable now, not at the first load: a read-only store would fail every load.
   const std::string probe = dir + "/.write-check.pending";
   const int probe_fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
@@ -221,8 +331,8 @@ Status MeshStore::WritePending(const StoredMesh& mesh) const {
     return Status::Internal("the server cannot keep the mesh in its store (see its log)");
   }
   const std::string header = mesh.header.SerializeAsString();
-  HashingWriter writer(fd);
-  bool ok = writer.Write(kMagic) &&
+  HashingWriter writer(fd, key_);
+  bool ok = writer.Write(key_.empty() ? kMagic : kKeyedMagic) &&
             writer.Write(LittleEndian(static_cast<std::uint32_t>(mesh.id.size()))) &&
             writer.Write(mesh.id) &&
             writer.Write(LittleEndian(static_cast<std::uint32_t>(mesh.tenant.size()))) &&
@@ -286,7 +396,7 @@ std::vector<StoredMesh> MeshStore::LoadAll() const {
       spdlog::warn("store: skipping '{}': {}", EscapeForLog(path), data.status().message());
       continue;
     }
-    StatusOr<StoredMesh> stored = ParseEntry(*data);
+    StatusOr<StoredMesh> stored = ParseEntry(*data, key_);
     if (stored.ok() && EntryPath(stored->id) != path) {
       stored = Status::InvalidArgument("its id '" + stored->id + "' does not match its file name");
     }

@@ -20,6 +20,12 @@
 // regular files are read: anything else named like an entry (a FIFO, a directory, a link) is
 // logged and skipped without being opened for blocking reads.
 //
+// Authenticity (--store-key FILE): with a key (kept outside the store) every entry is written as
+// "deformd-store v2\n" with an HMAC-SHA256 under the key in place of the SHA-256, so that an entry
+// whose tenant (or anything else) was edited and resealed without the key is refused at restore
+// with a warning. With a key, unkeyed (v1) entries are refused too (their owner cannot be
+// trusted); without one, keyed entries are. Without a key the SHA-256 is integrity only.
+//
 // Not encrypted: the host's disk encryption protects the files at rest (docs/operations.md, "Threat
 // model"). Thread-safe (each call works on its own files).
 #pragma once
@@ -45,7 +51,11 @@ class MeshStore {
   // Creates `dir` (0700) if missing; otherwise it must be a directory owned by this user, and
   // its mode is set to 0700. Deletes leftover pending files. FAILED_PRECONDITION naming the
   // problem otherwise.
-  static StatusOr<std::unique_ptr<MeshStore>> Open(const std::string& dir);
+  // `key_file` (--store-key; empty: none): the HMAC key authenticating the entries, created
+  // (32 random bytes, 0600) when missing; it must lie outside `dir` and be readable by this user
+  // only.
+  static StatusOr<std::unique_ptr<MeshStore>> Open(const std::string& dir,
+                                                   const std::string& key_file = "");
   ~MeshStore();
   MeshStore(const MeshStore&) = delete;
   MeshStore& operator=(const MeshStore&) = delete;
@@ -70,11 +80,14 @@ class MeshStore {
   std::string EntryPath(const std::string& id) const { return dir_ + "/" + id + ".mesh"; }
 
  private:
-  MeshStore(std::string dir, int lock_fd) : dir_(std::move(dir)), lock_fd_(lock_fd) {}
+  MeshStore(std::string dir, int lock_fd, std::string key)
+      : dir_(std::move(dir)), lock_fd_(lock_fd), key_(std::move(key)) {}
+  static StatusOr<std::string> ReadOrCreateKey(const std::string& path, const std::string& dir);
   std::string PendingPath(const std::string& id) const { return dir_ + "/." + id + ".pending"; }
 
   std::string dir_;
   int lock_fd_ = -1;  // holds the flock
+  std::string key_;   // the HMAC key; empty: entries are checksummed only
 };
 
 }  // namespace deform::service

@@ -155,8 +155,14 @@ Status DeformServer::Start() {
   return Status::Ok();
 }
 
-Status DeformServer::UseStore(const std::string& dir, int* restored) {
-  DEFORM_ASSIGN_OR_RETURN(std::unique_ptr<MeshStore> store, MeshStore::Open(dir));
+Status DeformServer::UseStore(const std::string& dir, int* restored, const std::string& key_file) {
+  DEFORM_ASSIGN_OR_RETURN(std::unique_ptr<MeshStore> store, MeshStore::Open(dir, key_file));
+  if (key_file.empty()) {
+    spdlog::warn(
+        "store: no --store-key: entries are checksummed, not authenticated (whoever "
+        "can write '{}' can change a mesh's owner)",
+        EscapeForLog(dir));
+  }
   ServiceContext& context = impl_->context;
   int count = 0;
   for (StoredMesh& stored : store->LoadAll()) {

@@ -52,8 +52,10 @@ class DeformServer {
   // Keeps loaded meshes in the store at `dir` (mesh_store.h) from now on, and first builds every
   // mesh stored there under its id and owner, on the calling thread; before Start(). A corrupt or
   // failing entry is logged and skipped. FAILED_PRECONDITION when the directory cannot be used.
-  // `restored` (optional) receives the number of meshes restored.
-  Status UseStore(const std::string& dir, int* restored = nullptr);
+  // `restored` (optional) receives the number of meshes restored. `key_file`: the store's HMAC
+  // key (--store-key; mesh_store.h), empty for none.
+  Status UseStore(const std::string& dir, int* restored = nullptr,
+                  const std::string& key_file = "");
 
   // Authenticates calls with the token file at `path` from now on (identity.h); before Start().
   // NOT_FOUND or INVALID_ARGUMENT (naming the line) for a bad file. Without it, every caller is

@@ -71,10 +71,11 @@ class MeshStoreTest : public ::testing::Test {
 // A server started on the store with tokens, as deformd --store --token-file does.
 class StoredServer {
  public:
-  StoredServer(const std::string& store, const std::string& tokens) {
+  StoredServer(const std::string& store, const std::string& tokens,
+               const std::string& key_file = "") {
     server_ = std::make_unique<service::DeformServer>(TestServerOptions());
     EXPECT_TRUE(server_->UseTokenFile(tokens).ok());
-    const Status used = server_->UseStore(store, &restored_);
+    const Status used = server_->UseStore(store, &restored_, key_file);
     EXPECT_TRUE(used.ok()) << used.ToString();
     EXPECT_TRUE(server_->Start().ok());
   }
@@ -305,6 +306,48 @@ TEST_F(MeshStoreTest, AnUnloadWhoseEntryCannotBeDeletedFailsAndKeepsTheMesh) {
   ASSERT_TRUE(client->ListMeshes(&meshes).ok());
   ASSERT_EQ(meshes.size(), 1u);
   EXPECT_EQ(meshes[0].mesh_id(), summary.mesh_id());
+}
+
+// An entry whose tenant was edited and whose checksum was recomputed was restored as the other
+// tenant's: with --store-key the entries carry an HMAC under a key outside the store, and such an
+// entry is refused at restore.
+TEST_F(MeshStoreTest, AnEntryWhoseOwnerWasEditedIsRefusedWithAKey) {
+  const std::string key = dir_.Path("store.key");  // beside the token file, outside the store
+  std::string id;
+  {
+    StoredServer server(store_, tokens_, key);
+    v1::MeshSummary summary;
+    ASSERT_TRUE(server.NewClient("token-a")->LoadPhantom(300, {}, &summary).ok());
+    id = summary.mesh_id();
+  }
+  EXPECT_EQ(Mode(key), 0600);
+  {
+    StoredServer server(store_, tokens_, key);  // untouched: restored
+    EXPECT_EQ(server.restored(), 1);
+  }
+  const std::string path = store_ + "/" + id + ".mesh";
+  std::ifstream in(path, std::ios::binary);
+  std::string entry((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  in.close();
+  const std::size_t at = entry.find("ward-a");
+  ASSERT_NE(at, std::string::npos);
+  entry.replace(at, 6, "ward-b");
+  // The seal recomputed as a SHA-256, all an editor without the key can do.
+  std::string body = entry.substr(0, entry.size() - 32);
+  const std::string hex = service::Sha256Hex(body);
+  std::string digest;
+  for (std::size_t i = 0; i < hex.size(); i += 2) {
+    digest.push_back(static_cast<char>(std::stoi(hex.substr(i, 2), nullptr, 16)));
+  }
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << body + digest;
+  StoredServer restarted(store_, tokens_, key);
+  EXPECT_EQ(restarted.restored(), 0);
+  std::vector<v1::MeshSummary> meshes;
+  ASSERT_TRUE(restarted.NewClient("token-b")->ListMeshes(&meshes).ok());
+  EXPECT_TRUE(meshes.empty()) << "ward-b was handed ward-a's mesh";
+  // A key inside the store is refused.
+  auto inside = service::MeshStore::Open(dir_.Path("other-store"), dir_.Path("other-store/key"));
+  EXPECT_FALSE(inside.ok());
 }
 
 }  // namespace
