@@ -12,6 +12,11 @@ namespace {
 
 std::string ResultText(const Status& status) { return status.ok() ? "OK" : status.ToString(); }
 
+// A mesh id as an audit line names it before its length was checked: cut to the limit.
+std::string_view BoundedForAudit(std::string_view mesh_id) {
+  return mesh_id.substr(0, kMaxMeshIdBytes);
+}
+
 }  // namespace
 
 StatusOr<Identity> AuthenticateCall(const ServiceContext& context, std::string_view authorization,
@@ -32,10 +37,11 @@ StatusOr<Identity> AuthenticateCall(const ServiceContext& context, std::string_v
 
 Status GetMeshInfoCall(ServiceContext& context, std::string_view authorization,
                        const v1::GetMeshInfoRequest& request, v1::GetMeshInfoResponse* response) {
-  DEFORM_RETURN_IF_ERROR(CheckLength(request.mesh_id(), kMaxMeshIdBytes, "mesh_id"));
   const char* action = request.include_geometry() ? "download" : "get_mesh_info";
-  DEFORM_ASSIGN_OR_RETURN(Identity caller,
-                          AuthenticateCall(context, authorization, action, request.mesh_id()));
+  // Authentication first: an unauthenticated caller learns nothing of the request's checks.
+  DEFORM_ASSIGN_OR_RETURN(Identity caller, AuthenticateCall(context, authorization, action,
+                                                            BoundedForAudit(request.mesh_id())));
+  DEFORM_RETURN_IF_ERROR(CheckLength(request.mesh_id(), kMaxMeshIdBytes, "mesh_id"));
   auto entry = context.registry().Find(request.mesh_id(), caller);
   Audit(caller.tenant, action, request.mesh_id(), ResultText(entry.status()));
   if (!entry.ok()) return entry.status();
@@ -58,9 +64,9 @@ Status ListMeshesCall(ServiceContext& context, std::string_view authorization,
 
 Status UnloadMeshCall(ServiceContext& context, std::string_view authorization,
                       const v1::UnloadMeshRequest& request, v1::UnloadMeshResponse* /*response*/) {
+  DEFORM_ASSIGN_OR_RETURN(Identity caller, AuthenticateCall(context, authorization, "unload",
+                                                            BoundedForAudit(request.mesh_id())));
   DEFORM_RETURN_IF_ERROR(CheckLength(request.mesh_id(), kMaxMeshIdBytes, "mesh_id"));
-  DEFORM_ASSIGN_OR_RETURN(Identity caller,
-                          AuthenticateCall(context, authorization, "unload", request.mesh_id()));
   // The stored entry first: a mesh whose entry cannot be deleted stays loaded (else it would
   // come back at the next start), and the caller is told.
   Status status = context.registry().Find(request.mesh_id(), caller).status();

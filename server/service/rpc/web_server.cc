@@ -161,6 +161,15 @@ bool HostAndOriginAllowed(const Shared& shared, const Request& request) {
 // `method` is the full gRPC name the call is counted under (ServiceMetrics::RpcFinished).
 template <typename RequestMessage, typename ResponseMessage, typename Call>
 Response UnaryCall(Shared& shared, const Request& request, std::string_view method, Call call) {
+  const std::string_view authorization(request[http::field::authorization].data(),
+                                       request[http::field::authorization].size());
+  // Authentication before the body is parsed (an unauthenticated garbage body is 401, not 400).
+  const StatusOr<service::Identity> caller =
+      service::AuthenticateCall(*shared.context, authorization, method, "");
+  if (!caller.ok()) {
+    shared.context->metrics().RpcFinished(method, static_cast<int>(CodeOf(caller.status())));
+    return ErrorResponse(request, CodeOf(caller.status()), caller.status().message());
+  }
   RequestMessage message;
   if (!message.ParseFromString(request.body())) {
     shared.context->metrics().RpcFinished(method,
@@ -169,8 +178,6 @@ Response UnaryCall(Shared& shared, const Request& request, std::string_view meth
                          "the body is not a " + RequestMessage::descriptor()->full_name());
   }
   ResponseMessage reply;
-  const std::string_view authorization(request[http::field::authorization].data(),
-                                       request[http::field::authorization].size());
   const Status status = call(*shared.context, authorization, message, &reply);
   shared.context->metrics().RpcFinished(method, static_cast<int>(CodeOf(status)));
   if (!status.ok()) {
