@@ -103,13 +103,17 @@ Status DeformServer::Start() {
   const std::string& address = impl_->options.listen_address;
   const std::size_t colon = address.rfind(':');
   const int fixed_port = colon == std::string::npos ? 0 : std::atoi(address.c_str() + colon + 1);
+  std::string bind_address = address;
   if (fixed_port > 0) {
     auto guard = LoopbackPortGuard::Hold(address, fixed_port);
     if (!guard.ok()) return guard.status();
     impl_->port_guard = std::move(*guard);
+  } else if (const int picked = LoopbackPortGuard::PickFreePort(address, &impl_->port_guard)) {
+    // Port 0 on a loopback address: a port free on both families, so the guard cannot fail.
+    bind_address = address.substr(0, colon) + ":" + std::to_string(picked);
   }
   grpc::ServerBuilder builder;
-  builder.AddListeningPort(impl_->options.listen_address, credentials, &impl_->port);
+  builder.AddListeningPort(bind_address, credentials, &impl_->port);
   builder.RegisterService(&impl_->service);
   builder.SetMaxReceiveMessageSize(impl_->options.max_message_bytes);
   builder.SetMaxSendMessageSize(impl_->options.max_message_bytes);
@@ -131,7 +135,7 @@ Status DeformServer::Start() {
     impl_->port_guard = LoopbackPortGuard();
     return Status::FailedPrecondition("cannot listen on '" + impl_->options.listen_address + "'");
   }
-  if (fixed_port == 0) {  // the kernel's port: its other loopback family's address now
+  if (impl_->port_guard.held().empty()) {  // the kernel's port: the other family's address now
     auto guard = LoopbackPortGuard::Hold(address, impl_->port);
     if (!guard.ok()) {
       impl_->server->Shutdown();

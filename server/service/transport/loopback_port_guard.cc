@@ -51,6 +51,48 @@ StatusOr<LoopbackPortGuard> LoopbackPortGuard::Hold(const std::string& listen_ad
   return guard;
 }
 
+int LoopbackPortGuard::PickFreePort(const std::string& listen_address, LoopbackPortGuard* guard) {
+  const std::size_t colon = listen_address.rfind(':');
+  const std::string host =
+      colon == std::string::npos ? listen_address : listen_address.substr(0, colon);
+  const bool v4 = host == "127.0.0.1";
+  if (!v4 && host != "[::1]") return 0;
+  for (int attempt = 0; attempt < 16; ++attempt) {
+    // A port the kernel picks in the server's own family ...
+    const int fd = ::socket(v4 ? AF_INET : AF_INET6, SOCK_STREAM | SOCK_CLOEXEC, 0);
+    if (fd < 0) return 0;
+    int port = 0;
+    if (v4) {
+      sockaddr_in address{};
+      address.sin_family = AF_INET;
+      address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+      socklen_t length = sizeof address;
+      if (::bind(fd, reinterpret_cast<const sockaddr*>(&address), sizeof address) == 0 &&
+          ::getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length) == 0) {
+        port = ntohs(address.sin_port);
+      }
+    } else {
+      sockaddr_in6 address{};
+      address.sin6_family = AF_INET6;
+      address.sin6_addr = in6addr_loopback;
+      socklen_t length = sizeof address;
+      if (::bind(fd, reinterpret_cast<const sockaddr*>(&address), sizeof address) == 0 &&
+          ::getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length) == 0) {
+        port = ntohs(address.sin6_port);
+      }
+    }
+    // ... that is free in the other family too.
+    StatusOr<LoopbackPortGuard> held =
+        port > 0 ? Hold(listen_address, port) : StatusOr<LoopbackPortGuard>(Status::Internal(""));
+    ::close(fd);  // the server binds it next
+    if (held.ok()) {
+      *guard = std::move(*held);
+      return port;
+    }
+  }
+  return 0;
+}
+
 LoopbackPortGuard::~LoopbackPortGuard() {
   if (fd_ >= 0) ::close(fd_);
 }

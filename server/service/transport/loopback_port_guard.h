@@ -22,6 +22,11 @@ class LoopbackPortGuard {
   // on `port`. FAILED_PRECONDITION naming that address when another socket holds it. Nothing held
   // (and OK) for other hosts, or when the host has no such family (no IPv6).
   static StatusOr<LoopbackPortGuard> Hold(const std::string& listen_address, int port);
+  // For a loopback `listen_address` asking for port 0: a port free on both families, the other
+  // family's address already held by the returned guard (the caller then binds its own family's
+  // address on that port). Tries a few kernel-chosen ports; 0 (and no guard) for other hosts or
+  // when none was found.
+  static int PickFreePort(const std::string& listen_address, LoopbackPortGuard* guard);
   ~LoopbackPortGuard();
   LoopbackPortGuard(LoopbackPortGuard&& other) noexcept;
   LoopbackPortGuard& operator=(LoopbackPortGuard&& other) noexcept;
