@@ -133,6 +133,7 @@ nlohmann::ordered_json DeformReport(const DeformArgs& args, const deform::ModelI
   const auto& q = run.quality;
   nlohmann::ordered_json out;
   out["mesh"] = input.description;
+  out["input_warnings"] = input.warnings;
   out["method"] = deform::MethodName(method);
   out["pose"] = args.pose;
   out["vertices"] = input.mesh.num_vertices();
@@ -233,6 +234,9 @@ int RunDeform(DeformArgs args) {
     const Status written =
         deform::WriteMeshFile({run->posed, input->mesh.triangles}, args.out_path);
     if (!written.ok()) return Fail(written);
+  }
+  for (const std::string& warning : input->warnings) {
+    std::cerr << "deformctl: warning: " << warning << "\n";
   }
   for (const std::string& warning : (*model)->binding_report().warnings) {
     std::cerr << "deformctl: warning: " << warning << "\n";

@@ -114,6 +114,27 @@ StatusOr<RigImport> ReadGltfUnguarded(std::string_view bytes, const MeshLimits& 
   result.weights = std::move(welded.weights);
   result.file_vertex_to_mesh = std::move(welded.file_vertex_to_mesh);
   result.unused_file_vertices = std::move(welded.unused_vertices);
+  const double diagonal = BoundingBoxDiagonal(result.mesh.vertices);
+  if (diagonal < kPlausibleDiagonalMetres[0] || diagonal > kPlausibleDiagonalMetres[1]) {
+    result.warnings.push_back(
+        "the skinned mesh's bounding-box diagonal is " + std::to_string(diagonal) +
+        " units, read as metres (glTF's unit): implausible for a limb or a character (" +
+        std::to_string(kPlausibleDiagonalMetres[0]) + " to " +
+        std::to_string(kPlausibleDiagonalMetres[1]) +
+        " m); the file may be in another unit (centimetres?)");
+  }
+  if (character.nodes.size() > 1) {
+    std::string line = "the file's vertices come from " + std::to_string(character.nodes.size()) +
+                       " skinned mesh nodes, in node order:";
+    for (const gltf_internal::SkinnedNodeVertices& range : character.nodes) {
+      const std::string& name = model.nodes[static_cast<std::size_t>(range.node)].name;
+      line += " " + std::to_string(range.first_vertex) + ".." +
+              std::to_string(range.first_vertex + range.num_vertices - 1) + " node " +
+              std::to_string(range.node) + (name.empty() ? "" : " '" + name + "'") + ";";
+    }
+    line.pop_back();
+    result.warnings.push_back(line);
+  }
   for (const gltf_internal::SkinnedNodeVertices& range : character.nodes) {
     const std::string& name = model.nodes[static_cast<std::size_t>(range.node)].name;
     result.skinned_nodes.push_back({range.node,

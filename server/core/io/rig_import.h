@@ -70,9 +70,17 @@ struct RigImport {
   std::vector<int> file_vertex_to_mesh;
   std::vector<int> unused_file_vertices;        // file vertices no triangle uses, ascending
   std::vector<SkinnedNodeRange> skinned_nodes;  // in file vertex order, one per skinned node
-  std::string units = "metre";                  // glTF's units (the spec says metres)
-  std::string up_axis = "+Y";                   // glTF's up axis
+  // What a user should know of the file, one line each: which file vertices each skinned node
+  // holds (when there are several), and a scale implausible in metres (a bounding-box diagonal
+  // outside kPlausibleDiagonalMetres for a limb or a character: often a file in centimetres).
+  std::vector<std::string> warnings;
+  std::string units = "metre";  // glTF's units (the spec says metres)
+  std::string up_axis = "+Y";   // glTF's up axis
 };
+
+// The bounding-box diagonals, in metres, of a plausible limb or character: a skinned mesh outside
+// gets a warning in RigImport::warnings.
+inline constexpr double kPlausibleDiagonalMetres[2] = {0.01, 10.0};
 
 // Parses a whole .gltf (JSON, buffers as data URIs) or .glb (told by its "glTF" magic) held in
 // memory. The vertex limit applies to the file's vertices before welding, the triangle limit to

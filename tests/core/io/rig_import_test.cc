@@ -419,6 +419,12 @@ TEST(ReadGltf, ConcatenatesEverySkinnedNodeInNodeOrder) {
     EXPECT_EQ(read.skinned_nodes[1].name, "eyes");
     EXPECT_EQ(read.skinned_nodes[1].first_file_vertex, n);
     EXPECT_EQ(read.skinned_nodes[1].num_file_vertices, n);
+    ASSERT_EQ(read.warnings.size(), 1u);
+    EXPECT_NE(read.warnings[0].find("2 skinned mesh nodes, in node order: 0.." +
+                                    std::to_string(n - 1) + " node 3 'mesh'; " + std::to_string(n) +
+                                    ".." + std::to_string(2 * n - 1)),
+              std::string::npos)
+        << read.warnings[0];
   };
   const auto add_mesh = [](GltfBuilder* builder, const PrimitiveData& data) {
     builder->doc()["meshes"].push_back(
@@ -458,6 +464,27 @@ TEST(ReadGltf, ConcatenatesEverySkinnedNodeInNodeOrder) {
         ShiftedSkin(&builder, {0, 2, 1}, {0, 0, 0})["inverseBindMatrices"];
     ExpectRefused(builder.ToGlb(), StatusCode::kInvalidArgument,
                   "skinned nodes must share one bind pose");
+  }
+}
+
+TEST(ReadGltf, WarnsOfAScaleImplausibleInMetres) {
+  for (const double scale : {1.0, 100.0, 0.001}) {
+    TestRig tube = Tube();
+    tube.mesh.vertices *= scale;
+    std::vector<Joint> joints = tube.skeleton.joints();
+    for (Joint& joint : joints) joint.rest_position *= scale;
+    tube.skeleton = *Skeleton::Create(joints, {{0, 1}, {1, 2}});
+    auto bytes = WriteGltf(tube.mesh, tube.skeleton, tube.weights, GltfContainer::kGlb);
+    ASSERT_TRUE(bytes.ok()) << bytes.status().ToString();
+    auto read = ReadGltf(*bytes);
+    ASSERT_TRUE(read.ok()) << read.status().ToString();
+    if (scale == 1.0) {
+      EXPECT_TRUE(read->warnings.empty()) << read->warnings.front();
+    } else {
+      ASSERT_EQ(read->warnings.size(), 1u) << "scale " << scale;
+      EXPECT_NE(read->warnings[0].find("implausible for a limb or a character"), std::string::npos)
+          << read->warnings[0];
+    }
   }
 }
 
