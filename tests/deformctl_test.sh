@@ -102,6 +102,11 @@ grep -q "no bone named 'elbow'" "$WORK/err" || { echo "FAIL: the refusal does no
 run "--joint-nodes maybe is refused" 2 "" --joint-nodes maybe
 run "--material 0 is refused" 2 "" --material 0
 run "an unknown method is refused" 1 "" --method arap
+run "--rigid-weight-tolerance 0.6 is refused naming the flag" 1 "" --rigid-weight-tolerance 0.6
+grep -q -- "--rigid-weight-tolerance" "$WORK/err" ||
+  { echo "FAIL: the refusal does not name --rigid-weight-tolerance" >&2; failed=1; }
+run "--rigid-weight-tolerance 0.2 is accepted" 0 "d['input_warnings'] == []" \
+  --rigid-weight-tolerance 0.2
 
 [ "$failed" -eq 0 ] || exit 1
 echo "PASS: deformctl deform's flags"

@@ -13,6 +13,11 @@ Eigen::Quaterniond ToQuaternion(const std::array<double, 4>& q) {
 
 Eigen::Vector3d ToVector(const std::array<double, 3>& t) { return {t[0], t[1], t[2]}; }
 
+// A child bone's head farther than this (relative to the coordinates' size) from where its root
+// bone's transform takes it means the motion is carried below the root (float round-off of an
+// exported pose stays far below).
+constexpr double kRootMotionTolerance = 1e-7;
+
 Eigen::Vector3d RestPosition(const deform::v1::MeshSummary& summary, int joint) {
   const auto& p = summary.joints(joint).rest_position();
   return p.size() == 3 ? Eigen::Vector3d(p[0], p[1], p[2]) : Eigen::Vector3d::Zero();
@@ -87,6 +92,42 @@ RootPlacement PlaceRoot(const deform::v1::MeshSummary& summary,
   return placement;
 }
 
+// A root bone at rest (identity transform) whose first child bone's head is not where the child's
+// transform takes it (a static, weightless top joint above a hip that carries the motion) takes the
+// transform of its first child bone: the child's heads then sit on its tail and the pose is exact
+// for every bone but that root bone (which a static top joint's skin does not follow). Returns the
+// bones used, and the child taken (or -1) in `taken_from`.
+std::vector<BoneTransform> RootFromMovingChild(const deform::v1::MeshSummary& summary,
+                                               const std::vector<BoneTransform>& bones,
+                                               int* taken_from) {
+  std::vector<BoneTransform> used = bones;
+  *taken_from = -1;
+  for (int r = 0; r < summary.bones_size(); ++r) {
+    if (summary.bones(r).parent_bone() >= 0) continue;
+    const bool at_rest =
+        ToQuaternion(bones[r].rotation).angularDistance(Eigen::Quaterniond::Identity()) <=
+            kRootMotionTolerance &&
+        ToVector(bones[r].translation).norm() <= kRootMotionTolerance;
+    if (!at_rest) continue;
+    for (int c = 0; c < summary.bones_size(); ++c) {
+      if (summary.bones(c).parent_bone() != r) continue;
+      const Eigen::Vector3d head =
+          RestPosition(summary, static_cast<int>(summary.bones(c).head_joint()));
+      const Eigen::Vector3d by_root =
+          ToQuaternion(bones[r].rotation) * head + ToVector(bones[r].translation);
+      const Eigen::Vector3d by_child =
+          ToQuaternion(bones[c].rotation) * head + ToVector(bones[c].translation);
+      const double scale = 1 + head.norm() + ToVector(bones[c].translation).norm();
+      if ((by_root - by_child).norm() > kRootMotionTolerance * scale) {
+        used[r] = bones[c];
+        if (*taken_from < 0) *taken_from = c;
+      }
+      break;  // the first child bone decides
+    }
+  }
+  return used;
+}
+
 }  // namespace
 
 BoneTransform BoneTransformFromMatrix(const std::array<double, 16>& m) {
@@ -103,10 +144,12 @@ BoneTransform BoneTransformFromMatrix(const std::array<double, 16>& m) {
 }
 
 bool PoseFromBoneTransforms(const deform::v1::MeshSummary& summary,
-                            const std::vector<BoneTransform>& bones, PoseConversion* result,
+                            const std::vector<BoneTransform>& given, PoseConversion* result,
                             std::string* error) {
-  if (!CheckSkeleton(summary, bones.size(), error)) return false;
+  if (!CheckSkeleton(summary, given.size(), error)) return false;
   *result = PoseConversion();
+  const std::vector<BoneTransform> bones =
+      RootFromMovingChild(summary, given, &result->root_taken_from_bone);
   const int bone_count = summary.bones_size();
   int root_bone = -1;
   for (int k = 0; k < bone_count && root_bone < 0; ++k) {

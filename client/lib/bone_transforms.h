@@ -10,6 +10,12 @@
 // this skeleton: bones that start at one joint turn together, and each bone's head stays on its
 // parent's tail (a root bone's on the root's image). The result reports how far the input is from
 // that (not an error: an engine's rounding or scale makes it non-zero).
+//
+// Root motion: when a root bone's transform is the identity (a static top joint) but its first
+// child bone's own transform moves that child's head (a common export: the top skin joint static
+// and weightless, the hip carrying the translation), the root bone takes that child's transform
+// first, so the root transform is the hip's and every bone below is exact; only the root bone
+// itself then moves with the hip (exact for linear blend skinning when it carries no weight).
 #pragma once
 
 #include <array>
@@ -35,6 +41,8 @@ struct PoseConversion {
   double sibling_disagreement_degrees = 0;
   // Largest distance between a bone's posed head and its parent's posed tail (model units).
   double joint_gap = 0;
+  // The child bone whose transform a root bone took (root motion, see above), or -1.
+  int root_taken_from_bone = -1;
 };
 
 // `summary` supplies the skeleton (joints with rest positions, bones with parents), `bones` one

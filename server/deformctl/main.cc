@@ -6,6 +6,7 @@
 //                    [--laplacian uniform|cotangent|intrinsic]
 //                    [--bone-surface FILE:BONE ...] [--bones input|capsules|none]
 //                    [--contacts on|off] [--volume on|off] [--out-bones DIR]
+//                    [--rigid-weight-tolerance X]
 //   deformctl phantom --out FILE [--skeleton-out FILE] [--vertices N]
 //
 // Prints one JSON object on stdout; errors are one line on stderr and a non-zero exit code.
@@ -54,6 +55,7 @@ struct DeformArgs {
   std::string joint_nodes = "on";  // off: ModelOptions::use_joint_nodes = false
   std::string material = "on";     // off: ModelOptions::uniform_material = true
   std::string laplacian = "uniform";
+  double rigid_weight_tolerance = deform::ModelOptions{}.rigid_weight_tolerance;
 };
 
 struct PhantomArgs {
@@ -74,6 +76,7 @@ StatusOr<deform::ModelOptions> ModelOptionsFrom(const DeformArgs& args) {
   options.regions.radius_factor = args.radius_factor;
   options.use_joint_nodes = args.joint_nodes == "on";
   options.uniform_material = args.material == "off";
+  options.rigid_weight_tolerance = args.rigid_weight_tolerance;
   DEFORM_ASSIGN_OR_RETURN(options.ordering, deform::OrderingFromName(args.ordering));
   DEFORM_ASSIGN_OR_RETURN(options.laplacian, deform::LaplacianWeightsFromName(args.laplacian));
   return options;
@@ -130,6 +133,7 @@ nlohmann::ordered_json DeformReport(const DeformArgs& args, const deform::ModelI
   const auto& q = run.quality;
   nlohmann::ordered_json out;
   out["mesh"] = input.description;
+  out["input_warnings"] = input.warnings;
   out["method"] = deform::MethodName(method);
   out["pose"] = args.pose;
   out["vertices"] = input.mesh.num_vertices();
@@ -231,6 +235,9 @@ int RunDeform(DeformArgs args) {
         deform::WriteMeshFile({run->posed, input->mesh.triangles}, args.out_path);
     if (!written.ok()) return Fail(written);
   }
+  for (const std::string& warning : input->warnings) {
+    std::cerr << "deformctl: warning: " << warning << "\n";
+  }
   for (const std::string& warning : (*model)->binding_report().warnings) {
     std::cerr << "deformctl: warning: " << warning << "\n";
   }
@@ -323,6 +330,9 @@ CLI::App* AddDeformCommand(CLI::App* app, DeformArgs* args) {
   AddWithDefault(command, "--laplacian", &args->laplacian,
                  "Laplacian edge weights: uniform | cotangent | intrinsic (intrinsic Delaunay "
                  "cotangent)");
+  AddWithDefault(command, "--rigid-weight-tolerance", &args->rigid_weight_tolerance,
+                 "With given weights (--weights, a glTF rig): a vertex whose largest weight is at "
+                 "least 1 - this is rigid on that bone (rigid_weight_tolerance, in [0, 0.5))");
   return command;
 }
 

@@ -9,7 +9,9 @@
 
 #include "core/geometry/pose.h"
 #include "core/io/phantom.h"
+#include "core/io/rig_import.h"
 #include "core/io/skeleton_io.h"
+#include "tests/core/io/gltf_test_util.h"
 #include "tests/shared_data.h"
 
 namespace deform {
@@ -106,7 +108,8 @@ TEST(PoseFromBoneTransforms, ReportsTransformsThatAreNoPoseOfTheSkeleton) {
   ASSERT_TRUE(phantom.ok());
   const v1::MeshSummary summary = SummaryOf(phantom->skeleton);
   std::vector<client::BoneTransform> given(phantom->skeleton.num_bones());
-  given.back().translation = {0.5, 0, 0};  // the shin leaves the knee
+  given.front().translation = {0, 0, 0.25};   // the thigh moves (not a static root)
+  given.back().translation = {0.5, 0, 0.25};  // and the shin leaves the knee
   client::PoseConversion conversion;
   std::string error;
   ASSERT_TRUE(client::PoseFromBoneTransforms(summary, given, &conversion, &error));
@@ -114,6 +117,100 @@ TEST(PoseFromBoneTransforms, ReportsTransformsThatAreNoPoseOfTheSkeleton) {
   given.pop_back();
   EXPECT_FALSE(client::PoseFromBoneTransforms(summary, given, &conversion, &error));
   EXPECT_NE(error.find("bone transforms"), std::string::npos) << error;
+}
+
+Eigen::Matrix4d NodeMatrix(const Eigen::Vector3d& translation, const Eigen::Quaterniond& rotation) {
+  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+  m.block<3, 3>(0, 0) = rotation.toRotationMatrix();
+  m.block<3, 1>(0, 3) = translation;
+  return m;
+}
+
+TEST(PoseFromBoneTransforms, TakesRootMotionFromTheHipUnderAStaticWeightlessTopJoint) {
+  // glTF nodes root -> hip -> knee -> ankle, one unit apart along +Y; the tube (moved up one unit)
+  // blends between hip and knee; the top joint "root" carries no weight and stays at rest.
+  const gltf_test::TestRig tube = gltf_test::Tube();
+  gltf_test::PrimitiveData data;
+  for (int v = 0; v < tube.mesh.num_vertices(); ++v) {
+    const double y = tube.mesh.vertices(v, 1);
+    data.positions.insert(data.positions.end(),
+                          {static_cast<float>(tube.mesh.vertices(v, 0)), static_cast<float>(y + 1),
+                           static_cast<float>(tube.mesh.vertices(v, 2))});
+    const float w = static_cast<float>(gltf_test::LowerBoneWeight(y));
+    data.joints.insert(data.joints.end(), {1, 2, 0, 0});
+    data.weights.insert(data.weights.end(), {w, 1 - w, 0, 0});
+  }
+  for (Eigen::Index t = 0; t < tube.mesh.triangles.rows(); ++t) {
+    for (int c = 0; c < 3; ++c)
+      data.indices.push_back(static_cast<std::uint32_t>(tube.mesh.triangles(t, c)));
+  }
+  gltf_test::GltfBuilder builder =
+      gltf_test::ChainRig({{0, 0, 0}, {0, 1, 0}, {0, 2, 0}, {0, 3, 0}}, {data});
+  const std::vector<std::string> names = {"root", "hip", "knee", "ankle"};
+  for (std::size_t j = 0; j < names.size(); ++j) builder.doc()["nodes"][j]["name"] = names[j];
+  auto rig = ReadGltf(builder.ToGlb());
+  ASSERT_TRUE(rig.ok()) << rig.status().ToString();
+
+  // The animated frame: the hip translated and turned, the knee bent; the root at rest. The file's
+  // own skinning (glTF: joint matrix = posed world * inverse bind), written here.
+  const std::vector<Eigen::Vector3d> rest_local = {{0, 0, 0}, {0, 1, 0}, {0, 1, 0}, {0, 1, 0}};
+  std::vector<Eigen::Vector3d> local = rest_local;
+  std::vector<Eigen::Quaterniond> turn(4, Eigen::Quaterniond::Identity());
+  local[1] = {0.3, 1.2, -0.4};
+  turn[1] = Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 0.5).normalized()));
+  turn[2] = Eigen::Quaterniond(Eigen::AngleAxisd(1.1, Eigen::Vector3d::UnitX()));
+  std::vector<Eigen::Matrix4d> rest_world(4), posed_world(4), joint_matrix(4);
+  for (std::size_t j = 0; j < 4; ++j) {
+    const Eigen::Matrix4d parent_rest = j == 0 ? Eigen::Matrix4d::Identity() : rest_world[j - 1];
+    const Eigen::Matrix4d parent_posed = j == 0 ? Eigen::Matrix4d::Identity() : posed_world[j - 1];
+    rest_world[j] = parent_rest * NodeMatrix(rest_local[j], Eigen::Quaterniond::Identity());
+    posed_world[j] = parent_posed * NodeMatrix(local[j], turn[j]);
+    joint_matrix[j] = posed_world[j] * rest_world[j].inverse();
+  }
+  const int n = data.vertex_count();
+  Positions reference(n, 3);
+  for (int v = 0; v < n; ++v) {
+    const Eigen::Vector4d p(data.positions[3 * v], data.positions[3 * v + 1],
+                            data.positions[3 * v + 2], 1);
+    Eigen::Vector4d sum = Eigen::Vector4d::Zero();
+    double total = 0;
+    for (int k = 0; k < 4; ++k) {
+      const double w = data.weights[4 * v + k];
+      sum += w * (joint_matrix[data.joints[4 * v + k]] * p);
+      total += w;
+    }
+    reference.row(v) = (sum / total).head<3>().transpose();
+  }
+
+  // Bone transforms as an engine holds them: each bone's head joint's joint matrix.
+  std::vector<client::BoneTransform> given;
+  for (const Bone& bone : rig->skeleton.bones()) {
+    const std::string& head = rig->skeleton.joint(bone.head_joint).name;
+    const auto node = std::find(names.begin(), names.end(), head) - names.begin();
+    std::array<double, 16> m;
+    for (int k = 0; k < 16; ++k) m[k] = joint_matrix[node](k % 4, k / 4);
+    given.push_back(client::BoneTransformFromMatrix(m));
+  }
+  client::PoseConversion conversion;
+  std::string error;
+  ASSERT_TRUE(client::PoseFromBoneTransforms(SummaryOf(rig->skeleton), given, &conversion, &error))
+      << error;
+  EXPECT_EQ(conversion.root_taken_from_bone, 1) << "the hip's bone carries the motion";
+  std::vector<RigidTransform> transforms;
+  ForwardKinematics(rig->skeleton, CorePose(rig->skeleton, conversion.pose), &transforms);
+  const Positions& rest = rig->mesh.vertices;
+  const double diagonal = (rest.colwise().maxCoeff() - rest.colwise().minCoeff()).norm();
+  double worst = 0;
+  for (int v = 0; v < n; ++v) {
+    const int m = rig->file_vertex_to_mesh[static_cast<std::size_t>(v)];
+    Eigen::Vector3d lbs = Eigen::Vector3d::Zero();
+    for (int e = rig->weights.offsets[m]; e < rig->weights.offsets[m + 1]; ++e) {
+      const RigidTransform& t = transforms[static_cast<std::size_t>(rig->weights.bones[e])];
+      lbs += rig->weights.weights[e] * (t.rotation * rest.row(m).transpose() + t.translation);
+    }
+    worst = std::max(worst, (lbs - reference.row(v).transpose()).norm());
+  }
+  EXPECT_LT(worst, 1e-6 * diagonal) << "lbs against the file's own skinning";
 }
 
 TEST(BoneTransformFromMatrix, ReadsAColumnMajorRigidMatrix) {

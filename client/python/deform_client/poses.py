@@ -1,6 +1,8 @@
 """Poses for DeformStream.send_pose: deformctl's "JOINT:AXIS:DEGREES[,...]" text, a dict
 {"joint": ..., "axis": ..., "degrees": ...}, a (joint, axis, degrees) tuple, a list of those, or a
-PoseUpdate message as is. JOINT is a name or a 0-based index, AXIS x, y, z or a degree of freedom's
+PoseUpdate message as is. JOINT is a name or a 0-based index (the axis and the angle are read
+from the right, so a name may hold colons: "mixamorig:LeftForeArm:z:60"; a name in double quotes
+may hold commas and spaces: '"left arm, upper":x:30'), AXIS x, y, z or a degree of freedom's
 name ("flexion"); the server resolves both. "" and "rest" are the rest pose. ValueError naming the
 offending term for malformed input (the same rules as core/base/pose_spec.h).
 """
@@ -25,17 +27,50 @@ def _term(joint, axis, degrees, text):
     return pb.JointAngle(joint=joint, axis=axis, degrees=value)
 
 
+def _split_terms(spec):
+    """`spec` split at the commas outside double quotes."""
+    terms, start, quoted = [], 0, False
+    for i, char in enumerate(spec):
+        if char == '"':
+            quoted = not quoted
+        elif char == "," and not quoted:
+            terms.append(spec[start:i])
+            start = i + 1
+    if quoted:
+        raise ValueError(f"pose {spec!r} has an unclosed '\"'")
+    terms.append(spec[start:])
+    return terms
+
+
+def _fields(text):
+    """A term's joint, axis and degrees: the axis and the angle are the last two fields, the joint
+    everything before them (names may hold colons) or a double-quoted name."""
+    malformed = ValueError(f"pose term {text!r} is not JOINT:AXIS:DEGREES")
+    if text.startswith('"'):
+        close = text.find('"', 1)
+        if close < 0:
+            raise malformed
+        rest = text[close + 1:].strip()
+        if not rest.startswith(":") or rest[1:].count(":") != 1:
+            raise malformed
+        axis, degrees = rest[1:].split(":")
+        return text[1:close], axis, degrees
+    fields = text.rsplit(":", 2)
+    if len(fields) != 3:
+        raise malformed
+    return fields
+
+
 def parse_pose_spec(spec):
     """deformctl's syntax -> a list of JointAngle messages."""
     spec = spec.strip()
     if spec in ("", "rest"):
         return []
     angles = []
-    for text in spec.split(","):
-        fields = text.strip().split(":")
-        if len(fields) != 3:
-            raise ValueError(f"pose term {text.strip()!r} is not JOINT:AXIS:DEGREES")
-        angles.append(_term(fields[0], fields[1], fields[2].strip(), text.strip()))
+    for text in _split_terms(spec):
+        text = text.strip()
+        joint, axis, degrees = _fields(text)
+        angles.append(_term(joint, axis, degrees.strip(), text))
     return angles
 
 

@@ -33,6 +33,7 @@ StatusOr<ModelInput> LoadGltfRig(const std::string& path, const MeshLimits& limi
   input.file_vertex_to_mesh = std::move(rig.file_vertex_to_mesh);
   input.units = std::move(rig.units);
   input.up_axis = std::move(rig.up_axis);
+  input.warnings = std::move(rig.warnings);
   input.description = path;
   return input;
 }

@@ -23,9 +23,10 @@ struct ModelInput {
   // For a glTF rig: per vertex in the file's own order, its vertex of `mesh` (see RigImport).
   // Empty when the mesh's vertices are the file's (OBJ, PLY, STL, OFF, the phantom).
   std::vector<int> file_vertex_to_mesh;
-  std::string units;        // "metre" for glTF; empty when the file does not say (OBJ...)
-  std::string up_axis;      // "+Y" for glTF; empty when the file does not say
-  std::string description;  // "phantom:2000" or the mesh path, for logs
+  std::string units;                  // "metre" for glTF; empty when the file does not say (OBJ...)
+  std::string up_axis;                // "+Y" for glTF; empty when the file does not say
+  std::string description;            // "phantom:2000" or the mesh path, for logs
+  std::vector<std::string> warnings;  // a glTF rig's (RigImport::warnings); empty otherwise
   // Bone surfaces that came with the input: the phantom's femur, tibia and patella.
   std::vector<BoneSurface> bones;
 };

@@ -1,7 +1,8 @@
-// The glTF rig import: bytes -> tinygltf::Model (internal/gltf_load), the skinned node, its
-// skin's joints and the node hierarchy (internal/gltf_skin, internal/gltf_scene), the primitives
-// (internal/gltf_skinned_mesh), the skeleton (internal/gltf_rig_skeleton), weights mapped from
-// joints to bones here, and welding (internal/gltf_weld).
+// The glTF rig import: bytes -> tinygltf::Model (internal/gltf_load), the node hierarchy
+// (internal/gltf_scene), every skinned node's mesh and the union of their skins' joints
+// (internal/gltf_character over internal/gltf_skin and internal/gltf_skinned_mesh), the skeleton
+// (internal/gltf_rig_skeleton), weights mapped from joints to bones here, and welding
+// (internal/gltf_weld).
 #include "core/io/rig_import.h"
 
 #include <filesystem>
@@ -11,10 +12,10 @@
 #include <vector>
 
 #include "internal/file_bytes.h"
+#include "internal/gltf_character.h"
 #include "internal/gltf_load.h"
 #include "internal/gltf_rig_skeleton.h"
 #include "internal/gltf_scene.h"
-#include "internal/gltf_skin.h"
 #include "internal/gltf_skinned_mesh.h"
 #include "internal/gltf_weld.h"
 #include "internal/mesh_io_internal.h"
@@ -92,15 +93,12 @@ StatusOr<SkinWeights> BoneWeights(const FileMesh& file, const RigSkeleton& rig) 
 StatusOr<RigImport> ReadGltfUnguarded(std::string_view bytes, const MeshLimits& limits) {
   tinygltf::Model model;
   DEFORM_RETURN_IF_ERROR(gltf_internal::LoadGltfModel(bytes, &model));
-  DEFORM_ASSIGN_OR_RETURN(const int node_index, gltf_internal::FindSkinnedNode(model));
-  const tinygltf::Node& node = model.nodes[static_cast<std::size_t>(node_index)];
   DEFORM_ASSIGN_OR_RETURN(const gltf_internal::SceneNodes scene,
                           gltf_internal::ReadSceneNodes(model));
-  DEFORM_ASSIGN_OR_RETURN(std::vector<SkinJoint> joints,
-                          gltf_internal::ReadSkinJoints(model, node.skin, scene));
-  DEFORM_ASSIGN_OR_RETURN(
-      const FileMesh file,
-      gltf_internal::ReadSkinnedMesh(model, node.mesh, static_cast<int>(joints.size()), limits));
+  DEFORM_ASSIGN_OR_RETURN(gltf_internal::CharacterMesh character,
+                          gltf_internal::ReadCharacterMesh(model, scene, limits));
+  const FileMesh& file = character.file;
+  std::vector<SkinJoint>& joints = character.joints;
   AccumulateJointVertices(file, &joints);
   DEFORM_ASSIGN_OR_RETURN(const RigSkeleton rig,
                           gltf_internal::BuildRigSkeleton(
@@ -116,6 +114,33 @@ StatusOr<RigImport> ReadGltfUnguarded(std::string_view bytes, const MeshLimits& 
   result.weights = std::move(welded.weights);
   result.file_vertex_to_mesh = std::move(welded.file_vertex_to_mesh);
   result.unused_file_vertices = std::move(welded.unused_vertices);
+  const double diagonal = BoundingBoxDiagonal(result.mesh.vertices);
+  if (diagonal < kPlausibleDiagonalMetres[0] || diagonal > kPlausibleDiagonalMetres[1]) {
+    result.warnings.push_back(
+        "the skinned mesh's bounding-box diagonal is " + std::to_string(diagonal) +
+        " units, read as metres (glTF's unit): implausible for a limb or a character (" +
+        std::to_string(kPlausibleDiagonalMetres[0]) + " to " +
+        std::to_string(kPlausibleDiagonalMetres[1]) +
+        " m); the file may be in another unit (centimetres?)");
+  }
+  if (character.nodes.size() > 1) {
+    std::string line = "the file's vertices come from " + std::to_string(character.nodes.size()) +
+                       " skinned mesh nodes, in node order:";
+    for (const gltf_internal::SkinnedNodeVertices& range : character.nodes) {
+      const std::string& name = model.nodes[static_cast<std::size_t>(range.node)].name;
+      line += " " + std::to_string(range.first_vertex) + ".." +
+              std::to_string(range.first_vertex + range.num_vertices - 1) + " node " +
+              std::to_string(range.node) + (name.empty() ? "" : " '" + name + "'") + ";";
+    }
+    line.pop_back();
+    result.warnings.push_back(line);
+  }
+  for (const gltf_internal::SkinnedNodeVertices& range : character.nodes) {
+    const std::string& name = model.nodes[static_cast<std::size_t>(range.node)].name;
+    result.skinned_nodes.push_back({range.node,
+                                    name.empty() ? "node" + std::to_string(range.node) : name,
+                                    range.first_vertex, range.num_vertices});
+  }
   return result;
 }
 

@@ -7,18 +7,24 @@
 // the problem (accessor, primitive, node); sizes beyond MeshLimits are RESOURCE_EXHAUSTED.
 //
 // What is read, and how it maps onto the core's types:
-//   - The skinned mesh: the one node with both "mesh" and "skin" (none: INVALID_ARGUMENT "no
-//     skin: ..."; several: INVALID_ARGUMENT). Every primitive must be triangles (mode 4, indexed
-//     or not) with POSITION (float VEC3) and JOINTS_n/WEIGHTS_n pairs (n = 0, 1, ...; JOINTS
-//     unsigned byte/short, WEIGHTS float or normalized unsigned byte/short). Primitives are
-//     concatenated in file order. Morph targets, normals, UVs and materials are ignored.
+//   - The skinned mesh: every node with both "mesh" and "skin" (none: INVALID_ARGUMENT "no
+//     skin: ..."), their meshes concatenated in node-index order (`skinned_nodes` says which file
+//     vertices each node holds), each mesh's primitives in file order. Every primitive must be
+//     triangles (mode 4, indexed or not) with POSITION (float VEC3) and JOINTS_n/WEIGHTS_n pairs
+//     (n = 0, 1, ...; JOINTS unsigned byte/short, WEIGHTS float or normalized unsigned
+//     byte/short). Morph targets, normals, UVs and materials are ignored. Mesh nodes without a
+//     skin are not part of the skinned mesh.
 //   - Positions are kept as the file holds them, in the bind space the inverse bind matrices refer
 //     to: glTF ignores a skinned mesh node's own transform (the joints place the mesh), so it is
 //     not applied here either.
-//   - Joints: the skin's joints, named after their nodes ("node<index>" when unnamed; a repeated
-//     name gets "_2", "_3"...). A joint's bind position is the translation of the inverse of its
-//     inverse bind matrix; without inverseBindMatrices, the translation of its node's world
-//     transform. Its parent is the nearest ancestor node that is also a skin joint.
+//   - Joints: the union of the skins' joints by node (the first skinned node's skin in its order,
+//     then each later skin's new joints). Several skins must bind the shared joints in one pose,
+//     up to one transform per skin that maps its mesh into the first skin's bind space (applied
+//     to that node's positions); otherwise INVALID_ARGUMENT naming the node. Joints are
+//     named after their nodes ("node<index>" when unnamed; a repeated name gets "_2", "_3"...). A
+//     joint's bind position is the translation of the inverse of its inverse bind matrix; without
+//     inverseBindMatrices, the translation of its node's world transform. Its parent is the nearest
+//     ancestor node that is also a skin joint.
 //   - Bones: one per (parent joint -> child joint). A joint within 1e-6 of the mesh's bounding-box
 //     diagonal of its parent joint is merged into it (same skeleton joint; its weights go to the
 //     parent's bones). A joint that heads no bone but has weighted vertices gets an end joint
@@ -44,6 +50,15 @@
 
 namespace deform {
 
+// The file vertices [first_file_vertex, first_file_vertex + num_file_vertices) come from the
+// skinned mesh node `node` (its glTF node index; `name` its name or "node<index>").
+struct SkinnedNodeRange {
+  int node = -1;
+  std::string name;
+  int first_file_vertex = 0;
+  int num_file_vertices = 0;
+};
+
 struct RigImport {
   TriangleMesh mesh;    // the welded mesh the solve uses (validated with ValidateMesh)
   Skeleton skeleton;    // the skin's joints (plus any "<name>_end" joints) and their bones
@@ -53,10 +68,19 @@ struct RigImport {
   // the used vertex before it, see Welding above). Frames computed on `mesh` return to the file's
   // order through this.
   std::vector<int> file_vertex_to_mesh;
-  std::vector<int> unused_file_vertices;  // file vertices no triangle uses, ascending
-  std::string units = "metre";            // glTF's units (the spec says metres)
-  std::string up_axis = "+Y";             // glTF's up axis
+  std::vector<int> unused_file_vertices;        // file vertices no triangle uses, ascending
+  std::vector<SkinnedNodeRange> skinned_nodes;  // in file vertex order, one per skinned node
+  // What a user should know of the file, one line each: which file vertices each skinned node
+  // holds (when there are several), and a scale implausible in metres (a bounding-box diagonal
+  // outside kPlausibleDiagonalMetres for a limb or a character: often a file in centimetres).
+  std::vector<std::string> warnings;
+  std::string units = "metre";  // glTF's units (the spec says metres)
+  std::string up_axis = "+Y";   // glTF's up axis
 };
+
+// The bounding-box diagonals, in metres, of a plausible limb or character: a skinned mesh outside
+// gets a warning in RigImport::warnings.
+inline constexpr double kPlausibleDiagonalMetres[2] = {0.01, 10.0};
 
 // Parses a whole .gltf (JSON, buffers as data URIs) or .glb (told by its "glTF" magic) held in
 // memory. The vertex limit applies to the file's vertices before welding, the triangle limit to

@@ -98,6 +98,7 @@ Status DeformationModel::Precompute(const SkinWeights* weights, const CancelToke
   const TriangleBvh bvh(mesh_);
   DEFORM_RETURN_IF_ERROR(CheckSkeletonAgainstMesh(mesh_, skeleton_, bvh));
   DEFORM_RETURN_IF_ERROR(EndPhase(cancel, "the mesh's adjacency"));
+  binding_report_.warnings.clear();
   if (weights != nullptr) {
     DEFORM_RETURN_IF_ERROR(BindToWeights(*weights, adjacency));
   } else {
@@ -119,6 +120,8 @@ Status DeformationModel::Precompute(const SkinWeights* weights, const CancelToke
   report.seen_through_body = binding_report_.seen_through_body;
   report.reached_along_surface = binding_report_.reached_along_surface;
   report.straight_line = binding_report_.straight_line;
+  report.warnings.insert(report.warnings.end(), binding_report_.warnings.begin(),
+                         binding_report_.warnings.end());
   binding_report_ = std::move(report);
   DEFORM_RETURN_IF_ERROR(EndPhase(cancel, "the binding report"));
   DEFORM_ASSIGN_OR_RETURN(
@@ -160,8 +163,16 @@ Status DeformationModel::BindToWeights(const SkinWeights& weights,
   DEFORM_ASSIGN_OR_RETURN(
       const SkinWeights normalized,
       NormalizeSkinWeights(weights, mesh_.num_vertices(), skeleton_.num_bones()));
-  const WeightBinding binding =
+  WeightBinding binding =
       BindFromWeights(mesh_, skeleton_, normalized, options_.rigid_weight_tolerance);
+  if (const int anchored =
+          AnchorPiecesWithoutRigidVertex(adjacency, options_.rigid_weight_tolerance, &binding);
+      anchored > 0) {
+    binding_report_.warnings.push_back(
+        std::to_string(anchored) +
+        " connected piece(s) of the mesh have no vertex weighted at least 1 - "
+        "rigid_weight_tolerance to one bone: each follows its best vertex's bone rigidly");
+  }
   DEFORM_RETURN_IF_ERROR(CheckEveryComponentAnchored(adjacency, binding.rigid_bone));
   regions_ = RegionsFromWeightBinding(mesh_, skeleton_, adjacency, binding);
   rigid_bones_ = binding.rigid_bone;

@@ -55,8 +55,10 @@ Status ValidateModelOptions(const ModelOptions& options) {
                                    std::to_string(options.anchor_distance_factor));
   }
   if (!(options.rigid_weight_tolerance >= 0 && options.rigid_weight_tolerance < 0.5)) {
-    return Status::InvalidArgument("rigid_weight_tolerance must be in [0, 0.5), got " +
-                                   std::to_string(options.rigid_weight_tolerance));
+    return Status::InvalidArgument(
+        "rigid_weight_tolerance (deformctl --rigid-weight-tolerance) "
+        "must be in [0, 0.5), got " +
+        std::to_string(options.rigid_weight_tolerance));
   }
   if (!(options.anchor_min_fraction >= 0 && options.anchor_min_fraction <= 1)) {
     return Status::InvalidArgument("anchor_min_fraction must be in [0, 1], got " +

@@ -55,6 +55,7 @@ WeightBinding BindFromWeights(const TriangleMesh& mesh, const Skeleton& skeleton
   result.rigid_bone.assign(n, -1);
   result.region_joint.assign(n, -1);
   result.main_bone.assign(n, -1);
+  result.main_weight.assign(n, 0);
   for (int i = 0; i < n; ++i) {
     int first = -1, second = -1;
     double first_weight = -1, second_weight = -1;
@@ -71,6 +72,7 @@ WeightBinding BindFromWeights(const TriangleMesh& mesh, const Skeleton& skeleton
       }
     }
     result.main_bone[i] = first;
+    result.main_weight[i] = first_weight;
     if (first_weight >= 1 - rigid_tolerance || second < 0) {
       result.rigid_bone[i] = first;
       continue;
@@ -79,6 +81,34 @@ WeightBinding BindFromWeights(const TriangleMesh& mesh, const Skeleton& skeleton
         skeleton, inner, JointsBetween(skeleton, first, second), mesh.vertices.row(i).transpose());
   }
   return result;
+}
+
+int AnchorPiecesWithoutRigidVertex(const VertexAdjacency& adjacency, double rigid_tolerance,
+                                   WeightBinding* binding) {
+  std::vector<int> component;
+  const int count = ConnectedComponents(adjacency, &component);
+  std::vector<char> has_rigid(count, 0);
+  std::vector<int> best(count, -1);
+  for (std::size_t i = 0; i < component.size(); ++i) {
+    const int c = component[i];
+    if (binding->rigid_bone[i] >= 0) has_rigid[c] = 1;
+    if (best[c] < 0 || binding->main_weight[i] > binding->main_weight[best[c]]) {
+      best[c] = static_cast<int>(i);
+    }
+  }
+  int anchored = 0;
+  for (int c = 0; c < count; ++c) anchored += has_rigid[c] ? 0 : 1;
+  for (std::size_t i = 0; i < component.size(); ++i) {
+    const int c = component[i];
+    if (has_rigid[c]) continue;
+    const int b = best[c];
+    if (binding->main_bone[i] == binding->main_bone[b] &&
+        binding->main_weight[i] >= binding->main_weight[b] - rigid_tolerance) {
+      binding->rigid_bone[i] = binding->main_bone[i];
+      binding->region_joint[i] = -1;
+    }
+  }
+  return anchored;
 }
 
 JointRegions RegionsFromWeightBinding(const TriangleMesh& mesh, const Skeleton& skeleton,

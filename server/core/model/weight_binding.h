@@ -15,10 +15,11 @@
 namespace deform {
 
 struct WeightBinding {
-  std::vector<int> rigid_bone;    // per vertex: the bone it follows alone, or -1 (it blends)
-  std::vector<int> region_joint;  // per blending vertex: the inner joint whose region it joins,
-                                  // or -1 when no inner joint lies between its bones
-  std::vector<int> main_bone;     // per vertex: its largest weight's bone
+  std::vector<int> rigid_bone;      // per vertex: the bone it follows alone, or -1 (it blends)
+  std::vector<int> region_joint;    // per blending vertex: the inner joint whose region it joins,
+                                    // or -1 when no inner joint lies between its bones
+  std::vector<int> main_bone;       // per vertex: its largest weight's bone
+  std::vector<double> main_weight;  // per vertex: its largest weight
 };
 
 // `weights` must be normalized for this mesh and skeleton (NormalizeSkinWeights). A vertex is
@@ -27,6 +28,14 @@ struct WeightBinding {
 // (the joint they share when they meet), the one nearest to the vertex.
 WeightBinding BindFromWeights(const TriangleMesh& mesh, const Skeleton& skeleton,
                               const SkinWeights& weights, double rigid_tolerance);
+
+// Anchors the connected pieces of the mesh that hold no rigid vertex (a strap, a buckle, an eye
+// weighted to several bones everywhere): in such a piece, the tolerance applies relative to its
+// best vertex, the one with the largest main_weight: the vertices on that vertex's bone whose
+// weight on it is within rigid_tolerance of the best's become rigid on it. Pieces with a rigid
+// vertex are unchanged. Returns the number of pieces so anchored.
+int AnchorPiecesWithoutRigidVertex(const VertexAdjacency& adjacency, double rigid_tolerance,
+                                   WeightBinding* binding);
 
 // The joint regions of a weight binding: region c holds the vertices whose region_joint is c's
 // joint (one region per inner joint, in Skeleton::InnerJoints() order, possibly empty). Its radius

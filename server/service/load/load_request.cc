@@ -56,6 +56,7 @@ Status ParseUpload(const v1::UploadSource& upload, std::string* mesh_bytes,
     job->file_metadata.unused_file_vertices = std::move(rig->unused_file_vertices);
     job->file_metadata.units = std::move(rig->units);
     job->file_metadata.up_axis = std::move(rig->up_axis);
+    job->file_metadata.warnings = std::move(rig->warnings);
     return Status::Ok();
   }
   DEFORM_ASSIGN_OR_RETURN(const MeshFormat format, CoreMeshFormat(upload.format()));

@@ -208,6 +208,7 @@ void FillMeshSummary(const MeshEntry& entry, v1::MeshSummary* summary) {
   }
   summary->set_binding(model.weights_given() ? v1::BINDING_WEIGHTS : v1::BINDING_THROUGH_BODY);
   summary->clear_warnings();
+  for (const std::string& warning : entry.file_metadata.warnings) summary->add_warnings(warning);
   for (const std::string& warning : model.binding_report().warnings) summary->add_warnings(warning);
   if (const std::size_t unused = entry.file_metadata.unused_file_vertices.size(); unused > 0) {
     summary->add_warnings(std::to_string(unused) +

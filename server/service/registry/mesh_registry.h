@@ -48,6 +48,7 @@ struct MeshFileMetadata {
   std::vector<int> unused_file_vertices;
   std::string units;
   std::string up_axis;
+  std::vector<std::string> warnings;  // the file's (RigImport::warnings), for the summary
 };
 
 // What a mesh's frames keep beyond the method's energy (core/constraints/skin_constraints.h).

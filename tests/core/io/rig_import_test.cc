@@ -343,6 +343,151 @@ TEST(ReadGltf, ReadsJointsFromInverseBindMatricesOrNodeTransforms) {
             1e-7);
 }
 
+// The tube moved by `offset` and shrunk by `scale` about its axis (a second piece: eyes, a strap).
+PrimitiveData MovedTubePrimitive(const TestRig& tube, const Eigen::Vector3d& offset, double scale) {
+  PrimitiveData data = RigidTubePrimitive(tube);
+  for (std::size_t v = 0; v < data.positions.size() / 3; ++v) {
+    for (int c = 0; c < 3; ++c) {
+      float& x = data.positions[3 * v + static_cast<std::size_t>(c)];
+      x = static_cast<float>((c == 1 ? x : scale * x) + offset[c]);
+    }
+  }
+  return data;
+}
+
+// A skin over the chain's three joints (nodes 0, 1, 2) listed in `order`, with inverse bind
+// matrices for joints at y = 0, 1, 2 whose bind space is moved by `shift` (the mesh's positions
+// are then given relative to that shift).
+nlohmann::json ShiftedSkin(GltfBuilder* builder, const std::vector<int>& order,
+                           const Eigen::Vector3d& shift) {
+  std::vector<float> matrices;
+  for (int node : order) {
+    const std::vector<float> m = {1,
+                                  0,
+                                  0,
+                                  0,
+                                  0,
+                                  1,
+                                  0,
+                                  0,
+                                  0,
+                                  0,
+                                  1,
+                                  0,
+                                  static_cast<float>(shift.x()),
+                                  static_cast<float>(shift.y() - node),
+                                  static_cast<float>(shift.z()),
+                                  1};
+    matrices.insert(matrices.end(), m.begin(), m.end());
+  }
+  return {
+      {"joints", order},
+      {"inverseBindMatrices", builder->AddAccessor(gltf_test::Bytes(matrices), gltf_test::kFloat,
+                                                   "MAT4", static_cast<int>(order.size()))}};
+}
+
+TEST(ReadGltf, ConcatenatesEverySkinnedNodeInNodeOrder) {
+  const TestRig tube = Tube();
+  const int n = tube.mesh.num_vertices();
+  const Eigen::Vector3d eye_offset(2, 0, 0);
+  // Expected: the body's vertices, then the eye's (the tube shrunk and moved to x = 2).
+  const PrimitiveData eye_data = MovedTubePrimitive(tube, eye_offset, 0.5);
+  const auto expect_character = [&](const RigImport& read) {
+    ASSERT_EQ(read.file_vertex_to_mesh.size(), static_cast<std::size_t>(2 * n));
+    ASSERT_EQ(read.mesh.num_vertices(), 2 * n);
+    ASSERT_EQ(read.mesh.num_triangles(), 2 * tube.mesh.num_triangles());
+    for (int v = 0; v < n; ++v) {
+      const int body = read.file_vertex_to_mesh[static_cast<std::size_t>(v)];
+      const int eye = read.file_vertex_to_mesh[static_cast<std::size_t>(n + v)];
+      EXPECT_LT((read.mesh.vertices.row(body) - tube.mesh.vertices.row(v)).norm(), 1e-6);
+      const Eigen::RowVector3d eye_expected(
+          eye_data.positions[3 * v], eye_data.positions[3 * v + 1], eye_data.positions[3 * v + 2]);
+      EXPECT_LT((read.mesh.vertices.row(eye) - eye_expected).norm(), 1e-6) << v;
+      // Both pieces are rigid on the lower bone below y = 1, on the upper one from there.
+      const bool lower = tube.mesh.vertices(v, 1) < 1.0;
+      EXPECT_NEAR(BoneWeight(read.skeleton, read.weights, eye, "joint0", "joint1"), lower ? 1 : 0,
+                  1e-9);
+      EXPECT_NEAR(BoneWeight(read.skeleton, read.weights, body, "joint1", "joint2"), lower ? 0 : 1,
+                  1e-9);
+    }
+    ASSERT_EQ(read.skeleton.num_joints(), 3);
+    EXPECT_EQ(read.skeleton.joint(0).name, "joint0");
+    ASSERT_EQ(read.skinned_nodes.size(), 2u);
+    EXPECT_EQ(read.skinned_nodes[0].name, "mesh");
+    EXPECT_EQ(read.skinned_nodes[0].first_file_vertex, 0);
+    EXPECT_EQ(read.skinned_nodes[0].num_file_vertices, n);
+    EXPECT_EQ(read.skinned_nodes[1].name, "eyes");
+    EXPECT_EQ(read.skinned_nodes[1].first_file_vertex, n);
+    EXPECT_EQ(read.skinned_nodes[1].num_file_vertices, n);
+    ASSERT_EQ(read.warnings.size(), 1u);
+    EXPECT_NE(read.warnings[0].find("2 skinned mesh nodes, in node order: 0.." +
+                                    std::to_string(n - 1) + " node 3 'mesh'; " + std::to_string(n) +
+                                    ".." + std::to_string(2 * n - 1)),
+              std::string::npos)
+        << read.warnings[0];
+  };
+  const auto add_mesh = [](GltfBuilder* builder, const PrimitiveData& data) {
+    builder->doc()["meshes"].push_back(
+        {{"primitives", nlohmann::json::array({AddPrimitive(builder, data)})}});
+    return static_cast<int>(builder->doc()["meshes"].size()) - 1;
+  };
+  {  // one skin shared by two nodes, and a mesh node without skin (not part of the skin)
+    GltfBuilder builder = ChainRig({{0, 0, 0}, {0, 1, 0}, {0, 2, 0}}, {RigidTubePrimitive(tube)});
+    const int eye_mesh = add_mesh(&builder, eye_data);
+    const int eyes = builder.AddNode({{"name", "eyes"}, {"mesh", eye_mesh}, {"skin", 0}});
+    const int prop_mesh = add_mesh(&builder, MovedTubePrimitive(tube, {5, 0, 0}, 1));
+    builder.doc()["nodes"][1]["children"].push_back(
+        builder.AddNode({{"name", "prop"}, {"mesh", prop_mesh}}));
+    builder.doc()["scenes"][0]["nodes"].push_back(eyes);
+    auto read = ReadGltf(builder.ToGlb());
+    ASSERT_TRUE(read.ok()) << read.status().ToString();
+    expect_character(*read);
+  }
+  {  // a second skin over the same joints in another order, its mesh in a shifted bind space
+    const Eigen::Vector3d shift(3, 0, 0);
+    GltfBuilder builder = ChainRig({{0, 0, 0}, {0, 1, 0}, {0, 2, 0}}, {RigidTubePrimitive(tube)});
+    builder.doc()["skins"].push_back(ShiftedSkin(&builder, {2, 1, 0}, shift));
+    PrimitiveData shifted = MovedTubePrimitive(tube, eye_offset - shift, 0.5);
+    for (std::uint8_t& joint : shifted.joints) joint = static_cast<std::uint8_t>(2 - joint);
+    for (std::size_t v = 0; v < shifted.joints.size(); v += 4) {
+      shifted.joints[v + 1] = shifted.joints[v + 2] = shifted.joints[v + 3] = 0;
+    }
+    const int eye_mesh = add_mesh(&builder, shifted);
+    const int eyes = builder.AddNode({{"name", "eyes"}, {"mesh", eye_mesh}, {"skin", 1}});
+    builder.doc()["scenes"][0]["nodes"].push_back(eyes);
+    auto read = ReadGltf(builder.ToGlb());
+    ASSERT_TRUE(read.ok()) << read.status().ToString();
+    expect_character(*read);
+    // Skins binding the joints in different poses (not one transform apart) are refused.
+    builder.doc()["skins"][1] = ShiftedSkin(&builder, {2, 1, 0}, {0, 0.5, 0});
+    builder.doc()["skins"][1]["inverseBindMatrices"] =
+        ShiftedSkin(&builder, {0, 2, 1}, {0, 0, 0})["inverseBindMatrices"];
+    ExpectRefused(builder.ToGlb(), StatusCode::kInvalidArgument,
+                  "skinned nodes must share one bind pose");
+  }
+}
+
+TEST(ReadGltf, WarnsOfAScaleImplausibleInMetres) {
+  for (const double scale : {1.0, 100.0, 0.001}) {
+    TestRig tube = Tube();
+    tube.mesh.vertices *= scale;
+    std::vector<Joint> joints = tube.skeleton.joints();
+    for (Joint& joint : joints) joint.rest_position *= scale;
+    tube.skeleton = *Skeleton::Create(joints, {{0, 1}, {1, 2}});
+    auto bytes = WriteGltf(tube.mesh, tube.skeleton, tube.weights, GltfContainer::kGlb);
+    ASSERT_TRUE(bytes.ok()) << bytes.status().ToString();
+    auto read = ReadGltf(*bytes);
+    ASSERT_TRUE(read.ok()) << read.status().ToString();
+    if (scale == 1.0) {
+      EXPECT_TRUE(read->warnings.empty()) << read->warnings.front();
+    } else {
+      ASSERT_EQ(read->warnings.size(), 1u) << "scale " << scale;
+      EXPECT_NE(read->warnings[0].find("implausible for a limb or a character"), std::string::npos)
+          << read->warnings[0];
+    }
+  }
+}
+
 TEST(ReadGltf, ReadsASecondInfluenceSet) {
   // Every vertex: joint 0 in JOINTS_0 with 0.25, joint 1 in JOINTS_1 with 0.75.
   const TestRig tube = Tube();

@@ -15,53 +15,48 @@ namespace deform::gltf_internal {
 
 using Normalization = AccessorSpec::IntegerNormalization;
 
-StatusOr<int> FindSkinnedNode(const tinygltf::Model& model) {
+StatusOr<std::vector<int>> FindSkinnedNodes(const tinygltf::Model& model) {
   std::vector<int> skinned;
   for (std::size_t n = 0; n < model.nodes.size(); ++n) {
-    if (model.nodes[n].mesh >= 0 && model.nodes[n].skin >= 0) {
-      skinned.push_back(static_cast<int>(n));
+    const tinygltf::Node& node = model.nodes[n];
+    if (node.mesh < 0 || node.skin < 0) continue;
+    if (static_cast<std::size_t>(node.mesh) >= model.meshes.size()) {
+      return Status::InvalidArgument("node " + std::to_string(n) + " refers to mesh " +
+                                     std::to_string(node.mesh) + ", which does not exist");
     }
+    if (static_cast<std::size_t>(node.skin) >= model.skins.size()) {
+      return Status::InvalidArgument("node " + std::to_string(n) + " refers to skin " +
+                                     std::to_string(node.skin) + ", which does not exist");
+    }
+    skinned.push_back(static_cast<int>(n));
   }
   if (skinned.empty()) {
     return Status::InvalidArgument(
         "no skin: the glTF has no node with both a mesh and a skin (export the mesh with its "
         "armature / skin, and its skinning weights)");
   }
-  if (skinned.size() > 1) {
-    return Status::InvalidArgument("the glTF has " + std::to_string(skinned.size()) +
-                                   " skinned mesh nodes (nodes " + std::to_string(skinned[0]) +
-                                   " and " + std::to_string(skinned[1]) +
-                                   "...); deformd deforms one: export the limb's mesh alone");
-  }
-  const tinygltf::Node& node = model.nodes[static_cast<std::size_t>(skinned[0])];
-  if (static_cast<std::size_t>(node.mesh) >= model.meshes.size()) {
-    return Status::InvalidArgument("node " + std::to_string(skinned[0]) + " refers to mesh " +
-                                   std::to_string(node.mesh) + ", which does not exist");
-  }
-  if (static_cast<std::size_t>(node.skin) >= model.skins.size()) {
-    return Status::InvalidArgument("node " + std::to_string(skinned[0]) + " refers to skin " +
-                                   std::to_string(node.skin) + ", which does not exist");
-  }
-  return skinned[0];
+  return skinned;
 }
 
-StatusOr<std::vector<SkinJoint>> ReadSkinJoints(const tinygltf::Model& model, int skin_index,
-                                                const SceneNodes& scene) {
+StatusOr<SkinBinds> ReadSkinBinds(const tinygltf::Model& model, int skin_index,
+                                  const SceneNodes& scene) {
   const tinygltf::Skin& skin = model.skins[static_cast<std::size_t>(skin_index)];
   const std::string where = "skin " + std::to_string(skin_index);
   if (skin.joints.empty()) return Status::InvalidArgument(where + " has no joints");
-  std::map<int, int> joint_of_node;
+  std::set<int> listed;
   for (std::size_t j = 0; j < skin.joints.size(); ++j) {
     const int node = skin.joints[j];
     if (node < 0 || static_cast<std::size_t>(node) >= model.nodes.size()) {
       return Status::InvalidArgument(where + "'s joint " + std::to_string(j) + " is node " +
                                      std::to_string(node) + ", which does not exist");
     }
-    if (!joint_of_node.emplace(node, static_cast<int>(j)).second) {
+    if (!listed.insert(node).second) {
       return Status::InvalidArgument(where + " lists node " + std::to_string(node) + " twice");
     }
   }
-  std::vector<SkinJoint> joints(skin.joints.size());
+  SkinBinds binds;
+  binds.joint_nodes = skin.joints;
+  binds.bind.resize(skin.joints.size());
   if (skin.inverseBindMatrices >= 0) {
     DEFORM_ASSIGN_OR_RETURN(const AccessorValues matrices,
                             ReadAccessor(model, skin.inverseBindMatrices,
@@ -76,7 +71,7 @@ StatusOr<std::vector<SkinJoint>> ReadSkinJoints(const tinygltf::Model& model, in
                                      " inverse bind matrices for " +
                                      std::to_string(skin.joints.size()) + " joints");
     }
-    for (std::size_t j = 0; j < joints.size(); ++j) {
+    for (std::size_t j = 0; j < skin.joints.size(); ++j) {
       Eigen::Matrix4d inverse_bind;
       for (int k = 0; k < 16; ++k) inverse_bind(k % 4, k / 4) = matrices.at(static_cast<int>(j), k);
       const Eigen::FullPivLU<Eigen::Matrix4d> lu(inverse_bind);
@@ -86,14 +81,24 @@ StatusOr<std::vector<SkinJoint>> ReadSkinJoints(const tinygltf::Model& model, in
         return Status::InvalidArgument(where + "'s inverse bind matrix " + std::to_string(j) +
                                        " is not invertible");
       }
-      joints[j].position = bind.block<3, 1>(0, 3);
+      binds.bind[j] = bind;
     }
   } else {
-    for (std::size_t j = 0; j < joints.size(); ++j) {
-      joints[j].position = scene.world[static_cast<std::size_t>(skin.joints[j])].block<3, 1>(0, 3);
+    for (std::size_t j = 0; j < skin.joints.size(); ++j) {
+      binds.bind[j] = scene.world[static_cast<std::size_t>(skin.joints[j])];
     }
   }
-  // Per node, the skin joint it is or the nearest one above it (-1: none), top-down.
+  return binds;
+}
+
+std::vector<SkinJoint> SkinJointsOf(const tinygltf::Model& model, const SkinBinds& binds,
+                                    const SceneNodes& scene) {
+  std::map<int, int> joint_of_node;
+  for (std::size_t j = 0; j < binds.joint_nodes.size(); ++j) {
+    joint_of_node.emplace(binds.joint_nodes[j], static_cast<int>(j));
+  }
+  std::vector<SkinJoint> joints(binds.joint_nodes.size());
+  // Per node, the joint it is or the nearest one above it (-1: none), top-down.
   std::vector<int> joint_at_or_above(model.nodes.size(), -1);
   for (int node : scene.parents_first) {
     const auto it = joint_of_node.find(node);
@@ -105,7 +110,8 @@ StatusOr<std::vector<SkinJoint>> ReadSkinJoints(const tinygltf::Model& model, in
   }
   std::set<std::string> names;
   for (std::size_t j = 0; j < joints.size(); ++j) {
-    const int node = skin.joints[j];
+    const int node = binds.joint_nodes[j];
+    joints[j].position = binds.bind[j].block<3, 1>(0, 3);
     std::string name = model.nodes[static_cast<std::size_t>(node)].name;
     if (name.empty()) name = "node" + std::to_string(node);
     std::string unique = name;
