@@ -2,8 +2,8 @@
 # deformctl deform's flags (ctest): deformctl_test.sh DEFORMCTL
 # On a small phantom: the ablation switches --joint-nodes and --material (default on/on, in the
 # JSON as joint_nodes_enabled and material_enabled, off removing the joint nodes or the material
-# weights), the methods cor and ddm (rest pose in, rest mesh out), the triangle counts in the JSON,
-# the bone surfaces (the phantom's, capsules, files; bone_penetration for every method) and the
+# weights; --material-profile 1,1,1 is --material off), the methods cor and ddm (rest pose in,
+# rest mesh out), the triangle counts in the JSON, the bone surfaces (the phantom's, capsules, files; bone_penetration for every method) and the
 # constraints (--contacts, --volume), and bad values (exit 2 for a flag CLI11 refuses, 1 for an
 # unknown method or a bad bone surface). Needs python3.
 set -euo pipefail
@@ -45,6 +45,12 @@ run "--joint-nodes off" 0 \
 run "--material off" 0 \
   "d['joint_nodes_enabled'] and not d['material_enabled'] and d['joint_nodes'] > 0" \
   --pose knee:flexion:90 --material off
+uniform=$(python3 -c "import json; print(json.load(open('$WORK/out'))['clearance_min'])")
+run "--material-profile 1,1,1 is every row weight 1" 0 \
+  "d['material_enabled'] and abs(d['clearance_min'] - $uniform) < 1e-12" \
+  --pose knee:flexion:90 --material-profile 1,1,1
+run "--material-profile 8,1,8 reaches the model" 0 \
+  "abs(d['clearance_min'] - $uniform) > 1e-6" --pose knee:flexion:90 --material-profile 8,1,8
 run "both off is the plain Laplacian's volume" 0 \
   "not d['joint_nodes_enabled'] and not d['material_enabled']" \
   --pose knee:flexion:90 --joint-nodes off --material off --contacts off --volume off
@@ -101,6 +107,8 @@ run "--bone-surface with an unknown bone is refused" 1 "" --bone-surface "$WORK/
 grep -q "no bone named 'elbow'" "$WORK/err" || { echo "FAIL: the refusal does not name the bone" >&2; failed=1; }
 run "--joint-nodes maybe is refused" 2 "" --joint-nodes maybe
 run "--material 0 is refused" 2 "" --material 0
+run "--material-profile with two weights is refused" 1 "" --material-profile 4,1
+run "--material-profile with a zero weight is refused" 1 "" --material-profile 0,1,4
 run "an unknown method is refused" 1 "" --method arap
 run "--rigid-weight-tolerance 0.6 is refused naming the flag" 1 "" --rigid-weight-tolerance 0.6
 grep -q -- "--rigid-weight-tolerance" "$WORK/err" ||

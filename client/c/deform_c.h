@@ -252,7 +252,7 @@ deform_stream_send_pose(deform_stream* stream, const deform_joint_angle* angles,
 DEFORM_C_API deform_status deform_stream_send_pose_text(deform_stream* stream, const char* pose,
                                                         uint64_t* sequence);
 
-/* The material of a joint's region: rigid (outside every region, default 4), soft (inside,
+/* The material of a joint's region: rigid (outside every region, default 2), soft (inside,
  * default 1), seam (the region's border, default 4). */
 typedef struct deform_joint_material {
   const char* joint;

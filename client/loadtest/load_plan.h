@@ -36,7 +36,7 @@ struct LoadPlan {
   double drain_s = 2.0;
 };
 
-// A StiffnessUpdate giving `joint` the material {rigid 4, soft `soft`, seam 4} (the defaults, but
+// A StiffnessUpdate giving `joint` the material {rigid 2, soft `soft`, seam 4} (the defaults, but
 // for the soft weight).
 deform::v1::StiffnessUpdate SoftWeightUpdate(const std::string& joint, double soft);
 

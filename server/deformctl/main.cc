@@ -3,6 +3,7 @@
 //   deformctl deform [--mesh FILE --skeleton FILE [--weights FILE] | --mesh RIG.glb] --pose SPEC
 //                    [--method paper|paper-linear|laplacian|lbs|dqs|cor|ddm] [--out FILE]
 //                    [--repeat N] [--joint-nodes on|off] [--material on|off]
+//                    [--material-profile RIGID,SOFT,SEAM]
 //                    [--laplacian uniform|cotangent|intrinsic]
 //                    [--bone-surface FILE:BONE ...] [--bones input|capsules|none]
 //                    [--contacts on|off] [--volume on|off] [--out-bones DIR]
@@ -22,6 +23,7 @@
 #include <vector>
 
 #include "core/base/build_info.h"
+#include "core/base/text.h"
 #include "core/constraints/skin_constraints.h"
 #include "core/eval/method_comparison.h"
 #include "core/io/bone_surface_io.h"
@@ -54,6 +56,7 @@ struct DeformArgs {
   int bone_surface_count = 0;      // set once they are loaded
   std::string joint_nodes = "on";  // off: ModelOptions::use_joint_nodes = false
   std::string material = "on";     // off: ModelOptions::uniform_material = true
+  std::string material_profile;    // RIGID,SOFT,SEAM: ModelOptions::default_material
   std::string laplacian = "uniform";
   double rigid_weight_tolerance = deform::ModelOptions{}.rigid_weight_tolerance;
 };
@@ -69,6 +72,29 @@ int Fail(const Status& status) {
   return 1;
 }
 
+// "RIGID,SOFT,SEAM" as a joint material, each weight checked by the material rule.
+StatusOr<deform::JointMaterial> MaterialProfileFromText(const std::string& text) {
+  double weights[3];
+  std::size_t start = 0;
+  for (int w = 0; w < 3; ++w) {
+    const std::size_t comma = w < 2 ? text.find(',', start) : text.size();
+    if (comma == std::string::npos ||
+        !deform::ParseFiniteDouble(std::string_view(text).substr(start, comma - start),
+                                   &weights[w])) {
+      return deform::Status::InvalidArgument(
+          "--material-profile takes RIGID,SOFT,SEAM (three numbers), got '" + text + "'");
+    }
+    start = comma + 1;
+  }
+  if (start <= text.size()) {
+    return deform::Status::InvalidArgument(
+        "--material-profile takes RIGID,SOFT,SEAM (three numbers), got '" + text + "'");
+  }
+  const deform::JointMaterial material{weights[0], weights[1], weights[2]};
+  DEFORM_RETURN_IF_ERROR(deform::CheckJointMaterial(material, "--material-profile"));
+  return material;
+}
+
 // The paper's options with the command line's region radius factor, ordering, Laplacian weights
 // and ablation switches (the joint nodes, the material weights).
 StatusOr<deform::ModelOptions> ModelOptionsFrom(const DeformArgs& args) {
@@ -76,6 +102,10 @@ StatusOr<deform::ModelOptions> ModelOptionsFrom(const DeformArgs& args) {
   options.regions.radius_factor = args.radius_factor;
   options.use_joint_nodes = args.joint_nodes == "on";
   options.uniform_material = args.material == "off";
+  if (!args.material_profile.empty()) {
+    DEFORM_ASSIGN_OR_RETURN(options.default_material,
+                            MaterialProfileFromText(args.material_profile));
+  }
   options.rigid_weight_tolerance = args.rigid_weight_tolerance;
   DEFORM_ASSIGN_OR_RETURN(options.ordering, deform::OrderingFromName(args.ordering));
   DEFORM_ASSIGN_OR_RETURN(options.laplacian, deform::LaplacianWeightsFromName(args.laplacian));
@@ -327,6 +357,9 @@ CLI::App* AddDeformCommand(CLI::App* app, DeformArgs* args) {
   AddWithDefault(command, "--material", &args->material,
                  "Material weights (off: every row weight 1, for ablation)")
       ->check(CLI::IsMember({"on", "off"}));
+  command->add_option("--material-profile", args->material_profile,
+                      "The default material profile RIGID,SOFT,SEAM (relative row weights far "
+                      "from a joint, in its region, on the region's border)");
   AddWithDefault(command, "--laplacian", &args->laplacian,
                  "Laplacian edge weights: uniform | cotangent | intrinsic (intrinsic Delaunay "
                  "cotangent)");

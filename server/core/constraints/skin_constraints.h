@@ -43,8 +43,8 @@ struct ConstraintOptions {
   // bounding-box diagonal. Default: 1e-3.
   double contact_margin = 1e-3;
   // At most this many contact constraints in a frame (the k of the low-rank terms); a frame that
-  // needs more is flagged unresolved. In [0, kMaxContacts]. Default: 64.
-  int max_contacts = 64;
+  // needs more is flagged unresolved. In [0, kMaxContacts]. Default: 128.
+  int max_contacts = 128;
   static constexpr int kMaxContacts = 256;
   // Keep the enclosed volume of the skin (an open skin closed by a fan at each boundary loop)
   // within volume_tolerance of its rest volume, relative. Default: on.

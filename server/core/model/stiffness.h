@@ -14,7 +14,7 @@ namespace deform {
 
 // The material profile around one joint. Weights are relative; a heavier row changes less.
 struct JointMaterial {
-  double rigid = 4.0;  // vertices outside every joint region (nearest joint's profile). Default: 4
+  double rigid = 2.0;  // vertices outside every joint region (nearest joint's profile). Default: 2
   double soft = 1.0;   // vertices inside this joint's region. Default: 1
   double seam = 4.0;   // vertices of the region on its border. Default: 4
 };
