@@ -22,4 +22,9 @@ struct deform_mesh {
   bool geometry_loaded = false;  // guarded by geometry_mutex, as are the two below
   std::vector<float> rest_positions;
   std::vector<std::uint32_t> triangles;
+  struct BoneSurfaceGeometry {
+    std::vector<float> rest_positions;
+    std::vector<std::uint32_t> triangles;
+  };
+  std::vector<BoneSurfaceGeometry> bone_surfaces;  // MeshSummary.bone_surfaces' order
 };

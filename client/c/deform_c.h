@@ -141,6 +141,15 @@ DEFORM_C_API deform_status deform_load_phantom(deform_client* client, int vertic
 DEFORM_C_API deform_status deform_load_files(deform_client* client, const char* mesh_path,
                                              const char* skeleton_path, const char* weights_path,
                                              deform_mesh** out);
+/* deform_load_files with bone surfaces: `bone_surfaces` holds `bone_surface_count` specs
+ * "FILE:BONE", FILE a closed mesh (.obj .ply .stl .off) in the skin's units and frame, BONE the
+ * bone that carries it (a bone index, "HEAD-TAIL", or the joint it starts at; the first ':'
+ * splits, so BONE may hold colons). A glTF rig's own bone surfaces (unskinned mesh nodes under its
+ * joints) come first and need no spec. `bone_surfaces` may be NULL when the count is 0. */
+DEFORM_C_API deform_status deform_load_files_with_bones(
+    deform_client* client, const char* mesh_path, const char* skeleton_path,
+    const char* weights_path, const char* const* bone_surfaces, size_t bone_surface_count,
+    deform_mesh** out);
 /* A handle for a mesh already on the server (e.g. from deform_list_meshes). NOT_FOUND when the
  * server has no mesh with that id (or none this client's token may see). */
 DEFORM_C_API deform_status deform_mesh_open(deform_client* client, const char* mesh_id,
@@ -181,6 +190,30 @@ DEFORM_C_API deform_status deform_mesh_joint(const deform_mesh* mesh, uint32_t j
                                              deform_joint_info* info);
 DEFORM_C_API deform_status deform_mesh_joint_dof(const deform_mesh* mesh, uint32_t joint,
                                                  uint32_t dof, deform_dof_info* info);
+
+/* The mesh's bone surfaces (the skin is kept outside them; frames carry their motion, see
+ * deform_stream_frame_bones), in the server's order. */
+typedef struct deform_bone_surface_info {
+  const char* name;      /* owned by the mesh handle */
+  uint32_t bone;         /* the bone that carries it */
+  int32_t blend_bone;    /* a child bone whose rotation it partly follows (a patella); -1: none */
+  float blend;           /* the fraction it follows, with blend_bone */
+  uint32_t vertex_count; /* of its rest geometry */
+  uint32_t triangle_count;
+} deform_bone_surface_info;
+DEFORM_C_API deform_status deform_mesh_bone_surface_count(const deform_mesh* mesh, uint32_t* count);
+/* OUT_OF_RANGE for an index past the end. */
+DEFORM_C_API deform_status deform_mesh_bone_surface(const deform_mesh* mesh, uint32_t surface,
+                                                    deform_bone_surface_info* info);
+/* Surface `surface`'s rest geometry (fetched with the skin's, once per handle), as
+ * deform_mesh_rest_geometry gives the skin's: 3 * vertex_count floats, 3 * triangle_count
+ * indices; either may be NULL. INVALID_ARGUMENT, nothing written, for a capacity too small;
+ * OUT_OF_RANGE for an index past the end. */
+DEFORM_C_API deform_status deform_mesh_bone_surface_geometry(deform_mesh* mesh, uint32_t surface,
+                                                             float* positions,
+                                                             size_t capacity_floats,
+                                                             uint32_t* triangles,
+                                                             size_t capacity_indices);
 
 /* The ids of the meshes on the server (those this client's token may see), one per line, each
  * followed by '\n', the whole NUL-terminated, into `buffer`. *needed (may be NULL) receives the

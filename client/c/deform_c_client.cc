@@ -76,13 +76,50 @@ deform_status LoadGeometryLocked(deform_mesh* mesh) {
                     std::to_string(info.rest_positions().size()) + " position bytes, " +
                     std::to_string(info.triangles().size()) + " triangle bytes)");
   }
+  const int surfaces = mesh->summary.bone_surfaces_size();
+  if (info.bone_surfaces_size() != surfaces) {
+    return Fail(DEFORM_INTERNAL, "deform_mesh_rest_geometry: the server sent " +
+                                     std::to_string(info.bone_surfaces_size()) +
+                                     " bone surfaces' geometry for " + std::to_string(surfaces) +
+                                     " bone surfaces");
+  }
+  std::vector<deform_mesh::BoneSurfaceGeometry> bones(static_cast<std::size_t>(surfaces));
+  for (int s = 0; s < surfaces; ++s) {
+    const v1::BoneSurfaceInfo& summary = mesh->summary.bone_surfaces(s);
+    const v1::BoneSurfaceGeometry& geometry = info.bone_surfaces(s);
+    const std::size_t bone_floats = 3 * static_cast<std::size_t>(summary.vertex_count());
+    const std::size_t bone_indices = 3 * static_cast<std::size_t>(summary.triangle_count());
+    if (geometry.rest_positions().size() != 4 * bone_floats ||
+        geometry.triangles().size() != 4 * bone_indices) {
+      return Fail(DEFORM_INTERNAL, "deform_mesh_rest_geometry: bone surface " + std::to_string(s) +
+                                       "'s geometry does not match its counts");
+    }
+    bones[static_cast<std::size_t>(s)].rest_positions.resize(bone_floats);
+    std::memcpy(bones[static_cast<std::size_t>(s)].rest_positions.data(),
+                geometry.rest_positions().data(), 4 * bone_floats);
+    bones[static_cast<std::size_t>(s)].triangles.resize(bone_indices);
+    std::memcpy(bones[static_cast<std::size_t>(s)].triangles.data(), geometry.triangles().data(),
+                4 * bone_indices);
+  }
   // Little-endian on the wire and on every host this library builds for.
   mesh->rest_positions.resize(floats);
   std::memcpy(mesh->rest_positions.data(), info.rest_positions().data(), 4 * floats);
   mesh->triangles.resize(indices);
   std::memcpy(mesh->triangles.data(), info.triangles().data(), 4 * indices);
+  mesh->bone_surfaces = std::move(bones);
   mesh->geometry_loaded = true;
   return Succeed();
+}
+
+const v1::BoneSurfaceInfo* FindBoneSurface(const deform_mesh* mesh, std::uint32_t surface,
+                                           const char* function, deform_status* status) {
+  if (surface >= static_cast<std::uint32_t>(mesh->summary.bone_surfaces_size())) {
+    *status = Fail(DEFORM_OUT_OF_RANGE, std::string(function) + ": bone surface " +
+                                            std::to_string(surface) + " of a mesh with " +
+                                            std::to_string(mesh->summary.bone_surfaces_size()));
+    return nullptr;
+  }
+  return &mesh->summary.bone_surfaces(static_cast<int>(surface));
 }
 
 static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "the wire format is little-endian");
@@ -146,6 +183,33 @@ deform_status deform_load_files(deform_client* client, const char* mesh_path,
         mesh_path, deform::c_api::Text(skeleton_path), deform::v1::MethodOptions(), &summary, {},
         deform::c_api::Text(weights_path));
     if (!loaded.ok()) return FromGrpc(loaded, "deform_load_files");
+    return deform::c_api::MakeMesh(client->client, summary, out);
+  });
+}
+
+deform_status deform_load_files_with_bones(deform_client* client, const char* mesh_path,
+                                           const char* skeleton_path, const char* weights_path,
+                                           const char* const* bone_surfaces,
+                                           size_t bone_surface_count, deform_mesh** out) {
+  const char* const fn = __func__;
+  return Guarded(fn, {{client, "client"}, {mesh_path, "mesh_path"}, {out, "out"}}, [&] {
+    if (bone_surface_count > 0 && bone_surfaces == nullptr) {
+      return Fail(DEFORM_INVALID_ARGUMENT, std::string(fn) + ": bone_surfaces is NULL with " +
+                                               std::to_string(bone_surface_count) + " specs");
+    }
+    std::vector<std::string> specs;
+    for (std::size_t i = 0; i < bone_surface_count; ++i) {
+      if (bone_surfaces[i] == nullptr) {
+        return Fail(DEFORM_INVALID_ARGUMENT,
+                    std::string(fn) + ": bone_surfaces[" + std::to_string(i) + "] is NULL");
+      }
+      specs.emplace_back(bone_surfaces[i]);
+    }
+    deform::v1::MeshSummary summary;
+    const grpc::Status loaded = client->client->LoadMeshFiles(
+        mesh_path, deform::c_api::Text(skeleton_path), deform::v1::MethodOptions(), &summary, {},
+        deform::c_api::Text(weights_path), specs);
+    if (!loaded.ok()) return FromGrpc(loaded, fn);
     return deform::c_api::MakeMesh(client->client, summary, out);
   });
 }
@@ -252,6 +316,63 @@ deform_status deform_mesh_joint_dof(const deform_mesh* mesh, uint32_t joint, uin
     }
     info->min_degrees = static_cast<float>(d.min_degrees());
     info->max_degrees = static_cast<float>(d.max_degrees());
+    return Succeed();
+  });
+}
+
+deform_status deform_mesh_bone_surface_count(const deform_mesh* mesh, uint32_t* count) {
+  return Get(__func__, mesh, "mesh", count, "count", [](const deform_mesh& m) {
+    return static_cast<uint32_t>(m.summary.bone_surfaces_size());
+  });
+}
+
+deform_status deform_mesh_bone_surface(const deform_mesh* mesh, uint32_t surface,
+                                       deform_bone_surface_info* info) {
+  const char* const fn = __func__;
+  return Guarded(fn, {{mesh, "mesh"}, {info, "info"}}, [&] {
+    deform_status status;
+    const deform::v1::BoneSurfaceInfo* found =
+        deform::c_api::FindBoneSurface(mesh, surface, fn, &status);
+    if (found == nullptr) return status;
+    info->name = found->name().c_str();
+    info->bone = found->bone();
+    info->blend_bone = found->blend_bone();
+    info->blend = static_cast<float>(found->blend());
+    info->vertex_count = found->vertex_count();
+    info->triangle_count = found->triangle_count();
+    return Succeed();
+  });
+}
+
+deform_status deform_mesh_bone_surface_geometry(deform_mesh* mesh, uint32_t surface,
+                                                float* positions, size_t capacity_floats,
+                                                uint32_t* triangles, size_t capacity_indices) {
+  const char* const fn = __func__;
+  return Guarded(fn, {{mesh, "mesh"}}, [&] {
+    deform_status status;
+    const deform::v1::BoneSurfaceInfo* found =
+        deform::c_api::FindBoneSurface(mesh, surface, fn, &status);
+    if (found == nullptr) return status;
+    const std::size_t floats = 3 * static_cast<std::size_t>(found->vertex_count());
+    const std::size_t indices = 3 * static_cast<std::size_t>(found->triangle_count());
+    if ((positions != nullptr && capacity_floats < floats) ||
+        (triangles != nullptr && capacity_indices < indices)) {
+      return Fail(DEFORM_INVALID_ARGUMENT,
+                  std::string(fn) + ": bone surface " + std::to_string(surface) + " needs " +
+                      std::to_string(floats) + " floats and " + std::to_string(indices) +
+                      " indices; given room for " + std::to_string(capacity_floats) + " and " +
+                      std::to_string(capacity_indices));
+    }
+    std::lock_guard<std::mutex> lock(mesh->geometry_mutex);
+    status = deform::c_api::LoadGeometryLocked(mesh);
+    if (status != DEFORM_OK) return status;
+    const deform_mesh::BoneSurfaceGeometry& geometry = mesh->bone_surfaces[surface];
+    if (positions != nullptr) {
+      std::memcpy(positions, geometry.rest_positions.data(), sizeof(float) * floats);
+    }
+    if (triangles != nullptr) {
+      std::memcpy(triangles, geometry.triangles.data(), sizeof(std::uint32_t) * indices);
+    }
     return Succeed();
   });
 }

@@ -74,21 +74,13 @@ int Fail(const Status& status) {
 
 // "RIGID,SOFT,SEAM" as a joint material, each weight checked by the material rule.
 StatusOr<deform::JointMaterial> MaterialProfileFromText(const std::string& text) {
+  const std::vector<std::string_view> fields = deform::Split(text, ',');
   double weights[3];
-  std::size_t start = 0;
-  for (int w = 0; w < 3; ++w) {
-    const std::size_t comma = w < 2 ? text.find(',', start) : text.size();
-    if (comma == std::string::npos ||
-        !deform::ParseFiniteDouble(std::string_view(text).substr(start, comma - start),
-                                   &weights[w])) {
+  for (std::size_t w = 0; w < 3; ++w) {
+    if (fields.size() != 3 || !deform::ParseFiniteDouble(fields[w], &weights[w])) {
       return deform::Status::InvalidArgument(
           "--material-profile takes RIGID,SOFT,SEAM (three numbers), got '" + text + "'");
     }
-    start = comma + 1;
-  }
-  if (start <= text.size()) {
-    return deform::Status::InvalidArgument(
-        "--material-profile takes RIGID,SOFT,SEAM (three numbers), got '" + text + "'");
   }
   const deform::JointMaterial material{weights[0], weights[1], weights[2]};
   DEFORM_RETURN_IF_ERROR(deform::CheckJointMaterial(material, "--material-profile"));

@@ -354,6 +354,29 @@ static void test_phantom_session(const char* target) {
   CHECK(constraints.constrained && constraints.penetrating_after == 0 && !constraints.unresolved);
   CHECK(fabs(bones[0] + bones[4] + bones[8] - 3.0) < 1e-5);
   CHECK(fabs(bones[12] + bones[16] + bones[20] - 1.0) < 1e-5);
+  /* Their descriptions and rest geometry, as the frames' motions apply to them. */
+  uint32_t surfaces = 0;
+  CHECK(deform_mesh_bone_surface_count(mesh, &surfaces) == DEFORM_OK && surfaces == 3);
+  deform_bone_surface_info surface;
+  CHECK(deform_mesh_bone_surface(mesh, 3, &surface) == DEFORM_OUT_OF_RANGE);
+  CHECK(deform_mesh_bone_surface(mesh, 0, &surface) == DEFORM_OK);
+  CHECK(strcmp(surface.name, "femur") == 0 && surface.bone == 0 && surface.blend_bone == -1);
+  CHECK(surface.vertex_count > 0 && surface.triangle_count > 0);
+  CHECK(deform_mesh_bone_surface(mesh, 2, &surface) == DEFORM_OK);
+  CHECK(strcmp(surface.name, "patella") == 0 && surface.blend_bone == 1 && surface.blend > 0);
+  float* bone_rest = malloc(sizeof(float) * 3 * surface.vertex_count);
+  uint32_t* bone_triangles = malloc(sizeof(uint32_t) * 3 * surface.triangle_count);
+  CHECK(bone_rest != NULL && bone_triangles != NULL);
+  CHECK(deform_mesh_bone_surface_geometry(mesh, 2, bone_rest, 3 * surface.vertex_count - 1, NULL,
+                                          0) == DEFORM_INVALID_ARGUMENT);
+  CHECK(deform_mesh_bone_surface_geometry(mesh, 2, bone_rest, 3 * surface.vertex_count,
+                                          bone_triangles, 3 * surface.triangle_count) == DEFORM_OK);
+  for (uint32_t k = 0; k < 3 * surface.triangle_count; ++k) {
+    CHECK(bone_triangles[k] < surface.vertex_count);
+  }
+  CHECK(isfinite(bone_rest[0]) && isfinite(bone_rest[3 * surface.vertex_count - 1]));
+  free(bone_rest);
+  free(bone_triangles);
 
   /* The thigh's far part (beyond 60% of the way from the knee to the hip) does not move; the shin
    * below its middle swings: each vertex moves by more than its distance below the knee (a 90-
@@ -624,6 +647,65 @@ static void test_files(const char* target) {
   CHECK(moved > 1.0);
   CHECK(deform_stream_close(stream, 5000) == DEFORM_OK);
   deform_stream_free(stream);
+
+  /* The same leg with a bone surface: an octahedron around the middle of its first bone (a
+   * twentieth of the bone's length in radius), uploaded from a file and carried by bone 0. */
+  deform_joint_info head, tail;
+  CHECK(deform_mesh_joint(mesh, 0, &head) == DEFORM_OK &&
+        deform_mesh_joint(mesh, 1, &tail) == DEFORM_OK);
+  const double radius = distance(head.rest_position, tail.rest_position) / 20;
+  char bone_dir[] = "/tmp/deform-c-api-bone-XXXXXX";
+  CHECK(mkdtemp(bone_dir) != NULL);
+  char bone_path[600];
+  snprintf(bone_path, sizeof bone_path, "%s/bone.obj", bone_dir);
+  FILE* obj_file = fopen(bone_path, "w");
+  CHECK(obj_file != NULL);
+  static const int kAxes[6][3] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                  {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
+  for (int v = 0; v < 6; ++v) {
+    fprintf(obj_file, "v");
+    for (int c = 0; c < 3; ++c) {
+      fprintf(obj_file, " %.9g",
+              (head.rest_position[c] + tail.rest_position[c]) / 2 + radius * kAxes[v][c]);
+    }
+    fprintf(obj_file, "\n");
+  }
+  /* Outward: each face's corners counter-clockwise seen from outside. */
+  fputs("f 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n", obj_file);
+  CHECK(fclose(obj_file) == 0);
+  char spec[700];
+  snprintf(spec, sizeof spec, "%s:0", bone_path);
+  const char* specs[1] = {spec};
+  deform_mesh* with_bone = NULL;
+  CHECK(deform_load_files_with_bones(client, obj, tgf, NULL, NULL, 1, &with_bone) ==
+        DEFORM_INVALID_ARGUMENT);
+  CHECK(deform_load_files_with_bones(client, obj, tgf, NULL, specs, 1, &with_bone) == DEFORM_OK);
+  unlink(bone_path);
+  rmdir(bone_dir);
+  uint32_t surfaces = 0;
+  CHECK(deform_mesh_bone_surface_count(with_bone, &surfaces) == DEFORM_OK && surfaces == 1);
+  deform_bone_surface_info surface;
+  CHECK(deform_mesh_bone_surface(with_bone, 0, &surface) == DEFORM_OK);
+  CHECK(strcmp(surface.name, "bone") == 0 && surface.bone == 0);
+  CHECK(surface.vertex_count == 6 && surface.triangle_count == 8);
+  float octahedron[18];
+  CHECK(deform_mesh_bone_surface_geometry(with_bone, 0, octahedron, 18, NULL, 0) == DEFORM_OK);
+  CHECK(fabs(octahedron[0] - ((head.rest_position[0] + tail.rest_position[0]) / 2 + radius)) <
+        1e-4 * (1 + radius));
+  const char* with_bone_id = NULL;
+  CHECK(deform_mesh_id(with_bone, &with_bone_id) == DEFORM_OK);
+  CHECK(deform_stream_open(client, with_bone_id, DEFORM_ENCODING_FLOAT32, 0, &stream) == DEFORM_OK);
+  CHECK(deform_stream_send_pose_text(stream, "1:x:90", &sequence) == DEFORM_OK);
+  frame_for(stream, sequence, frame, floats, &info);
+  float motion[12];
+  deform_frame_constraints constraints;
+  CHECK(deform_stream_frame_bones(stream, motion, 12, &constraints) == DEFORM_OK);
+  CHECK(constraints.bone_surface_count == 1 && constraints.constrained);
+  CHECK(deform_stream_close(stream, 5000) == DEFORM_OK);
+  deform_stream_free(stream);
+  CHECK(deform_unload_mesh(client, with_bone_id) == DEFORM_OK);
+  deform_mesh_free(with_bone);
+
   CHECK(deform_unload_mesh(client, mesh_id) == DEFORM_OK);
   deform_mesh_free(mesh);
   deform_client_free(client);

@@ -165,13 +165,14 @@ class DeformClient:
         return self._load(header, None, progress)
 
     def load_files(self, mesh, skeleton=None, weights=None, *, name=None, options=None,
-                   progress=None, bone_surfaces=()):
+                   progress=None, bone_surfaces=(), gltf_bone_nodes=True):
         """Uploads a mesh file (.obj .ply .stl .off, or a .gltf/.glb rig that carries skeleton and
         weights: then neither is given) with its skeleton (.tgf, else the project's JSON) and
         optionally the rig's skinning weights (.csv, else DMAT). `bone_surfaces`: closed meshes
         inside the skin (.obj .ply .stl .off), each "FILE:BONE" or a (file, bone) pair, BONE a
-        bone index, "HEAD-TAIL" or the joint the bone starts at; named after their files.
-        Returns the MeshSummary."""
+        bone index, "HEAD-TAIL" or the joint the bone starts at; named after their files. A glTF
+        rig's own bone surfaces (unskinned mesh nodes under its joints that are bones) come first;
+        `gltf_bone_nodes=False` leaves them out. Returns the MeshSummary."""
         mesh = pathlib.Path(mesh)
         mesh_format = _MESH_FORMATS.get(mesh.suffix.lower())
         if mesh_format is None:
@@ -191,6 +192,7 @@ class DeformClient:
                                      else pb.SKIN_WEIGHTS_FORMAT_DMAT)
         for surface in bone_surfaces:
             upload.bone_surfaces.append(_bone_surface_upload(surface))
+        upload.skip_gltf_bone_nodes = not gltf_bone_nodes
         header = pb.LoadMeshHeader(name=name or mesh.name, upload=upload)
         if options is not None:
             header.options.CopyFrom(options)

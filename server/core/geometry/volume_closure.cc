@@ -70,6 +70,25 @@ void VolumeClosure::Centroid(const double* xyz, const Loop& loop, double* c) con
   centroid = sum / (2.0 * loop.edges);
 }
 
+TriangleMesh VolumeClosure::ClosedMesh(const Positions& positions) const {
+  TriangleMesh closed;
+  closed.vertices.resize(num_vertices_ + static_cast<Eigen::Index>(loops_.size()), 3);
+  closed.vertices.topRows(num_vertices_) = positions.topRows(num_vertices_);
+  closed.triangles.resize(triangles_.rows() + static_cast<Eigen::Index>(boundary_.size() / 2), 3);
+  closed.triangles.topRows(triangles_.rows()) = triangles_;
+  Eigen::Index row = triangles_.rows();
+  for (std::size_t l = 0; l < loops_.size(); ++l) {
+    const int centre = num_vertices_ + static_cast<int>(l);
+    double centroid[3];
+    Centroid(positions.data(), loops_[l], centroid);
+    closed.vertices.row(centre) << centroid[0], centroid[1], centroid[2];
+    for (int e = loops_[l].first_edge; e < loops_[l].first_edge + loops_[l].edges; ++e) {
+      closed.triangles.row(row++) << centre, boundary_[2 * e + 1], boundary_[2 * e];
+    }
+  }
+  return closed;
+}
+
 double VolumeClosure::Volume(const double* xyz) const {
   double six_volume = 0;
   for (int f = 0; f < triangles_.rows(); ++f) {

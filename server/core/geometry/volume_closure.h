@@ -25,6 +25,11 @@ class VolumeClosure {
   // cubic: the volume is a sum of triple products). No allocation.
   void VolumeAlong(const double* xyz, const double* direction, double c[4]) const;
 
+  // The closure as a mesh at `positions` (num_vertices rows): the mesh's triangles, then each
+  // boundary loop's fan, its centroid a vertex appended after the mesh's (one per loop, in loop
+  // order). What a point-inside test on an open skin (a limb cut at its ends) asks.
+  TriangleMesh ClosedMesh(const Positions& positions) const;
+
   int num_vertices() const { return num_vertices_; }
   bool closed() const { return loops_.empty(); }
 

@@ -113,10 +113,43 @@ std::string GlbBytes(const std::string& json_text, std::string binary) {
   return out;
 }
 
+// Adds surface `surface` as a mesh (positions, indices) and a node under its bone's head joint
+// node, placed in that joint's frame (a translation by the joint's rest position).
+void AddBoneSurface(const BoneSurface& surface, const Skeleton& skeleton, BufferBuilder* buffer,
+                    nlohmann::json* doc, std::vector<std::vector<int>>* children) {
+  const int joint = skeleton.bone(surface.bone).head_joint;
+  const Eigen::Vector3d origin = skeleton.joint(joint).rest_position;
+  std::vector<float> positions;
+  for (int v = 0; v < surface.mesh.num_vertices(); ++v) {
+    for (int c = 0; c < 3; ++c) {
+      positions.push_back(static_cast<float>(surface.mesh.vertices(v, c) - origin[c]));
+    }
+  }
+  std::vector<std::uint32_t> indices;
+  for (Eigen::Index t = 0; t < surface.mesh.triangles.rows(); ++t) {
+    for (int c = 0; c < 3; ++c) {
+      indices.push_back(static_cast<std::uint32_t>(surface.mesh.triangles(t, c)));
+    }
+  }
+  nlohmann::json attributes;
+  attributes["POSITION"] = buffer->Add(positions, kFloat, "VEC3", surface.mesh.num_vertices());
+  const int index_accessor =
+      buffer->Add(indices, kUnsignedInt, "SCALAR", static_cast<int>(indices.size()));
+  (*doc)["meshes"].push_back(
+      {{"primitives", {{{"attributes", attributes}, {"indices", index_accessor}, {"mode", 4}}}}});
+  (*doc)["nodes"].push_back(
+      {{"name", surface.name}, {"mesh", static_cast<int>((*doc)["meshes"].size()) - 1}});
+  (*children)[static_cast<std::size_t>(joint)].push_back(static_cast<int>((*doc)["nodes"].size()) -
+                                                         1);
+}
+
 }  // namespace
 
 StatusOr<std::string> WriteGltf(const TriangleMesh& mesh, const Skeleton& skeleton,
-                                const SkinWeights& weights, GltfContainer container) {
+                                const SkinWeights& weights, GltfContainer container,
+                                const std::vector<BoneSurface>& bone_surfaces) {
+  DEFORM_RETURN_IF_ERROR(
+      ValidateBoneSurfaces(bone_surfaces, skeleton).WithContext("cannot write glTF bone surfaces"));
   DEFORM_ASSIGN_OR_RETURN(const SkinWeights normalized,
                           NormalizeSkinWeights(weights, mesh.num_vertices(), skeleton.num_bones()));
   if (skeleton.num_joints() > 65536) {
@@ -150,11 +183,6 @@ StatusOr<std::string> WriteGltf(const TriangleMesh& mesh, const Skeleton& skelet
     (parent < 0 ? roots : children[static_cast<std::size_t>(parent)]).push_back(j);
     doc["nodes"].push_back(
         {{"name", skeleton.joint(j).name}, {"translation", {offset.x(), offset.y(), offset.z()}}});
-  }
-  for (int j = 0; j < num_joints; ++j) {
-    if (!children[static_cast<std::size_t>(j)].empty()) {
-      doc["nodes"][static_cast<std::size_t>(j)]["children"] = children[static_cast<std::size_t>(j)];
-    }
   }
   std::vector<float> inverse_binds;
   for (int j = 0; j < num_joints; ++j) {
@@ -219,6 +247,14 @@ StatusOr<std::string> WriteGltf(const TriangleMesh& mesh, const Skeleton& skelet
       {{"primitives", {{{"attributes", attributes}, {"indices", index_accessor}, {"mode", 4}}}}}};
   doc["nodes"].push_back({{"name", "mesh"}, {"mesh", 0}, {"skin", 0}});
   roots.push_back(num_joints);
+  for (const BoneSurface& surface : bone_surfaces) {
+    AddBoneSurface(surface, skeleton, &buffer, &doc, &children);
+  }
+  for (int j = 0; j < num_joints; ++j) {
+    if (!children[static_cast<std::size_t>(j)].empty()) {
+      doc["nodes"][static_cast<std::size_t>(j)]["children"] = children[static_cast<std::size_t>(j)];
+    }
+  }
   doc["scenes"] = {{{"nodes", roots}}};
   doc["scene"] = 0;
 
@@ -233,7 +269,7 @@ StatusOr<std::string> WriteGltf(const TriangleMesh& mesh, const Skeleton& skelet
 }
 
 Status WriteGltfFile(const std::string& path, const TriangleMesh& mesh, const Skeleton& skeleton,
-                     const SkinWeights& weights) {
+                     const SkinWeights& weights, const std::vector<BoneSurface>& bone_surfaces) {
   const std::string extension = path.substr(std::min(path.size(), path.rfind('.')));
   GltfContainer container;
   if (mesh_io_internal::EqualsIgnoreCase(extension, ".gltf")) {
@@ -243,7 +279,8 @@ Status WriteGltfFile(const std::string& path, const TriangleMesh& mesh, const Sk
   } else {
     return Status::InvalidArgument("cannot write " + path + ": expected a .gltf or .glb name");
   }
-  DEFORM_ASSIGN_OR_RETURN(const std::string bytes, WriteGltf(mesh, skeleton, weights, container));
+  DEFORM_ASSIGN_OR_RETURN(const std::string bytes,
+                          WriteGltf(mesh, skeleton, weights, container, bone_surfaces));
   std::ofstream out(path, std::ios::binary);
   if (!out) return Status::NotFound("cannot write " + path);
   out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));

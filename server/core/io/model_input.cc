@@ -34,6 +34,7 @@ StatusOr<ModelInput> LoadGltfRig(const std::string& path, const MeshLimits& limi
   input.units = std::move(rig.units);
   input.up_axis = std::move(rig.up_axis);
   input.warnings = std::move(rig.warnings);
+  input.bones = std::move(rig.bone_surfaces);
   input.description = path;
   return input;
 }

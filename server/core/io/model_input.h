@@ -27,7 +27,8 @@ struct ModelInput {
   std::string up_axis;                // "+Y" for glTF; empty when the file does not say
   std::string description;            // "phantom:2000" or the mesh path, for logs
   std::vector<std::string> warnings;  // a glTF rig's (RigImport::warnings); empty otherwise
-  // Bone surfaces that came with the input: the phantom's femur, tibia and patella.
+  // Bone surfaces that came with the input: the phantom's femur, tibia and patella, a glTF rig's
+  // (RigImport::bone_surfaces).
   std::vector<BoneSurface> bones;
 };
 

@@ -1,8 +1,9 @@
 // The glTF rig import: bytes -> tinygltf::Model (internal/gltf_load), the node hierarchy
 // (internal/gltf_scene), every skinned node's mesh and the union of their skins' joints
 // (internal/gltf_character over internal/gltf_skin and internal/gltf_skinned_mesh), the skeleton
-// (internal/gltf_rig_skeleton), weights mapped from joints to bones here, and welding
-// (internal/gltf_weld).
+// (internal/gltf_rig_skeleton), weights mapped from joints to bones here, welding
+// (internal/gltf_weld), and the bone surfaces among the unskinned mesh nodes
+// (internal/gltf_bone_nodes).
 #include "core/io/rig_import.h"
 
 #include <filesystem>
@@ -12,6 +13,7 @@
 #include <vector>
 
 #include "internal/file_bytes.h"
+#include "internal/gltf_bone_nodes.h"
 #include "internal/gltf_character.h"
 #include "internal/gltf_load.h"
 #include "internal/gltf_rig_skeleton.h"
@@ -108,7 +110,12 @@ StatusOr<RigImport> ReadGltfUnguarded(std::string_view bytes, const MeshLimits& 
       gltf_internal::WeldSeams(file.positions, file_weights, file.triangles);
   DEFORM_RETURN_IF_ERROR(
       ValidateMesh(welded.mesh, limits).WithContext("the glTF's skinned mesh (welded)"));
+  std::vector<std::string> result_warnings;
+  std::vector<gltf_internal::BoneNodeMesh> bone_nodes = gltf_internal::ReadBoneNodeMeshes(
+      model, scene, character, limits, BoneSurfaceLimits{}, &result_warnings);
   RigImport result;
+  result.bone_surfaces = gltf_internal::SelectBoneSurfaces(std::move(bone_nodes), joints, rig,
+                                                           welded.mesh, &result_warnings);
   result.mesh = std::move(welded.mesh);
   result.skeleton = rig.skeleton;
   result.weights = std::move(welded.weights);
@@ -135,6 +142,7 @@ StatusOr<RigImport> ReadGltfUnguarded(std::string_view bytes, const MeshLimits& 
     line.pop_back();
     result.warnings.push_back(line);
   }
+  result.warnings.insert(result.warnings.end(), result_warnings.begin(), result_warnings.end());
   for (const gltf_internal::SkinnedNodeVertices& range : character.nodes) {
     const std::string& name = model.nodes[static_cast<std::size_t>(range.node)].name;
     result.skinned_nodes.push_back({range.node,

@@ -33,6 +33,10 @@
 //     their principal direction when they centre on the joint).
 //   - Weights: a glTF joint's weight goes to the bone that starts at its skeleton joint; where
 //     several start there, to the one nearest the vertex; normalized (NormalizeSkinWeights).
+//   - Bone surfaces: mesh nodes without a skin that a joint carries (the joint's node or a
+//     descendant of it) and that are bones: closed, inside the skin, not entered by it at rest
+//     (internal/gltf_bone_nodes.h has the whole rule). Each goes on the bone that starts at its
+//     joint; a node left out (a prop: a sword, eyes, a helmet) gets a line in `warnings`.
 //   - Welding: vertices that glTF splits at seams (exactly equal position, weights equal within
 //     1e-6) become one vertex of the mesh; vertices no triangle uses are dropped from it, and each
 //     follows the used vertex before it in the file (the first used one, for those before it):
@@ -44,6 +48,7 @@
 #include <vector>
 
 #include "core/base/status.h"
+#include "core/geometry/bone_surface.h"
 #include "core/geometry/mesh.h"
 #include "core/geometry/skeleton.h"
 #include "core/geometry/skin_weights.h"
@@ -70,9 +75,13 @@ struct RigImport {
   std::vector<int> file_vertex_to_mesh;
   std::vector<int> unused_file_vertices;        // file vertices no triangle uses, ascending
   std::vector<SkinnedNodeRange> skinned_nodes;  // in file vertex order, one per skinned node
+  // The file's bone surfaces (see above), in node order, in `mesh`'s space and on `skeleton`'s
+  // bones; valid (ValidateBoneSurfaces).
+  std::vector<BoneSurface> bone_surfaces;
   // What a user should know of the file, one line each: which file vertices each skinned node
-  // holds (when there are several), and a scale implausible in metres (a bounding-box diagonal
-  // outside kPlausibleDiagonalMetres for a limb or a character: often a file in centimetres).
+  // holds (when there are several), mesh nodes under joints not taken as bone surfaces, and a scale
+  // implausible in metres (a bounding-box diagonal outside kPlausibleDiagonalMetres for a limb or a
+  // character: often a file in centimetres).
   std::vector<std::string> warnings;
   std::string units = "metre";  // glTF's units (the spec says metres)
   std::string up_axis = "+Y";   // glTF's up axis

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <climits>
+#include <iterator>
 #include <utility>
 
 #include "core/geometry/bone_surface.h"
@@ -57,6 +58,7 @@ Status ParseUpload(const v1::UploadSource& upload, std::string* mesh_bytes,
     job->file_metadata.units = std::move(rig->units);
     job->file_metadata.up_axis = std::move(rig->up_axis);
     job->file_metadata.warnings = std::move(rig->warnings);
+    if (!upload.skip_gltf_bone_nodes()) job->bone_surfaces = std::move(rig->bone_surfaces);
     return Status::Ok();
   }
   DEFORM_ASSIGN_OR_RETURN(const MeshFormat format, CoreMeshFormat(upload.format()));
@@ -139,8 +141,11 @@ StatusOr<LoadJob> LoadJobFromRequest(const v1::LoadMeshHeader& header, std::stri
     if (job.name.empty()) job.name = "upload";
     MeshLimits mesh_limits;
     mesh_limits.max_vertices = limits.max_vertices;
-    DEFORM_ASSIGN_OR_RETURN(job.bone_surfaces,
+    DEFORM_ASSIGN_OR_RETURN(std::vector<BoneSurface> uploaded,
                             ParseBoneSurfaces(header.upload(), job.skeleton, mesh_limits));
+    job.bone_surfaces.insert(job.bone_surfaces.end(), std::make_move_iterator(uploaded.begin()),
+                             std::make_move_iterator(uploaded.end()));
+    DEFORM_RETURN_IF_ERROR(ValidateBoneSurfaces(job.bone_surfaces, job.skeleton, mesh_limits));
   }
   auto options = ModelOptionsFromProto(header.options(), job.skeleton);
   if (!options.ok()) return options.status().WithContext("options");

@@ -17,22 +17,12 @@
 #include "tests/service/support/stream_recorder.h"
 #include "tests/service/support/temp_dir.h"
 #include "tests/service/support/test_server.h"
+#include "tests/service/support/token_file.h"
 
 namespace deform::test_support {
 namespace {
 
 using ::testing::HasSubstr;
-
-std::string TokenLine(const std::string& token, const std::string& tenant,
-                      const std::string& role) {
-  return service::Sha256Hex(token) + " " + tenant + " " + role + "\n";
-}
-
-client::ClientOptions WithToken(const std::string& token) {
-  client::ClientOptions options;
-  options.token = token;
-  return options;
-}
 
 class RolesTest : public ::testing::Test {
  protected:

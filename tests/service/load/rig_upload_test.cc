@@ -266,6 +266,55 @@ TEST_F(RigUploadTest, GltfUploadRefusesASkeletonBesideIt) {
   EXPECT_THAT(status.error_message(), HasSubstr("carries its own skeleton"));
 }
 
+// The phantom written as a glTF with its bone surfaces as mesh nodes under their joints: they
+// come back as the rig's bone surfaces (the patella on its bone alone: glTF has no blend), keep
+// the skin out of them when the knee bends, and skip_gltf_bone_nodes leaves them out.
+TEST_F(RigUploadTest, AGltfRigsBoneNodesAreItsBoneSurfaces) {
+  StartServer();
+  auto phantom = MakeKneePhantom(1200);
+  ASSERT_TRUE(phantom.ok());
+  const auto [weights, csv] = PhantomWeights(*phantom);
+  auto glb =
+      WriteGltf(phantom->mesh, phantom->skeleton, weights, GltfContainer::kGlb, phantom->bones);
+  ASSERT_TRUE(glb.ok()) << glb.status().ToString();
+  v1::LoadMeshHeader header;
+  header.mutable_upload()->set_format(v1::MESH_FORMAT_GLTF);
+  v1::MeshSummary summary;
+  grpc::Status loaded = client_->LoadMesh(header, *glb, &summary);
+  ASSERT_TRUE(loaded.ok()) << loaded.error_message();
+  ASSERT_EQ(summary.bone_surfaces_size(), 3);
+  for (int s = 0; s < 3; ++s) {
+    const BoneSurface& written = phantom->bones[static_cast<std::size_t>(s)];
+    EXPECT_EQ(summary.bone_surfaces(s).name(), written.name);
+    EXPECT_EQ(summary.bone_surfaces(s).bone(), static_cast<std::uint32_t>(written.bone));
+    EXPECT_EQ(summary.bone_surfaces(s).blend_bone(), -1);
+    EXPECT_EQ(summary.bone_surfaces(s).vertex_count(),
+              static_cast<std::uint32_t>(written.mesh.num_vertices()));
+  }
+  for (const std::string& warning : summary.warnings()) {
+    EXPECT_EQ(warning.find("not a bone surface"), std::string::npos) << warning;
+  }
+  test_support::StreamRecorder recorder(/*keep_positions=*/false);
+  auto stream = client_->OpenStream(summary.mesh_id(), recorder.Callbacks(), {});
+  v1::PoseUpdate pose;
+  std::string error;
+  ASSERT_TRUE(client::ParsePoseAngles("knee:x:100", &pose, &error)) << error;
+  pose.set_sequence(1);
+  ASSERT_TRUE(stream->SendPose(pose));
+  ASSERT_TRUE(recorder.WaitForFrameWithSequence(1));
+  stream->Close();
+  EXPECT_TRUE(stream->Wait().ok());
+  const v1::FrameConstraints& constraints = recorder.last_frame().constraints();
+  EXPECT_EQ(constraints.penetrating_after(), 0u);
+  EXPECT_FALSE(constraints.unresolved());
+
+  header.mutable_upload()->set_skip_gltf_bone_nodes(true);
+  loaded = client_->LoadMesh(header, *glb, &summary);
+  ASSERT_TRUE(loaded.ok()) << loaded.error_message();
+  EXPECT_EQ(summary.bone_surfaces_size(), 0);
+  ExpectBackgroundStreamAlive();
+}
+
 TEST_F(RigUploadTest, SummaryCarriesBonesAndTheAutomaticBinding) {
   StartServer();
   v1::MeshSummary summary;

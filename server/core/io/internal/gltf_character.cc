@@ -92,6 +92,8 @@ StatusOr<CharacterMesh> ReadCharacterMesh(const tinygltf::Model& model, const Sc
     character.file.triangles.row(static_cast<Eigen::Index>(t)) = triangles[t].transpose();
   }
   character.joints = SkinJointsOf(model, unified, scene);
+  character.joint_nodes = unified.joint_nodes;
+  character.joint_bind = unified.bind;
   return character;
 }
 

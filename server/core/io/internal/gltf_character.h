@@ -2,6 +2,7 @@
 // joint list (the union of their skins' joints, by node), in node order.
 #pragma once
 
+#include <Eigen/Core>
 #include <vector>
 
 #include "core/base/status.h"
@@ -26,6 +27,10 @@ struct CharacterMesh {
   // The union of the skins' joints: the first skinned node's skin's joints in its order, then each
   // later skin's joints not yet listed. Bind positions from the first skin that lists the joint.
   std::vector<SkinJoint> joints;
+  // Per joint: its node, and its bind matrix in the unified bind space (joint space to the mesh's
+  // space in the bind pose): what places a mesh node parented to the joint in the mesh's space.
+  std::vector<int> joint_nodes;
+  std::vector<Eigen::Matrix4d> joint_bind;
   std::vector<SkinnedNodeVertices> nodes;  // one per skinned mesh node, in node order
 };
 

@@ -153,10 +153,11 @@ struct PrimitiveData {
 StatusOr<PrimitiveData> ReadPrimitive(const tinygltf::Model& model,
                                       const tinygltf::Primitive& primitive,
                                       const std::string& where, std::uint64_t vertex_room,
-                                      const MeshLimits& limits) {
+                                      const MeshLimits& limits, bool skinned) {
   if (primitive.mode != TINYGLTF_MODE_TRIANGLES) {
     return Status::InvalidArgument(where + " has mode " + std::to_string(primitive.mode) +
-                                   "; a skinned mesh must be triangles (mode 4)");
+                                   (skinned ? "; a skinned mesh" : "; a bone surface") +
+                                   " must be triangles (mode 4)");
   }
   if (Attribute(primitive, "POSITION") < 0) {
     return Status::InvalidArgument(where + " has no POSITION");
@@ -170,17 +171,19 @@ StatusOr<PrimitiveData> ReadPrimitive(const tinygltf::Model& model,
                                         Normalization::kNever,
                                         vertex_room,
                                         "vertices (with the primitives before it)"}));
-  DEFORM_ASSIGN_OR_RETURN(data.influences,
-                          ReadInfluenceSets(model, primitive, where, data.positions.count));
+  if (skinned) {
+    DEFORM_ASSIGN_OR_RETURN(data.influences,
+                            ReadInfluenceSets(model, primitive, where, data.positions.count));
+  }
   DEFORM_ASSIGN_OR_RETURN(data.corners,
                           ReadCorners(model, primitive, where, data.positions.count, limits));
   return data;
 }
 
-}  // namespace
-
-StatusOr<FileMesh> ReadSkinnedMesh(const tinygltf::Model& model, int mesh_index, int num_joints,
-                                   const MeshLimits& limits) {
+// Mesh `mesh_index`'s primitives concatenated; with `num_joints` > 0 their influences too.
+StatusOr<FileMesh> ReadMeshPrimitives(const tinygltf::Model& model, int mesh_index, int num_joints,
+                                      const MeshLimits& limits) {
+  const bool skinned = num_joints > 0;
   const tinygltf::Mesh& gltf_mesh = model.meshes[static_cast<std::size_t>(mesh_index)];
   if (gltf_mesh.primitives.empty()) {
     return Status::InvalidArgument("mesh " + std::to_string(mesh_index) + " has no primitives");
@@ -198,14 +201,16 @@ StatusOr<FileMesh> ReadSkinnedMesh(const tinygltf::Model& model, int mesh_index,
         ReadPrimitive(
             model, gltf_mesh.primitives[p], where,
             limits.max_vertices - std::min<std::uint64_t>(num_vertices, limits.max_vertices),
-            limits));
+            limits, skinned));
     DEFORM_RETURN_IF_ERROR(AppendInfluences(data.influences, where, data.positions.count,
                                             num_joints, &mesh.joint_weights));
     data.influences.clear();  // no longer needed: keep memory to one primitive's worth
     num_vertices += static_cast<std::uint64_t>(data.positions.count);
     num_triangles += data.corners.size() / 3;
     if (num_triangles > limits.max_triangles) {
-      return mesh_io_internal::TooManyTriangles("the glTF's skinned mesh", limits.max_triangles);
+      return mesh_io_internal::TooManyTriangles(
+          skinned ? "the glTF's skinned mesh" : "mesh " + std::to_string(mesh_index),
+          limits.max_triangles);
     }
     primitives.push_back(std::move(data));
   }
@@ -224,6 +229,19 @@ StatusOr<FileMesh> ReadSkinnedMesh(const tinygltf::Model& model, int mesh_index,
     }
   }
   return mesh;
+}
+
+}  // namespace
+
+StatusOr<FileMesh> ReadSkinnedMesh(const tinygltf::Model& model, int mesh_index, int num_joints,
+                                   const MeshLimits& limits) {
+  if (num_joints <= 0) return Status::InvalidArgument("a skin without joints");
+  return ReadMeshPrimitives(model, mesh_index, num_joints, limits);
+}
+
+StatusOr<FileMesh> ReadStaticMesh(const tinygltf::Model& model, int mesh_index,
+                                  const MeshLimits& limits) {
+  return ReadMeshPrimitives(model, mesh_index, 0, limits);
 }
 
 }  // namespace deform::gltf_internal

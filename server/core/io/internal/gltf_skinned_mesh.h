@@ -28,4 +28,9 @@ struct FileMesh {
 StatusOr<FileMesh> ReadSkinnedMesh(const tinygltf::Model& model, int mesh_index, int num_joints,
                                    const MeshLimits& limits);
 
+// Mesh `mesh_index` (in range) without a skin: positions and triangles as ReadSkinnedMesh reads
+// them, no influences (joint_weights empty). The same errors but those of influences.
+StatusOr<FileMesh> ReadStaticMesh(const tinygltf::Model& model, int mesh_index,
+                                  const MeshLimits& limits);
+
 }  // namespace deform::gltf_internal
