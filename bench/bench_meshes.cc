@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <map>
 
+#include "core/constraints/bone_reach.h"
 #include "core/io/model_input.h"
 #include "core/io/phantom.h"
 
@@ -12,6 +13,7 @@ namespace deform::bench {
 namespace {
 
 std::map<std::string, std::shared_ptr<const DeformationModel>> g_models;
+std::map<std::string, BonedModel> g_boned_models;
 
 }  // namespace
 
@@ -26,6 +28,26 @@ std::shared_ptr<const DeformationModel> ModelFor(const BenchMesh& mesh, Rotation
   auto model = DeformationModel::Build(input->mesh, input->skeleton, options);
   if (!model.ok()) return nullptr;
   return g_models[key] = *model;
+}
+
+BonedModel BonedModelFor(const BenchMesh& mesh) {
+  auto it = g_boned_models.find(mesh.name);
+  if (it != g_boned_models.end()) return it->second;
+  auto input = LoadModelInput(mesh.mesh_path, mesh.skeleton_path, kDefaultPhantomVertices);
+  if (!input.ok()) return {};
+  BonedModel boned;
+  boned.surfaces =
+      input->bones.empty() ? MakeCapsuleBoneSurfaces(input->mesh, input->skeleton) : input->bones;
+  ModelOptions options = ModelOptions::Paper();
+  if (!UnanchorReachedSkin(input->mesh, input->skeleton, boned.surfaces, ConstraintOptions{},
+                           &options)
+           .ok()) {
+    return {};
+  }
+  auto model = DeformationModel::Build(input->mesh, input->skeleton, options);
+  if (!model.ok()) return {};
+  boned.model = *model;
+  return g_boned_models[mesh.name] = boned;
 }
 
 std::vector<BenchMesh> AvailableMeshes() {

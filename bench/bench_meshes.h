@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "core/geometry/bone_surface.h"
 #include "core/model/deformation_model.h"
 
 namespace deform::bench {
@@ -25,6 +26,16 @@ std::vector<BenchMesh> AvailableMeshes();
 // null when it cannot be built.
 std::shared_ptr<const DeformationModel> ModelFor(const BenchMesh& mesh,
                                                  RotationBlend blend = RotationBlend::kQuaternion);
+
+// A limb with bones: its bone surfaces (the phantom's own; capsules by the sizing rule,
+// MakeCapsuleBoneSurfaces, on the shared meshes) and its model built for them with the default
+// constraints (the reached skin unanchored: UnanchorReachedSkin). Built once and kept; model null
+// when it cannot be built.
+struct BonedModel {
+  std::shared_ptr<const DeformationModel> model;
+  std::vector<BoneSurface> surfaces;
+};
+BonedModel BonedModelFor(const BenchMesh& mesh);
 
 // The pose `spec` on `model`'s skeleton (the rest pose when it does not parse).
 Pose PoseFromSpecOrRest(const DeformationModel& model, const std::string& spec);

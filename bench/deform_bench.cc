@@ -87,11 +87,10 @@ struct FrameSetup {
   DeformScratch scratch;
 };
 
-// The setup for `mesh` with `blend`, or null with the benchmark skipped when the mesh could not be
-// loaded.
-std::unique_ptr<FrameSetup> SetUpFrames(benchmark::State& state, const BenchMesh& mesh,
-                                        RotationBlend blend = RotationBlend::kQuaternion) {
-  auto model = ModelFor(mesh, blend);
+// The setup for `model` in `mesh`'s benchmark pose, or null with the benchmark skipped when the
+// model could not be built.
+std::unique_ptr<FrameSetup> SetUpFramesOf(benchmark::State& state, const BenchMesh& mesh,
+                                          std::shared_ptr<const DeformationModel> model) {
   if (!model) {
     state.SkipWithError("mesh could not be loaded");
     return nullptr;
@@ -102,6 +101,12 @@ std::unique_ptr<FrameSetup> SetUpFrames(benchmark::State& state, const BenchMesh
   setup->scratch = model->MakeScratch();
   setup->model = std::move(model);
   return setup;
+}
+
+// The setup for `mesh` with `blend` (ModelFor).
+std::unique_ptr<FrameSetup> SetUpFrames(benchmark::State& state, const BenchMesh& mesh,
+                                        RotationBlend blend = RotationBlend::kQuaternion) {
+  return SetUpFramesOf(state, mesh, ModelFor(mesh, blend));
 }
 
 // The benchmark pose's right-hand side A^T b ((n + m) by 3), a copy that the solves keep as input.
@@ -121,27 +126,19 @@ void BM_Frame(benchmark::State& state, BenchMesh mesh) {
   state.counters["vertices"] = frames->model->mesh().num_vertices();
 }
 
-// The bone surfaces of `mesh`'s limb: the phantom's own (femur, tibia, patella), capsules by the
-// sizing rule (MakeCapsuleBoneSurfaces) on the shared meshes.
-std::vector<BoneSurface> BenchBones(const BenchMesh& mesh, const DeformationModel& model) {
-  if (mesh.mesh_path.empty()) {
-    auto phantom = MakeKneePhantom();  // as ModelFor builds it
-    if (phantom.ok()) return phantom->bones;
-  }
-  return MakeCapsuleBoneSurfaces(model.mesh(), model.skeleton());
-}
-
 // A whole frame with the constraints (core/constraints): the frame of BM_Frame, then the skin held
-// outside the bones and the volume kept, at `degrees` of flexion (the benchmark pose where 0).
-// Compare with Frame/ of the same mesh in the same run.
+// outside the bones and the volume kept, at `degrees` of flexion (the benchmark pose where 0), on
+// the model built for the bones (BonedModelFor). Compare with Frame/ of the same mesh in the same
+// run.
 void BM_ConstrainedFrame(benchmark::State& state, BenchMesh mesh, int degrees) {
-  auto frames = SetUpFrames(state, mesh);
+  const BonedModel boned = BonedModelFor(mesh);
+  auto frames = SetUpFramesOf(state, mesh, boned.model);
   if (!frames) return;
   if (degrees > 0) {
     frames->pose =
         PoseFromSpecOrRest(*frames->model, mesh.flexion_prefix + std::to_string(degrees));
   }
-  auto bones = BoneContacts::Create(BenchBones(mesh, *frames->model), frames->model->skeleton(),
+  auto bones = BoneContacts::Create(boned.surfaces, frames->model->skeleton(),
                                     frames->model->mesh(), frames->model->rigid_bones());
   if (!bones.ok()) {
     state.SkipWithError(bones.status().ToString().c_str());

@@ -4,7 +4,7 @@
 # JSON as joint_nodes_enabled and material_enabled, off removing the joint nodes or the material
 # weights; --material-profile 1,1,1 is --material off), the methods cor and ddm (rest pose in,
 # rest mesh out), the triangle counts in the JSON, the bone surfaces (the phantom's, capsules, files; bone_penetration for every method) and the
-# constraints (--contacts, --volume), and bad values (exit 2 for a flag CLI11 refuses, 1 for an
+# constraints (--contacts, --bone-reach, --volume), and bad values (exit 2 for a flag CLI11 refuses, 1 for an
 # unknown method or a bad bone surface). Needs python3.
 set -euo pipefail
 DEFORMCTL="$1"
@@ -58,7 +58,16 @@ plain=$(python3 -c "import json; print(json.load(open('$WORK/out'))['volume_chan
 run "laplacian reports neither" 0 \
   "not d['joint_nodes_enabled'] and not d['material_enabled'] and \
    abs(d['volume_change'] - $plain) < 1e-12" \
-  --pose knee:flexion:90 --method laplacian
+  --pose knee:flexion:90 --method laplacian --bone-reach off
+run "--bone-reach off keeps the rigid zones" 0 \
+  "not d['constraints']['bone_reach'] and d['constraints']['reached_vertices'] == 0" \
+  --pose knee:flexion:120 --bone-reach off
+rigid_kept=$(python3 -c "import json; print(sum(b['rigid_vertices'] for b in json.load(open('$WORK/out'))['binding']['bones']))")
+run "--bone-reach (default on): the skin the bones reach leaves the rigid zones" 0 \
+  "d['constraints']['bone_reach'] and d['constraints']['reached_vertices'] > 0 and \
+   sum(b['rigid_vertices'] for b in d['binding']['bones']) < $rigid_kept and \
+   d['bone_penetration']['vertices'] == 0" \
+  --pose knee:flexion:120
 run "--method cor: rest in, rest out" 0 "d['method'] == 'cor' and d['max_displacement'] < 1e-9" \
   --method cor
 run "--method ddm: rest in, rest out" 0 "d['method'] == 'ddm' and d['max_displacement'] < 1e-9" \

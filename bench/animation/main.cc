@@ -27,6 +27,7 @@
 #include "cli/command_line.h"
 #include "cli/mesh_source.h"
 #include "cli/rotation_blend_flag.h"
+#include "core/constraints/bone_reach.h"
 #include "core/io/model_input.h"
 #include "core/io/phantom.h"
 
@@ -178,9 +179,14 @@ int main(int argc, char** argv) {
     if (!resolved.ok()) return Fail(resolved.status().WithContext(args.poses_path), 2);
   }
   const auto build_start = std::chrono::steady_clock::now();
+  // As the server builds a limb with bones (its default constraints).
+  deform::ModelOptions options = ReferenceOptions(args.source.rotation_blend);
+  const deform::Status unanchored =
+      deform::UnanchorReachedSkin(reference->input.mesh, reference->input.skeleton,
+                                  reference->input.bones, deform::ConstraintOptions{}, &options);
+  if (!unanchored.ok()) return Fail(unanchored.WithContext("local reference model"));
   auto model = deform::DeformationModel::Build(
-      reference->input.mesh, reference->input.skeleton,
-      ReferenceOptions(args.source.rotation_blend),
+      reference->input.mesh, reference->input.skeleton, options,
       reference->input.weights.has_value() ? &*reference->input.weights : nullptr);
   if (!model.ok()) return Fail(model.status().WithContext("local reference model"));
   reference->model = std::move(*model);

@@ -6,7 +6,8 @@
 //                    [--material-profile RIGID,SOFT,SEAM]
 //                    [--laplacian uniform|cotangent|intrinsic]
 //                    [--bone-surface FILE:BONE ...] [--bones input|capsules|none]
-//                    [--contacts on|off] [--volume on|off] [--out-bones DIR]
+//                    [--contacts on|off] [--bone-reach on|off] [--volume on|off]
+//                    [--out-bones DIR]
 //                    [--rigid-weight-tolerance X]
 //   deformctl phantom --out FILE [--skeleton-out FILE] [--vertices N]
 //
@@ -24,6 +25,7 @@
 
 #include "core/base/build_info.h"
 #include "core/base/text.h"
+#include "core/constraints/bone_reach.h"
 #include "core/constraints/skin_constraints.h"
 #include "core/eval/method_comparison.h"
 #include "core/io/bone_surface_io.h"
@@ -52,6 +54,8 @@ struct DeformArgs {
   std::string bones = "input";
   bool contacts = true;
   bool volume = true;
+  bool bone_reach = true;       // ModelOptions::unanchored_vertices from SkinReachedAcrossJoints
+  int unanchored_vertices = 0;  // set once they are found
   std::string out_bones_dir;
   int bone_surface_count = 0;      // set once they are loaded
   std::string joint_nodes = "on";  // off: ModelOptions::use_joint_nodes = false
@@ -190,6 +194,8 @@ nlohmann::ordered_json DeformReport(const DeformArgs& args, const deform::ModelI
     const deform::ConstraintReport& c = run.constraints;
     out["constraints"] = {{"contacts", args.contacts},
                           {"volume", args.volume},
+                          {"bone_reach", args.bone_reach},
+                          {"reached_vertices", args.unanchored_vertices},
                           {"penetration_before", PenetrationJson(c.before)},
                           {"active_contacts", c.contacts},
                           {"rounds", c.rounds},
@@ -224,13 +230,21 @@ int RunDeform(DeformArgs args) {
   deform::Pose pose;
   auto clamped = deform::PoseFromTerms(input->skeleton, *terms, &pose);
   if (!clamped.ok()) return Fail(clamped.status());
+  auto surfaces = BoneSurfacesFrom(args, *input);
+  if (!surfaces.ok()) return Fail(surfaces.status());
+  args.bone_surface_count = static_cast<int>(surfaces->size());
+  deform::ConstraintOptions constraint_options;
+  constraint_options.keep_volume = args.volume;
+  constraint_options.bone_reach = args.bone_reach;
+  if (!args.contacts) constraint_options.max_contacts = 0;
+  const Status unanchored = deform::UnanchorReachedSkin(input->mesh, input->skeleton, *surfaces,
+                                                        constraint_options, &*options);
+  if (!unanchored.ok()) return Fail(unanchored);
+  args.unanchored_vertices = static_cast<int>(options->unanchored_vertices.size());
   auto model =
       deform::DeformationModel::Build(input->mesh, input->skeleton, *options,
                                       input->weights.has_value() ? &*input->weights : nullptr);
   if (!model.ok()) return Fail(model.status());
-  auto surfaces = BoneSurfacesFrom(args, *input);
-  if (!surfaces.ok()) return Fail(surfaces.status());
-  args.bone_surface_count = static_cast<int>(surfaces->size());
   std::shared_ptr<const deform::BoneContacts> bones;
   if (!surfaces->empty()) {
     auto made = deform::BoneContacts::Create(*surfaces, input->skeleton, input->mesh,
@@ -238,9 +252,6 @@ int RunDeform(DeformArgs args) {
     if (!made.ok()) return Fail(made.status());
     bones = *made;
   }
-  deform::ConstraintOptions constraint_options;
-  constraint_options.keep_volume = args.volume;
-  if (!args.contacts) constraint_options.max_contacts = 0;
   auto constraints = deform::SkinConstraints::Create(**model, bones, constraint_options);
   if (!constraints.ok()) return Fail(constraints.status());
   auto run = deform::RunMethod(**model, *method, pose, args.repeat, constraints->get());
@@ -334,6 +345,12 @@ CLI::App* AddDeformCommand(CLI::App* app, DeformArgs* args) {
   command
       ->add_option("--contacts", args->contacts,
                    "on | off: keep the skin outside the bone surfaces (paper, paper-linear)")
+      ->transform(CLI::CheckedTransformer(OnOff()))
+      ->default_str("on");
+  command
+      ->add_option("--bone-reach", args->bone_reach,
+                   "on | off: leave the skin a bone surface reaches across a joint out of the "
+                   "rigid zones, so that contacts may move it (with --contacts on)")
       ->transform(CLI::CheckedTransformer(OnOff()))
       ->default_str("on");
   command

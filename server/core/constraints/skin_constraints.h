@@ -52,6 +52,10 @@ struct ConstraintOptions {
   double volume_tolerance = 1e-4;
   // Rounds of the active set (each: find contacts, solve). In [1, 16]. Default: 8.
   int max_rounds = 8;
+  // With contacts: the skin a bone surface reaches across a joint within its range of motion is
+  // solved rather than anchored (UnanchorReachedSkin, bone_reach.h, applied before the model is
+  // built), so contacts move it without pulling a rigid zone off its bone. Default: on.
+  bool bone_reach = true;
 };
 
 // What the constraints did to one frame.

@@ -149,6 +149,10 @@ Status DeformationModel::BindAutomatically(const VertexAdjacency& adjacency, con
                                                                     bound, options_.regions));
   regions_ = KeepRigidCores(mesh_, adjacency, bound, std::move(regions), kMinRigidFraction);
   rigid_bones_ = RigidZones(regions_, bound);
+  DEFORM_RETURN_IF_ERROR(ReleaseFromRigidZones(options_.unanchored_vertices,
+                                               regions_.relative_distance,
+                                               ModelOptions::kMinAnchoredFraction, &rigid_bones_)
+                             .status());
   DEFORM_RETURN_IF_ERROR(EndPhase(cancel, "the joint regions"));
   DEFORM_ASSIGN_OR_RETURN(bone_weights_,
                           HarmonicBoneWeights(adjacency, rigid_bones_, skeleton_.num_bones(),
@@ -176,6 +180,10 @@ Status DeformationModel::BindToWeights(const SkinWeights& weights,
   DEFORM_RETURN_IF_ERROR(CheckEveryComponentAnchored(adjacency, binding.rigid_bone));
   regions_ = RegionsFromWeightBinding(mesh_, skeleton_, adjacency, binding);
   rigid_bones_ = binding.rigid_bone;
+  DEFORM_RETURN_IF_ERROR(ReleaseFromRigidZones(options_.unanchored_vertices,
+                                               regions_.relative_distance,
+                                               ModelOptions::kMinAnchoredFraction, &rigid_bones_)
+                             .status());
   bound_bones_ = binding.main_bone;
   bone_weights_ = BoneWeightsFromSkinWeights(normalized);
   given_weights_ = normalized;

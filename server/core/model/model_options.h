@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string_view>
+#include <vector>
 
 #include "core/base/status.h"
 #include "core/geometry/mesh.h"
@@ -90,6 +91,15 @@ struct ModelOptions {
   // skinning does (anchoring only the far ones let the zone next to a region drift: docs/method.md,
   // "Anchors"); the joint regions are what the method solves.
   double anchor_min_fraction = 1.0;
+  // Vertices kept out of every rigid zone whatever the binding says: solved (with their material
+  // weight and their bone's rotation) rather than anchored. For the skin a bone surface across a
+  // joint reaches within the joint's range of motion (SkinReachedAcrossJoints,
+  // core/constraints/bone_reach.h), which contacts must be free to move. Each bone keeps at least
+  // kMinAnchoredFraction of its rigid zone anchored: the vertices of this list farthest from the
+  // joints (by relative distance to the region centres) stay rigid beyond that. Indices must be
+  // vertices of the mesh. Default: none.
+  std::vector<int> unanchored_vertices;
+  static constexpr double kMinAnchoredFraction = 0.25;
   // Without given weights: which bone a vertex follows. Default: kThroughBody.
   BindingMethod binding = BindingMethod::kThroughBody;
   // With given weights: a vertex whose largest weight is at least 1 minus this is in that bone's

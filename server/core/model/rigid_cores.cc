@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <utility>
 
 namespace deform {
@@ -69,6 +70,47 @@ std::vector<std::vector<int>> RegionBonesPerVertex(const JointRegions& regions,
     }
   }
   return allowed;
+}
+
+StatusOr<int> ReleaseFromRigidZones(const std::vector<int>& vertices,
+                                    const std::vector<double>& relative_distance,
+                                    double min_fraction, std::vector<int>* rigid_bones) {
+  const int n = static_cast<int>(rigid_bones->size());
+  int bones = 0;
+  for (int i = 0; i < n; ++i) bones = std::max(bones, (*rigid_bones)[i] + 1);
+  std::vector<int> zone_size(bones, 0);
+  for (int i = 0; i < n; ++i) {
+    if ((*rigid_bones)[i] >= 0) ++zone_size[(*rigid_bones)[i]];
+  }
+  std::vector<std::vector<int>> listed(bones);
+  std::vector<char> seen(n, 0);
+  for (const int i : vertices) {
+    if (i < 0 || i >= n) {
+      return Status::InvalidArgument("unanchored_vertices: vertex " + std::to_string(i) +
+                                     " is not a vertex of the " + std::to_string(n) +
+                                     "-vertex mesh");
+    }
+    if (seen[i] != 0 || (*rigid_bones)[i] < 0) continue;
+    seen[i] = 1;
+    listed[(*rigid_bones)[i]].push_back(i);
+  }
+  int released = 0;
+  for (int k = 0; k < bones; ++k) {
+    std::vector<int>& zone = listed[k];
+    const auto keep = static_cast<std::size_t>(std::ceil(min_fraction * zone_size[k]));
+    const std::size_t may_go =
+        static_cast<std::size_t>(zone_size[k]) - std::min<std::size_t>(keep, zone_size[k]);
+    if (zone.size() > may_go) {  // the nearest to the joints go
+      std::sort(zone.begin(), zone.end(), [&](int a, int b) {
+        return relative_distance[a] < relative_distance[b] ||
+               (relative_distance[a] == relative_distance[b] && a < b);
+      });
+      zone.resize(may_go);
+    }
+    for (const int i : zone) (*rigid_bones)[i] = -1;
+    released += static_cast<int>(zone.size());
+  }
+  return released;
 }
 
 }  // namespace deform

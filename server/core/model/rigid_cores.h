@@ -9,6 +9,7 @@
 
 #include <vector>
 
+#include "core/base/status.h"
 #include "core/geometry/mesh.h"
 #include "core/geometry/mesh_topology.h"
 #include "core/geometry/skeleton.h"
@@ -30,5 +31,13 @@ JointRegions KeepRigidCores(const TriangleMesh& mesh, const VertexAdjacency& adj
 std::vector<std::vector<int>> RegionBonesPerVertex(const JointRegions& regions,
                                                    const Skeleton& skeleton,
                                                    const std::vector<NearestBone>& nearest);
+
+// Takes `vertices` (ModelOptions::unanchored_vertices) out of the rigid zones `rigid_bones` (per
+// vertex its bone, or -1), keeping at least `min_fraction` of each bone's zone: where more of a
+// zone is listed, its listed vertices farthest from the joints (largest `relative_distance`) stay.
+// Returns how many vertices left a zone; INVALID_ARGUMENT naming an index outside the mesh.
+StatusOr<int> ReleaseFromRigidZones(const std::vector<int>& vertices,
+                                    const std::vector<double>& relative_distance,
+                                    double min_fraction, std::vector<int>* rigid_bones);
 
 }  // namespace deform

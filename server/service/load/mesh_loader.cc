@@ -4,6 +4,7 @@
 
 #include <utility>
 
+#include "core/constraints/bone_reach.h"
 #include "service/base/log_text.h"
 
 namespace deform::service {
@@ -88,6 +89,8 @@ StatusOr<std::shared_ptr<const MeshEntry>> Build(ServiceContext* context, Admiss
   hooks.precomputed = [&] {
     if (progress) progress(LoadStage::kWeights, MillisecondsSince(job.start));
   };
+  DEFORM_RETURN_IF_ERROR(UnanchorReachedSkin(job.mesh, job.skeleton, job.bone_surfaces,
+                                             job.constraints, &job.options, job.cancel));
   DEFORM_ASSIGN_OR_RETURN(
       std::shared_ptr<const DeformationModel> model,
       DeformationModel::Build(std::move(job.mesh), std::move(job.skeleton), job.options,
