@@ -7,12 +7,13 @@
 #include <cmath>
 #include <string>
 
+#include "update_product.h"
+
 namespace deform::solver_internal {
 namespace {
 
 using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 using BlockMap = Eigen::Map<RowMatrix, 0, Eigen::OuterStride<>>;
-using ConstBlockMap = Eigen::Map<const RowMatrix, 0, Eigen::OuterStride<>>;
 
 std::vector<int> SupernodeOfColumn(int size, const std::vector<int>& supernode_columns) {
   std::vector<int> supernode_of(static_cast<std::size_t>(size));
@@ -160,9 +161,7 @@ SupernodalResult FactorizeSupernodes(const SupernodalNumericInput& in, const int
       const std::int64_t m = in.row_pointers[d + 1] - in.row_pointers[d] - u.begin;
       const int k = u.end - u.begin;
       const double* d_block = in.values + in.value_pointers[d] + u.begin * wd;
-      BlockMap product(work->product.data(), m, k, Eigen::OuterStride<>(k));
-      product.noalias() = ConstBlockMap(d_block, m, wd, Eigen::OuterStride<>(wd)) *
-                          ConstBlockMap(d_block, k, wd, Eigen::OuterStride<>(wd)).transpose();
+      UpdateProduct(d_block, m, d_block, k, wd, work->product.data());
       for (std::int64_t r = 0; r < m; ++r) {
         double* target = block + position[d_rows[r]] * w - first;
         const double* from = work->product.data() + r * k;
