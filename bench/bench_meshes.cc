@@ -21,7 +21,7 @@ std::shared_ptr<const DeformationModel> ModelFor(const BenchMesh& mesh, Rotation
   const std::string key = mesh.name + (blend == RotationBlend::kLinear ? "/linear" : "");
   auto it = g_models.find(key);
   if (it != g_models.end()) return it->second;
-  auto input = LoadModelInput(mesh.mesh_path, mesh.skeleton_path, kDefaultPhantomVertices);
+  auto input = LoadModelInput(mesh.mesh_path, mesh.skeleton_path, mesh.phantom_vertices);
   if (!input.ok()) return nullptr;
   ModelOptions options = ModelOptions::Paper();
   options.rotation_blend = blend;
@@ -33,7 +33,7 @@ std::shared_ptr<const DeformationModel> ModelFor(const BenchMesh& mesh, Rotation
 BonedModel BonedModelFor(const BenchMesh& mesh) {
   auto it = g_boned_models.find(mesh.name);
   if (it != g_boned_models.end()) return it->second;
-  auto input = LoadModelInput(mesh.mesh_path, mesh.skeleton_path, kDefaultPhantomVertices);
+  auto input = LoadModelInput(mesh.mesh_path, mesh.skeleton_path, mesh.phantom_vertices);
   if (!input.ok()) return {};
   BonedModel boned;
   boned.surfaces =
@@ -50,9 +50,32 @@ BonedModel BonedModelFor(const BenchMesh& mesh) {
   return g_boned_models[mesh.name] = boned;
 }
 
+namespace {
+
+std::string SharedDataDir() {
+  return std::getenv("DEFORM_SHARED_DATA") ? std::getenv("DEFORM_SHARED_DATA")
+                                           : DEFORM_SHARED_DATA_DIR;
+}
+
+}  // namespace
+
+std::vector<BenchMesh> FactorizationScalingMeshes() {
+  const std::string data = SharedDataDir();
+  std::vector<BenchMesh> meshes;
+  const BenchMesh arm{"arm_8311", data + "/arm/arm_8311.obj", data + "/arm/arm.tgf", "2:z:-60",
+                      "2:z:-"};
+  if (std::filesystem::exists(arm.mesh_path)) meshes.push_back(arm);
+  for (const int vertices : {20'000, 200'000}) {
+    BenchMesh phantom{"phantom_" + std::to_string(vertices / 1000) + "k", "", "", "knee:flexion:60",
+                      "knee:flexion:"};
+    phantom.phantom_vertices = vertices;
+    meshes.push_back(phantom);
+  }
+  return meshes;
+}
+
 std::vector<BenchMesh> AvailableMeshes() {
-  const std::string data = std::getenv("DEFORM_SHARED_DATA") ? std::getenv("DEFORM_SHARED_DATA")
-                                                             : DEFORM_SHARED_DATA_DIR;
+  const std::string data = SharedDataDir();
   std::vector<BenchMesh> meshes = {{"phantom_2k", "", "", "knee:flexion:60", "knee:flexion:"}};
   const std::vector<BenchMesh> shared = {
       {"leg_1633", data + "/leg/leg_1633.obj", data + "/leg/leg.tgf", "1:x:60", "1:x:"},

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/geometry/bone_surface.h"
+#include "core/io/phantom.h"
 #include "core/model/deformation_model.h"
 
 namespace deform::bench {
@@ -17,10 +18,14 @@ struct BenchMesh {
   std::string skeleton_path;
   std::string pose_spec;       // the benchmarks' pose
   std::string flexion_prefix;  // the flexion at DEG degrees is flexion_prefix + DEG
+  int phantom_vertices = kDefaultPhantomVertices;  // the phantom's size (mesh_path empty)
 };
 
 // The meshes present (a line on stderr for each shared mesh absent).
 std::vector<BenchMesh> AvailableMeshes();
+// More meshes for the numeric factorization's scaling alone: the 8k arm (where present) and the
+// phantom at 20k and 200k vertices.
+std::vector<BenchMesh> FactorizationScalingMeshes();
 
 // The paper's model of `mesh` (built once per rotation blend and kept for the later benchmarks);
 // null when it cannot be built.

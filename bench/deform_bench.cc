@@ -27,6 +27,7 @@
 
 #include "bench/arithmetic_peak.h"
 #include "bench/bench_meshes.h"
+#include "bench/cholmod_anchor.h"
 #include "bench/memory_bandwidth.h"
 #include "core/base/build_info.h"
 #include "core/base/median.h"
@@ -510,9 +511,47 @@ void BM_Factorize(benchmark::State& state, BenchMesh mesh) {
   state.counters["factor_MB"] = model->default_factorization()->factor().bytes() / 1e6;
 }
 
+// The numeric factorization alone on `threads` threads (a ThreadTeam for two), of the model's
+// normal matrix with the model's ordering, and CHOLMOD's (cholmod_anchor.h) of the same matrix with
+// the same permutation on as many BLAS threads, the two alternating: x_cholmod = ours / CHOLMOD's
+// (medians). Without CHOLMOD in the build, ours alone.
+void BM_NumericFactorization(benchmark::State& state, BenchMesh mesh, int threads) {
+  auto model = ModelFor(mesh);
+  if (!model) return state.SkipWithError("mesh could not be loaded");
+  Eigen::SparseMatrix<double> a = model->NormalMatrix(*model->default_factorization());
+  a.makeCompressed();
+  auto symbolic = SymbolicCholesky::Analyze(a, model->options().ordering);
+  if (!symbolic.ok()) return state.SkipWithError(symbolic.status().ToString().c_str());
+  std::unique_ptr<ThreadTeam> team = threads > 1 ? std::make_unique<ThreadTeam>(threads) : nullptr;
+  std::unique_ptr<CholmodAnchor> cholmod = CholmodAnchor::Create(a, (*symbolic)->permutation());
+  std::vector<double> seconds, cholmod_seconds;
+  for (auto _ : state) {
+    const auto start = Clock::now();
+    auto factor = CholeskyFactor::Factorize(*symbolic, a, nullptr, team.get());
+    seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
+    if (!factor.ok()) return state.SkipWithError(factor.status().ToString().c_str());
+    if (cholmod) {
+      state.PauseTiming();
+      const double s = cholmod->Factorize(threads);
+      if (s >= 0) cholmod_seconds.push_back(s);
+      state.ResumeTiming();
+    }
+  }
+  state.counters["median_ms"] = Median(seconds) * 1e3;
+  state.counters["vertices"] = model->mesh().num_vertices();
+  state.counters["L_nonzeros_M"] = static_cast<double>((*symbolic)->factor_nonzeros()) / 1e6;
+  if (!cholmod_seconds.empty()) {
+    state.counters["cholmod_ms"] = Median(cholmod_seconds) * 1e3;
+    state.counters["x_cholmod"] = Median(seconds) / Median(cholmod_seconds);
+    state.counters["cholmod_blas_threads"] = cholmod->blas_threads();
+    state.counters["cholmod_supernodal"] = cholmod->supernodal() ? 1 : 0;
+    state.counters["cholmod_L_nonzeros_M"] = cholmod->factor_nonzeros() / 1e6;
+  }
+}
+
 // Everything Build() does: validation, weights, regions, symbolic analysis, first factorization.
 void BM_Precompute(benchmark::State& state, BenchMesh mesh) {
-  auto input = LoadModelInput(mesh.mesh_path, mesh.skeleton_path, kDefaultPhantomVertices);
+  auto input = LoadModelInput(mesh.mesh_path, mesh.skeleton_path, mesh.phantom_vertices);
   if (!input.ok()) return state.SkipWithError(input.status().ToString().c_str());
   std::vector<double> seconds, precompute;
   for (auto _ : state) {
@@ -533,11 +572,22 @@ benchmark::internal::Benchmark* RegisterFor(const BenchMesh& mesh, const std::st
       ->Unit(benchmark::kMillisecond);
 }
 
+// The numeric factorization on one thread and on two, fewer times on the large meshes.
+void RegisterNumericFactorization(const BenchMesh& mesh) {
+  const bool large = mesh.name == "arm_132946" || mesh.phantom_vertices >= 100'000;
+  for (const int threads : {1, 2}) {
+    RegisterFor(mesh, "NumericFactorization/threads:" + std::to_string(threads),
+                BM_NumericFactorization, threads)
+        ->Iterations(large ? 3 : 7);
+  }
+}
+
 // Every benchmark of one mesh (the 133k arm with fewer precomputation iterations).
 void RegisterBenchmarks(const BenchMesh& mesh) {
   const bool large = mesh.name == "arm_132946";
   RegisterFor(mesh, "Precompute", BM_Precompute)->Iterations(large ? 1 : 3);
   RegisterFor(mesh, "Factorize", BM_Factorize)->Iterations(large ? 2 : 5);
+  RegisterNumericFactorization(mesh);
   RegisterFor(mesh, "Frame", BM_Frame)->MinTime(1.0);
   RegisterFor(mesh, "ConstrainedFrame", BM_ConstrainedFrame, 0)->MinTime(1.0);
   RegisterFor(mesh, "ConstrainedFrame/degrees:120", BM_ConstrainedFrame, 120)->MinTime(1.0);
@@ -594,6 +644,8 @@ int main(int argc, char** argv) {
                               std::to_string(MeasureReadBandwidth(std::size_t{1} << 30) / 1e9));
   benchmark::AddCustomContext("solve_kernel", deform::SolveKernelName(deform::BestSolveKernel()));
   for (const BenchMesh& mesh : AvailableMeshes()) RegisterBenchmarks(mesh);
+  for (const BenchMesh& mesh : FactorizationScalingMeshes()) RegisterNumericFactorization(mesh);
+  benchmark::AddCustomContext("cholmod", CholmodAnchor::Available() ? "linked" : "absent");
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
   return 0;

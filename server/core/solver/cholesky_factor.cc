@@ -5,7 +5,7 @@
 #include <string>
 #include <utility>
 
-#include "internal/row_pattern.h"
+#include "internal/supernodal_numeric.h"
 #include "internal/unit_solve.h"
 
 namespace deform {
@@ -25,14 +25,13 @@ Status CheckFrameCount(int frames) {
 
 StatusOr<CholeskyFactor> CholeskyFactor::Factorize(std::shared_ptr<const SymbolicCholesky> symbolic,
                                                    const ColMajorMatrix& a,
-                                                   const CancelToken* cancel) {
+                                                   const CancelToken* cancel,
+                                                   ParallelRunner* runner) {
   if (!symbolic) return Status::InvalidArgument("no symbolic analysis to factorize with");
   DEFORM_RETURN_IF_ERROR(CheckAnalysedPattern(*symbolic, a));
-  DEFORM_ASSIGN_OR_RETURN(const ColumnFactor l,
-                          UpLookingCholesky(*symbolic, PermutedUpperValues(*symbolic, a), cancel));
   CholeskyFactor f;
-  f.PackSupernodes(*symbolic, l);
   f.symbolic_ = std::move(symbolic);
+  DEFORM_RETURN_IF_ERROR(f.FactorizeSupernodal(a, cancel, runner));
   return f;
 }
 
@@ -56,89 +55,111 @@ std::vector<double> CholeskyFactor::PermutedUpperValues(const SymbolicCholesky& 
   return c_values;
 }
 
-// Up-looking factorization (CSparse's cs_chol): row k of L from the rows above it.
-StatusOr<CholeskyFactor::ColumnFactor> CholeskyFactor::UpLookingCholesky(
-    const SymbolicCholesky& s, const std::vector<double>& c_values, const CancelToken* cancel) {
+// C's lower triangle by columns: the transpose of its upper triangle's pattern, with its values.
+CholeskyFactor::LowerTriangle CholeskyFactor::PermutedLowerTriangle(const SymbolicCholesky& s,
+                                                                    const ColMajorMatrix& a) {
+  const std::vector<double> upper = PermutedUpperValues(s, a);
   const int n = s.n_;
-  ColumnFactor l{std::vector<int>(s.column_pointers_[n], 0),
-                 std::vector<double>(s.column_pointers_[n], 0.0)};
-  std::vector<std::int64_t> next(s.column_pointers_.begin(), s.column_pointers_.end() - 1);
-  std::vector<double> x(n, 0.0);
-  std::vector<int> stack(n), mark(n, -1);
-  for (int k = 0; k < n; ++k) {
-    if (k % kCancelCheckRows == 0) {
-      DEFORM_RETURN_IF_ERROR(CheckCancelled(cancel, "the numeric factorization"));
+  LowerTriangle lower;
+  lower.pointers.assign(n + 1, 0);
+  for (const int row : s.c_row_indices_) ++lower.pointers[row + 1];
+  for (int j = 0; j < n; ++j) lower.pointers[j + 1] += lower.pointers[j];
+  lower.rows.resize(upper.size());
+  lower.values.resize(upper.size());
+  std::vector<std::int64_t> next(lower.pointers.begin(), lower.pointers.end() - 1);
+  for (int column = 0; column < n; ++column) {  // ascending: each lower column's rows ascend
+    for (int p = s.c_column_pointers_[column]; p < s.c_column_pointers_[column + 1]; ++p) {
+      const std::int64_t q = next[s.c_row_indices_[p]]++;
+      lower.rows[q] = column;
+      lower.values[q] = upper[p];
     }
-    const int top = solver_internal::RowPattern(k, s.c_column_pointers_, s.c_row_indices_,
-                                                s.elimination_tree_, &stack, &mark);
-    x[k] = 0;
-    for (int p = s.c_column_pointers_[k]; p < s.c_column_pointers_[k + 1]; ++p) {
-      if (s.c_row_indices_[p] <= k) x[s.c_row_indices_[p]] = c_values[p];
-    }
-    double d = x[k];
-    x[k] = 0;
-    for (int t = top; t < n; ++t) {
-      const int i = stack[t];
-      const double lki = x[i] / l.values[s.column_pointers_[i]];
-      x[i] = 0;
-      for (std::int64_t p = s.column_pointers_[i] + 1; p < next[i]; ++p) {
-        x[l.rows[p]] -= l.values[p] * lki;
-      }
-      d -= lki * lki;
-      const std::int64_t q = next[i]++;
-      l.rows[q] = k;
-      l.values[q] = lki;
-    }
-    if (!(d > 0) || !std::isfinite(d)) {
-      return Status::Internal("matrix is not positive definite (pivot " + std::to_string(k) +
-                              " is " + std::to_string(d) + ")");
-    }
-    const std::int64_t q = next[k]++;
-    l.rows[q] = k;
-    l.values[q] = std::sqrt(d);
   }
-  return l;
+  return lower;
 }
 
-// Packs `l` into supernodal blocks (the layout in the class comment).
-void CholeskyFactor::PackSupernodes(const SymbolicCholesky& s, const ColumnFactor& l) {
+// The supernodal layout (the class comment), every block zero and every row index in place.
+void CholeskyFactor::LayOutSupernodes(const LowerTriangle& lower) {
+  const SymbolicCholesky& s = *symbolic_;
   const int num_supernodes = static_cast<int>(s.supernode_columns_.size()) - 1;
   // Supernode sn's rows: its own columns, then its last column's pattern below that column (every
   // member column's pattern lies in them: symbolic_cholesky.cc, SupernodeColumns).
-  const auto rows_of = [&](int sn) {
-    const int first = s.supernode_columns_[sn], last = s.supernode_columns_[sn + 1] - 1;
-    return static_cast<std::int64_t>(last - first) + s.column_pointers_[last + 1] -
-           s.column_pointers_[last];
-  };
   row_pointers_.assign(num_supernodes + 1, 0);
   value_pointers_.assign(num_supernodes + 1, 0);
   for (int sn = 0; sn < num_supernodes; ++sn) {
-    const int width = s.supernode_columns_[sn + 1] - s.supernode_columns_[sn];
-    const std::int64_t rows = rows_of(sn);
+    const int first = s.supernode_columns_[sn], last = s.supernode_columns_[sn + 1] - 1;
+    const int width = last - first + 1;
+    const std::int64_t rows = static_cast<std::int64_t>(last - first) +
+                              s.column_pointers_[last + 1] - s.column_pointers_[last];
     row_pointers_[sn + 1] = row_pointers_[sn] + rows;
     value_pointers_[sn + 1] = value_pointers_[sn] + rows * width;
   }
   row_indices_.resize(row_pointers_.back());
   values_.assign(value_pointers_.back() + kSolveValuePadding, 0.0);
-  std::vector<std::int64_t> position(static_cast<std::size_t>(s.n_), -1);  // row -> block row
-  for (int sn = 0; sn < num_supernodes; ++sn) {
-    const int first = s.supernode_columns_[sn];
-    const int last = s.supernode_columns_[sn + 1] - 1;
-    const int width = last - first + 1;
-    int* rows = row_indices_.data() + row_pointers_[sn];
-    for (int c = 0; c < width - 1; ++c) rows[c] = first + c;
-    std::copy(l.rows.begin() + s.column_pointers_[last],
-              l.rows.begin() + s.column_pointers_[last + 1], rows + (width - 1));
-    const std::int64_t count = row_pointers_[sn + 1] - row_pointers_[sn];
-    for (std::int64_t k = 0; k < count; ++k) position[rows[k]] = k;
-    double* block = values_.data() + value_pointers_[sn];
-    for (int c = 0; c < width; ++c) {
-      for (std::int64_t p = s.column_pointers_[first + c]; p < s.column_pointers_[first + c + 1];
-           ++p) {
-        block[position[l.rows[p]] * width + c] = l.values[p];
-      }
+  solver_internal::SupernodeRows(s.n_, s.supernode_columns_, row_pointers_, lower.pointers,
+                                 lower.rows, row_indices_.data());
+}
+
+Status CholeskyFactor::FactorizeSupernodal(const ColMajorMatrix& a, const CancelToken* cancel,
+                                           ParallelRunner* runner) {
+  const SymbolicCholesky& s = *symbolic_;
+  const LowerTriangle lower = PermutedLowerTriangle(s, a);
+  LayOutSupernodes(lower);
+  const solver_internal::SupernodalUpdates updates = solver_internal::PlanSupernodalUpdates(
+      s.n_, s.supernode_columns_, row_pointers_, row_indices_);
+  solver_internal::SupernodalNumericInput input;
+  input.size = s.n_;
+  input.num_supernodes = static_cast<int>(s.supernode_columns_.size()) - 1;
+  input.supernode_columns = s.supernode_columns_.data();
+  input.row_pointers = row_pointers_.data();
+  input.value_pointers = value_pointers_.data();
+  input.row_indices = row_indices_.data();
+  input.lower_pointers = lower.pointers.data();
+  input.lower_rows = lower.rows.data();
+  input.lower_values = lower.values.data();
+  input.updates = &updates;
+  input.values = values_.data();
+  const int helpers = runner != nullptr ? runner->IdleHelpers() : 0;
+  const ParallelSolvePlan plan =
+      helpers > 0 ? PlanParallelSolve(View(), 1 + helpers) : ParallelSolvePlan();
+  if (plan.parts < 2) {
+    std::vector<int> all(input.num_supernodes);
+    for (int sn = 0; sn < input.num_supernodes; ++sn) all[sn] = sn;
+    solver_internal::SupernodalWorkspace work;
+    return solver_internal::FactorizeSupernodes(input, all.data(), input.num_supernodes, &work,
+                                                cancel)
+        .status;
+  }
+  // The parts' subtrees side by side (each reads only its own supernodes), then the top.
+  struct Job {
+    const solver_internal::SupernodalNumericInput* input;
+    const ParallelSolvePlan* plan;
+    const CancelToken* cancel;
+    std::vector<solver_internal::SupernodalResult> results;
+  } job{&input, &plan, cancel, std::vector<solver_internal::SupernodalResult>(plan.parts)};
+  runner->Run(
+      plan.parts,
+      [](void* context, int part) {
+        Job& j = *static_cast<Job*>(context);
+        const int begin = j.plan->part_offsets[part], end = j.plan->part_offsets[part + 1];
+        solver_internal::SupernodalWorkspace work;
+        j.results[part] = solver_internal::FactorizeSupernodes(
+            *j.input, j.plan->part_supernodes.data() + begin, end - begin, &work, j.cancel);
+      },
+      &job);
+  // A failed part: the smallest column that failed (cancellation first), as one thread would.
+  const solver_internal::SupernodalResult* failed = nullptr;
+  for (const solver_internal::SupernodalResult& r : job.results) {
+    if (r.status.ok()) continue;
+    if (failed == nullptr || r.failed_column < 0 ||
+        (failed->failed_column >= 0 && r.failed_column < failed->failed_column)) {
+      failed = &r;
     }
   }
+  if (failed != nullptr) return failed->status;
+  solver_internal::SupernodalWorkspace work;
+  return solver_internal::FactorizeSupernodes(input, plan.top.data(),
+                                              static_cast<int>(plan.top.size()), &work, cancel)
+      .status;
 }
 
 std::size_t CholeskyFactor::WorkSize() const {
@@ -246,6 +267,29 @@ void CholeskyFactor::LongestUnitSolvePath(std::int64_t* columns, int* supernodes
 
 int CholeskyFactor::SupernodeWidth(int s) const {
   return symbolic_->supernode_columns_[s + 1] - symbolic_->supernode_columns_[s];
+}
+
+Eigen::SparseMatrix<double, Eigen::ColMajor, int> CholeskyFactor::FactorMatrix() const {
+  if (!symbolic_) return {};
+  const SymbolicCholesky& s = *symbolic_;
+  std::vector<Eigen::Triplet<double, int>> entries;
+  entries.reserve(static_cast<std::size_t>(value_pointers_.back()));
+  for (std::size_t sn = 0; sn + 1 < row_pointers_.size(); ++sn) {
+    const int first = s.supernode_columns_[sn];
+    const int width = s.supernode_columns_[sn + 1] - first;
+    for (std::int64_t k = 0; k < row_pointers_[sn + 1] - row_pointers_[sn]; ++k) {
+      const int row = row_indices_[row_pointers_[sn] + k];
+      for (int c = 0; c < width && first + c <= row; ++c) {
+        const std::int64_t at = value_pointers_[sn] + k * width + c;
+        entries.emplace_back(
+            row, first + c,
+            stores_float32() ? static_cast<double>(float_values_[at]) : values_[at]);
+      }
+    }
+  }
+  Eigen::SparseMatrix<double, Eigen::ColMajor, int> l(s.n_, s.n_);
+  l.setFromTriplets(entries.begin(), entries.end());
+  return l;
 }
 
 SupernodalFactorView CholeskyFactor::View() const {

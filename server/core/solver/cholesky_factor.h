@@ -22,15 +22,24 @@ class CholeskyFactor {
   CholeskyFactor() = default;
 
   // `a` must have exactly the pattern that `symbolic` was analysed with. INTERNAL if `a` is not
-  // positive definite (names the pivot); INVALID_ARGUMENT for another pattern or a null `symbolic`.
-  // `cancel` (optional) is checked every kCancelCheckRows rows: once it is cancelled the
-  // factorization stops there with FAILED_PRECONDITION "cancelled during the numeric
-  // factorization" and frees what it built: a cancel waits for at most kCancelCheckRows rows, not
-  // for the whole factorization of a large mesh (docs/performance.md, "Time to first frame").
+  // positive definite (names the pivot: a column of the factor's order); INVALID_ARGUMENT for
+  // another pattern or a null `symbolic`. Supernodal and left-looking
+  // (internal/supernodal_numeric.h): each supernode's block updated by its descendants' blocks and
+  // factorized in dense kernels, in place in the factor's storage; beside the factor it holds C's
+  // lower triangle, the list of updates and, per thread, one update's dense product. `runner`
+  // (optional): when it has idle helpers, disjoint subtrees of the supernodal elimination tree
+  // (PlanParallelSolve's parts) are factorized on its threads, then the supernodes above them on
+  // the calling thread; the factor is the same as on one thread, bit for bit (every supernode's
+  // sums run in the same order). `cancel` (optional) is checked before every supernode (at most 128
+  // columns, fewer than kCancelCheckRows: symbolic_cholesky.cc, SupernodeColumns) on every thread:
+  // once it is cancelled the factorization stops there with FAILED_PRECONDITION "cancelled during
+  // the numeric factorization" and frees what it built: a cancel waits for at most one supernode on
+  // each thread, not for the whole factorization of a large mesh (docs/performance.md, "Time to
+  // first frame").
   static StatusOr<CholeskyFactor> Factorize(
       std::shared_ptr<const SymbolicCholesky> symbolic,
       const Eigen::SparseMatrix<double, Eigen::ColMajor, int>& a,
-      const CancelToken* cancel = nullptr);
+      const CancelToken* cancel = nullptr, ParallelRunner* runner = nullptr);
   static constexpr int kCancelCheckRows = 256;
 
   int size() const { return symbolic_ ? symbolic_->size() : 0; }
@@ -107,11 +116,16 @@ class CholeskyFactor {
   void LongestUnitSolvePath(std::int64_t* columns, int* supernodes) const;
   // Supernode s's columns (in the factor's order): [first, first + width).
   int SupernodeWidth(int s) const;
+  // L in the factor's order (P A P^T = L L^T, P the analysis' permutation()), column-major, with
+  // the supernodes' explicit zeros: for tests and tools, not for solving. Empty (0 by 0) for an
+  // empty factor; a float32 factor gives its rounded values.
+  Eigen::SparseMatrix<double, Eigen::ColMajor, int> FactorMatrix() const;
 
  private:
   using ColMajorMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
-  // L column by column before it is packed: per column the diagonal first, then rows ascending.
-  struct ColumnFactor {
+  // C = P A P^T's lower triangle by columns (each column's rows ascending), with its values.
+  struct LowerTriangle {
+    std::vector<std::int64_t> pointers;
     std::vector<int> rows;
     std::vector<double> values;
   };
@@ -119,10 +133,10 @@ class CholeskyFactor {
   static Status CheckAnalysedPattern(const SymbolicCholesky& s, const ColMajorMatrix& a);
   static std::vector<double> PermutedUpperValues(const SymbolicCholesky& s,
                                                  const ColMajorMatrix& a);
-  static StatusOr<ColumnFactor> UpLookingCholesky(const SymbolicCholesky& s,
-                                                  const std::vector<double>& c_values,
-                                                  const CancelToken* cancel);
-  void PackSupernodes(const SymbolicCholesky& s, const ColumnFactor& l);
+  static LowerTriangle PermutedLowerTriangle(const SymbolicCholesky& s, const ColMajorMatrix& a);
+  void LayOutSupernodes(const LowerTriangle& lower);
+  Status FactorizeSupernodal(const ColMajorMatrix& a, const CancelToken* cancel,
+                             ParallelRunner* runner);
 
   SupernodalFactorView View() const;
 

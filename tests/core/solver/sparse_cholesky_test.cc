@@ -11,10 +11,12 @@
 #include <random>
 #include <string>
 #include <thread>
+#include <tuple>
 #include <utility>
 #include <vector>
 
 #include "core/base/cancel_token.h"
+#include "tests/core/solver/up_looking_reference.h"
 
 namespace deform {
 namespace {
@@ -108,6 +110,34 @@ TEST_P(SparseCholeskyTest, RefactorizationReusesTheAnalysis) {
   ASSERT_TRUE(reused->Solve3(b.data(), x1.data(), work.data()).ok());
   ASSERT_TRUE(fresh->Solve3(b.data(), x2.data(), work.data()).ok());
   EXPECT_LT((x1 - x2).norm(), 1e-12 * x2.norm());
+}
+
+TEST_P(SparseCholeskyTest, SupernodalFactorMatchesTheUpLookingOne) {
+  for (const auto& [n, edges, seed] :
+       {std::tuple{40, 2, 3u}, {300, 3, 5u}, {1500, 4, 9u}, {2500, 2, 13u}}) {
+    const ColMajorMatrix a = RandomSpdMatrix(n, edges, seed);
+    auto symbolic = SymbolicCholesky::Analyze(a, GetParam());
+    ASSERT_TRUE(symbolic.ok());
+    auto factor = CholeskyFactor::Factorize(*symbolic, a);
+    ASSERT_TRUE(factor.ok()) << factor.status().ToString();
+    EXPECT_LT(testing::DifferenceFromUpLookingFactor(*factor, **symbolic, a), 1e-13) << n;
+  }
+}
+
+TEST_P(SparseCholeskyTest, TwoThreadsFactorizeExactlyAsOne) {
+  const ColMajorMatrix a = RandomSpdMatrix(2500, 3, 21);
+  auto symbolic = SymbolicCholesky::Analyze(a, GetParam());
+  ASSERT_TRUE(symbolic.ok());
+  ThreadTeam team(2);
+  auto serial = CholeskyFactor::Factorize(*symbolic, a);
+  auto parallel = CholeskyFactor::Factorize(*symbolic, a, nullptr, &team);
+  ASSERT_TRUE(serial.ok() && parallel.ok());
+  const ColMajorMatrix difference = serial->FactorMatrix() - parallel->FactorMatrix();
+  EXPECT_EQ(difference.norm(), 0.0);
+  CancelToken cancelled;
+  cancelled.Cancel();
+  EXPECT_EQ(CholeskyFactor::Factorize(*symbolic, a, &cancelled, &team).status().ToString(),
+            "FAILED_PRECONDITION: cancelled during the numeric factorization");
 }
 
 TEST_P(SparseCholeskyTest, ACancelledFactorizationStopsAndAnUncancelledOneCompletes) {
@@ -734,6 +764,18 @@ TEST(SparseCholesky, IndefiniteMatrixIsRefused) {
   ASSERT_FALSE(factor.ok());
   EXPECT_EQ(factor.status().code(), StatusCode::kInternal);
   EXPECT_NE(factor.status().message().find("not positive definite"), std::string::npos);
+  // The pivot named is the negative diagonal's column in the factor's order (no column before it
+  // depends on it), on one thread or two.
+  auto symbolic = SymbolicCholesky::Analyze(a, Ordering::kAmd);
+  const std::vector<int>& permutation = (*symbolic)->permutation();
+  const int column =
+      static_cast<int>(std::find(permutation.begin(), permutation.end(), 10) - permutation.begin());
+  const std::string pivot = "(pivot " + std::to_string(column) + " is ";
+  EXPECT_NE(factor.status().message().find(pivot), std::string::npos) << factor.status().ToString();
+  ThreadTeam team(2);
+  const auto parallel = CholeskyFactor::Factorize(*symbolic, a, nullptr, &team);
+  EXPECT_NE(parallel.status().message().find(pivot), std::string::npos)
+      << parallel.status().ToString();
 }
 
 TEST(SparseCholesky, MissingDiagonalIsRefused) {

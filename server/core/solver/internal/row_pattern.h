@@ -1,5 +1,5 @@
-// The row patterns of a Cholesky factor, shared by the symbolic analysis (column counts) and the
-// numeric factorization (the up-looking elimination). Internal to the solver.
+// The row patterns of a Cholesky factor, for the symbolic analysis' column counts. Internal to the
+// solver.
 #pragma once
 
 #include <vector>
