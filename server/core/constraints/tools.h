@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <string_view>
 
 #include "core/base/status.h"
 #include "core/constraints/bone_contacts.h"
@@ -49,6 +50,10 @@ Status ValidateTool(const Tool& tool, int index, const Eigen::Vector3d& lower,
                     const Eigen::Vector3d& upper);
 Status ValidateToolSet(const ToolSet& tools, const Eigen::Vector3d& lower,
                        const Eigen::Vector3d& upper);
+
+// A tool from text: "sphere:X,Y,Z,R" or "capsule:X0,Y0,Z0,X1,Y1,Z1,R" (model units).
+// INVALID_ARGUMENT naming the text otherwise; the values are not validated (ValidateTool).
+StatusOr<Tool> ParseToolSpec(std::string_view text);
 
 // The penetration of the point `x` into `tool` (depth > 0: the distance to its surface; normal
 // outward; surface_point its nearest surface point; `surface` left to the caller), or false.
