@@ -56,9 +56,9 @@ struct ConstraintOptions {
   // needs more is flagged unresolved. In [0, kMaxContacts]. Default: 128.
   int max_contacts = 128;
   static constexpr int kMaxContacts = 256;
-  // At most this many tool contacts in a frame, besides max_contacts: a tool pressed 1 cm into the
-  // 26k leg holds a few dozen vertices (docs/instruments.md). 0: tools are refused. In
-  // [0, kMaxToolContacts]. Default: 64.
+  // At most this many tool contacts in a frame, besides max_contacts, so that a tool never takes
+  // the bones' budget (docs/instruments.md). 0: tools are refused. In [0, kMaxToolContacts].
+  // Default: 64.
   int max_tool_contacts = 64;
   static constexpr int kMaxToolContacts = 256;
   // Keep the enclosed volume of the skin (an open skin closed by a fan at each boundary loop)

@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <string>
-#include <vector>
+
+#include "core/base/tool_spec.h"
 
 namespace deform {
 namespace {
@@ -26,42 +26,12 @@ bool ToolSet::Add(const Tool& tool) {
 }
 
 StatusOr<Tool> ParseToolSpec(std::string_view text) {
-  const auto refuse = [&] {
-    return Status::InvalidArgument("tool '" + std::string(text) +
-                                   "': expected sphere:X,Y,Z,R or capsule:X0,Y0,Z0,X1,Y1,Z1,R");
-  };
-  const std::size_t colon = text.find(':');
-  if (colon == std::string_view::npos) return refuse();
-  const std::string_view shape = text.substr(0, colon);
+  DEFORM_ASSIGN_OR_RETURN(const ToolSpec spec, ParseToolSpecText(text));
   Tool tool;
-  std::size_t expected;
-  if (shape == "sphere") {
-    tool.shape = Tool::Shape::kSphere;
-    expected = 4;
-  } else if (shape == "capsule") {
-    tool.shape = Tool::Shape::kCapsule;
-    expected = 7;
-  } else {
-    return refuse();
-  }
-  std::vector<double> values;
-  const std::string numbers(text.substr(colon + 1));
-  std::size_t start = 0;
-  for (;;) {
-    const std::size_t comma = numbers.find(',', start);
-    const std::string item =
-        numbers.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-    char* end = nullptr;
-    const double value = std::strtod(item.c_str(), &end);
-    if (item.empty() || end != item.c_str() + item.size()) return refuse();
-    values.push_back(value);
-    if (comma == std::string::npos) break;
-    start = comma + 1;
-  }
-  if (values.size() != expected) return refuse();
-  tool.a = Eigen::Vector3d(values[0], values[1], values[2]);
-  tool.b = expected == 7 ? Eigen::Vector3d(values[3], values[4], values[5]) : tool.a;
-  tool.radius = values.back();
+  tool.shape = spec.capsule ? Tool::Shape::kCapsule : Tool::Shape::kSphere;
+  tool.a = Eigen::Vector3d(spec.a[0], spec.a[1], spec.a[2]);
+  tool.b = Eigen::Vector3d(spec.b[0], spec.b[1], spec.b[2]);
+  tool.radius = spec.radius;
   return tool;
 }
 

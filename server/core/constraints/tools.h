@@ -51,8 +51,8 @@ Status ValidateTool(const Tool& tool, int index, const Eigen::Vector3d& lower,
 Status ValidateToolSet(const ToolSet& tools, const Eigen::Vector3d& lower,
                        const Eigen::Vector3d& upper);
 
-// A tool from text: "sphere:X,Y,Z,R" or "capsule:X0,Y0,Z0,X1,Y1,Z1,R" (model units).
-// INVALID_ARGUMENT naming the text otherwise; the values are not validated (ValidateTool).
+// A tool from text (ParseToolSpecText, core/base/tool_spec.h); the values are not validated
+// (ValidateTool).
 StatusOr<Tool> ParseToolSpec(std::string_view text);
 
 // The penetration of the point `x` into `tool` (depth > 0: the distance to its surface; normal
