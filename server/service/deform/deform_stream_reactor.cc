@@ -329,7 +329,7 @@ void DeformStreamReactor::HandleStart() {
   stiffness_.Reset(model_->default_factorization());
   UpdateBatchKeyLocked();
   outbox_.AllocateFrames(entry_->client_vertex_count(), encoded_bytes, transform_floats,
-                         bone_surface_bytes, constraints != nullptr);
+                         bone_surface_bytes, constraints != nullptr && constraints->active());
   if (!pump_.finish_requested()) StartRead(&request_);
 }
 

@@ -195,6 +195,9 @@ void FrameSolver::Finish(const PoseInput& input, const Deformed& deformed, const
       constraints_ != nullptr && (constraints_->active() || !input.tools.empty());
   const double constraint_ms =
       constrained ? Constrain(*deformed.factorization, input.tools, frame) : 0.0;
+  // A mesh whose constraints act only with tools: a frame without them reports zeros (its slot
+  // may hold an earlier tool frame's report; cleared, not freed, so no frame allocates).
+  if (!constrained && frame->has_constraints()) frame->mutable_constraints()->Clear();
   if (encoder_) {
     Encode(frame);
   } else {

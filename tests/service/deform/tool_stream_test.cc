@@ -110,5 +110,36 @@ TEST_P(ToolStreamTest, BadToolsRejectThePoseAndTheStreamGoesOn) {
   EXPECT_TRUE(stream->Wait().ok());
 }
 
+TEST_P(ToolStreamTest, AMeshWithoutBonesOrVolumeTakesTools) {
+  StartServer();
+  v1::LoadMeshHeader header;
+  header.mutable_phantom()->set_vertices(kVertices);
+  header.mutable_phantom()->set_without_bones(true);
+  header.mutable_options()->mutable_constraints()->set_keep_volume(false);
+  v1::MeshSummary summary;
+  ASSERT_TRUE(client_->LoadMesh(header, {}, &summary).ok());
+  StreamRecorder recorder(/*keep_positions=*/true);
+  auto stream = OpenStream(summary.mesh_id(), recorder.Callbacks());
+  ASSERT_TRUE(stream->SendPose(KneePose(1, 30)));
+  ASSERT_TRUE(recorder.WaitForFrameWithSequence(1));
+  const v1::DeformFrame free = recorder.last_frame();
+  EXPECT_FALSE(free.has_constraints());
+  ASSERT_TRUE(stream->SendPose(WithTool(KneePose(2, 30), kSphere)));
+  ASSERT_TRUE(recorder.WaitForFrameWithSequence(2));
+  const v1::DeformFrame pressed = recorder.last_frame();
+  EXPECT_GT(pressed.constraints().tool_contacts(), 0u);
+  EXPECT_LE(pressed.constraints().tool_max_depth_after(), 1e-4 * kDiagonal);
+  for (std::uint64_t sequence = 3; sequence <= 5; ++sequence) {  // through every frame slot
+    ASSERT_TRUE(stream->SendPose(KneePose(sequence, 30)));
+    ASSERT_TRUE(recorder.WaitForFrameWithSequence(sequence));
+    const v1::DeformFrame lifted = recorder.last_frame();
+    EXPECT_EQ(lifted.positions(), free.positions());
+    EXPECT_EQ(lifted.constraints().tool_contacts(), 0u);
+    EXPECT_EQ(lifted.constraints().tool_penetrating_before(), 0u);
+  }
+  stream->Close();
+  EXPECT_TRUE(stream->Wait().ok());
+}
+
 }  // namespace
 }  // namespace deform::test_support
