@@ -20,6 +20,7 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <memory>
 #include <string>
@@ -161,6 +162,85 @@ void BM_ConstrainedFrame(benchmark::State& state, BenchMesh mesh, int degrees) {
   state.counters["inside_after"] = report.after.vertices;
   state.counters["contacts"] = report.contacts;
   state.counters["solves"] = report.solves;
+}
+
+// A whole frame with the constraints and `tool_contacts` tool constraints (0: no tool, the same
+// frame as ConstrainedFrame/): four spheres (ToolSet::kMaxTools) pressed half their radius into
+// the skin from +x, -x, +z and -z at its extreme vertices in those directions in the middle fifth
+// of its height (y, the limbs' long axis) in the benchmark frame, like four fingers, all of one
+// radius: the smallest (by bisection) that puts at least `tool_contacts` skin vertices inside them,
+// so the frame holds that many (ConstraintOptions::max_tool_contacts). Compare ToolFrame/tools:0/
+// with ToolFrame/tools:64/ of the same mesh in the same run.
+void BM_ToolFrame(benchmark::State& state, BenchMesh mesh, int tool_contacts) {
+  auto frames = SetUpFrames(state, mesh);
+  if (!frames) return;
+  auto bones = BoneContacts::Create(BenchBones(mesh, *frames->model), frames->model->skeleton(),
+                                    frames->model->mesh(), frames->model->rigid_bones());
+  if (!bones.ok()) {
+    state.SkipWithError(bones.status().ToString().c_str());
+    return;
+  }
+  ConstraintOptions options;
+  if (tool_contacts > 0) options.max_tool_contacts = tool_contacts;
+  auto constraints = SkinConstraints::Create(*frames->model, *bones, options);
+  if (!constraints.ok()) {
+    state.SkipWithError(constraints.status().ToString().c_str());
+    return;
+  }
+  ConstraintScratch scratch = (*constraints)->MakeScratch();
+  ConstraintReport report;
+  frames->model->Deform(*frames->factorization, frames->pose, &frames->scratch);
+  (*constraints)->Apply(*frames->factorization, &frames->scratch, &scratch, &report);
+  ToolSet tools;
+  if (tool_contacts > 0) {
+    const Positions free = frames->scratch.positions();
+    const double diagonal = frames->model->bounding_box_diagonal();
+    const double y_low = free.col(1).minCoeff(), y_high = free.col(1).maxCoeff();
+    const Eigen::Vector3d directions[4] = {Eigen::Vector3d::UnitX(), -Eigen::Vector3d::UnitX(),
+                                           Eigen::Vector3d::UnitZ(), -Eigen::Vector3d::UnitZ()};
+    Eigen::Vector3d extremes[4];
+    for (int t = 0; t < 4; ++t) {
+      double best = -std::numeric_limits<double>::infinity();
+      for (Eigen::Index i = 0; i < free.rows(); ++i) {
+        const double h = (free(i, 1) - y_low) / (y_high - y_low);
+        const Eigen::Vector3d x = free.row(i).transpose();
+        if (h < 0.4 || h > 0.6 || directions[t].dot(x) <= best) continue;
+        best = directions[t].dot(x);
+        extremes[t] = x;
+      }
+    }
+    const int n = static_cast<int>(free.rows());
+    auto press = [&](double radius) {
+      tools = {};
+      for (int t = 0; t < 4; ++t) {
+        Tool tool;
+        tool.radius = radius;
+        tool.a = extremes[t] + 0.5 * radius * directions[t];
+        tools.Add(tool);
+      }
+      PenetrationSummary summary;
+      FindToolPenetrations(tools, free.data(), n, nullptr, 0, &summary);
+      return summary.vertices;
+    };
+    double low = 0, high = 0.25 * diagonal;
+    for (int step = 0; step < 40; ++step) {
+      const double middle = 0.5 * (low + high);
+      (press(middle) >= tool_contacts ? high : low) = middle;
+    }
+    press(high);
+    state.counters["tool_radius_per_diagonal"] = high / diagonal;
+  }
+  const auto seconds = TimeEach(state, [&] {
+    frames->model->Deform(*frames->factorization, frames->pose, &frames->scratch);
+    (*constraints)
+        ->Apply(*frames->factorization, &frames->scratch, &scratch, &report,
+                tools.empty() ? nullptr : &tools);
+  });
+  ReportAgainstBound(state, frames->factorization->factor().bytes(), seconds);
+  state.counters["tool_contacts"] = report.tool_contacts;
+  state.counters["tool_inside_before"] = report.tool_before.vertices;
+  state.counters["tool_inside_after"] = report.tool_after.vertices;
+  state.counters["rounds"] = report.rounds;
 }
 
 // A whole frame of the linear rotation blend (METHOD.md's fast path): kinematics and one pass over
@@ -591,6 +671,11 @@ void RegisterBenchmarks(const BenchMesh& mesh) {
   RegisterFor(mesh, "Frame", BM_Frame)->MinTime(1.0);
   RegisterFor(mesh, "ConstrainedFrame", BM_ConstrainedFrame, 0)->MinTime(1.0);
   RegisterFor(mesh, "ConstrainedFrame/degrees:120", BM_ConstrainedFrame, 120)->MinTime(1.0);
+  for (const int tool_contacts : {0, 64}) {
+    RegisterFor(mesh, "ToolFrame/tools:" + std::to_string(tool_contacts), BM_ToolFrame,
+                tool_contacts)
+        ->MinTime(1.0);
+  }
   RegisterFor(mesh, "LinearBlendFrame", BM_LinearBlendFrame)->MinTime(1.0);
   RegisterFor(mesh, "RightHandSide", BM_RightHandSide)->MinTime(0.5);
   RegisterFor(mesh, "TriangularSolve", BM_TriangularSolve, BestSolveKernel())->MinTime(1.0);

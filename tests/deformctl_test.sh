@@ -3,9 +3,11 @@
 # On a small phantom: the ablation switches --joint-nodes and --material (default on/on, in the
 # JSON as joint_nodes_enabled and material_enabled, off removing the joint nodes or the material
 # weights; --material-profile 1,1,1 is --material off), the methods cor and ddm (rest pose in,
-# rest mesh out), the triangle counts in the JSON, the bone surfaces (the phantom's, capsules, files; bone_penetration for every method) and the
-# constraints (--contacts, --bone-reach, --volume), and bad values (exit 2 for a flag CLI11 refuses, 1 for an
-# unknown method or a bad bone surface). Needs python3.
+# rest mesh out), the triangle counts in the JSON, the bone surfaces (the phantom's, capsules,
+# files; bone_penetration for every method), the
+# constraints (--contacts, --bone-reach, --volume), bad values (exit 2 for a flag CLI11 refuses,
+# 1 for an unknown method or a bad bone surface), and --tool (a sphere, a capsule:
+# tool_penetration_max, tool_dent; bad tools refused with exit 1). Needs python3.
 set -euo pipefail
 DEFORMCTL="$1"
 WORK="$(mktemp -d)"
@@ -124,6 +126,33 @@ grep -q -- "--rigid-weight-tolerance" "$WORK/err" ||
   { echo "FAIL: the refusal does not name --rigid-weight-tolerance" >&2; failed=1; }
 run "--rigid-weight-tolerance 0.2 is accepted" 0 "d['input_warnings'] == []" \
   --rigid-weight-tolerance 0.2
+
+# Tools (the 800-vertex phantom: front of the thigh at y 6, z 0.66; diagonal 8.97).
+run "--tool sphere presses the skin and leaves none inside" 0 \
+  "d['tools'] == 1 and d['tool_penetration']['before']['vertices'] > 0 and \
+   d['tool_penetration_max'] <= 1e-4 * 8.97 and not d['tool_penetration']['unresolved'] and \
+   d['tool_dent']['vertices'] > 0 and d['tool_dent']['max_displacement'] > 0.05 and \
+   d['bone_penetration']['vertices'] == 0" \
+  --tool sphere:0,6,0.86,0.3
+run "--tool capsule and a sphere together" 0 \
+  "d['tools'] == 2 and d['tool_penetration']['before']['vertices'] > 0 and \
+   d['tool_penetration_max'] <= 1e-4 * 8.97" \
+  --pose knee:flexion:45 --tool capsule:-0.3,6,0.8,0.3,6,0.8,0.2 --tool sphere:0,6.8,0.9,0.3
+run "--tool away from the skin changes nothing" 0 \
+  "d['tool_penetration']['before']['vertices'] == 0 and d['tool_dent']['vertices'] == 0 and \
+   d['tool_dent']['max_displacement'] == 0" \
+  --tool sphere:0,6,3,0.3
+run "--tool with --contacts off --volume off still pushes" 0 \
+  "d['tool_penetration_max'] <= 1e-4 * 8.97 and d['tool_dent']['vertices'] > 0" \
+  --contacts off --volume off --tool sphere:0,6,0.86,0.3
+run "--tool without a radius is refused" 1 "" --tool sphere:0,6,0.86
+grep -q "expected sphere:X,Y,Z,R" "$WORK/err" || { echo "FAIL: the refusal does not show the form" >&2; failed=1; }
+run "--tool with a negative radius is refused" 1 "" --tool sphere:0,6,0.86,-1
+run "--tool with a radius beyond half the diagonal is refused" 1 "" --tool sphere:0,6,0.86,5
+run "--tool cube is refused" 1 "" --tool cube:0,6,0.86,0.3
+run "five --tool are refused" 1 "" --tool sphere:0,6,3,0.1 --tool sphere:0,6,3,0.1 \
+  --tool sphere:0,6,3,0.1 --tool sphere:0,6,3,0.1 --tool sphere:0,6,3,0.1
+run "--tool with --method lbs is refused" 1 "" --method lbs --tool sphere:0,6,0.86,0.3
 
 [ "$failed" -eq 0 ] || exit 1
 echo "PASS: deformctl deform's flags"

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/base/pose_spec.h"
+#include "core/base/tool_spec.h"
 #include "deform_client.h"
 
 namespace deform::client {
@@ -23,6 +24,42 @@ bool ParsePoseAngles(const std::string& spec, deform::v1::PoseUpdate* pose, std:
     angle->set_joint(term.joint);
     angle->set_axis(term.axis);
     angle->set_degrees(term.degrees);
+  }
+  return true;
+}
+
+void AddSphereTool(double x, double y, double z, double radius, deform::v1::PoseUpdate* pose) {
+  deform::v1::ToolState* tool = pose->add_tools();
+  tool->set_shape(deform::v1::ToolState::SHAPE_SPHERE);
+  tool->mutable_center()->set_x(x);
+  tool->mutable_center()->set_y(y);
+  tool->mutable_center()->set_z(z);
+  tool->set_radius(radius);
+}
+
+void AddCapsuleTool(const double center[3], const double end[3], double radius,
+                    deform::v1::PoseUpdate* pose) {
+  deform::v1::ToolState* tool = pose->add_tools();
+  tool->set_shape(deform::v1::ToolState::SHAPE_CAPSULE);
+  tool->mutable_center()->set_x(center[0]);
+  tool->mutable_center()->set_y(center[1]);
+  tool->mutable_center()->set_z(center[2]);
+  tool->mutable_end()->set_x(end[0]);
+  tool->mutable_end()->set_y(end[1]);
+  tool->mutable_end()->set_z(end[2]);
+  tool->set_radius(radius);
+}
+
+bool AddToolSpec(const std::string& spec, deform::v1::PoseUpdate* pose, std::string* error) {
+  StatusOr<ToolSpec> parsed = ParseToolSpecText(spec);
+  if (!parsed.ok()) {
+    if (error != nullptr) *error = parsed.status().ToString();
+    return false;
+  }
+  if (parsed->capsule) {
+    AddCapsuleTool(parsed->a, parsed->b, parsed->radius, pose);
+  } else {
+    AddSphereTool(parsed->a[0], parsed->a[1], parsed->a[2], parsed->radius, pose);
   }
   return true;
 }

@@ -181,6 +181,15 @@ std::vector<BoneSurfaceMotion> DecodeBoneTransforms(const std::string& bytes);
 // "JOINT:AXIS:DEGREES[,...]" (deformctl's syntax) into JointAngle terms; INVALID_ARGUMENT status
 // in `error` (and false) for malformed text. Joint and axis names are checked by the server.
 bool ParsePoseAngles(const std::string& spec, deform::v1::PoseUpdate* pose, std::string* error);
+// A tool pressing the skin (docs/instruments.md) added to `pose`'s tools: a sphere, or a capsule
+// from `center` to `end`; model units, the posed skin's frame. The server checks the values (and
+// at most 4 tools a pose) and rejects the pose otherwise.
+void AddSphereTool(double x, double y, double z, double radius, deform::v1::PoseUpdate* pose);
+void AddCapsuleTool(const double center[3], const double end[3], double radius,
+                    deform::v1::PoseUpdate* pose);
+// "sphere:X,Y,Z,R" or "capsule:X0,Y0,Z0,X1,Y1,Z1,R" (deformctl's --tool) added to `pose`'s tools;
+// INVALID_ARGUMENT status in `error` (and false, nothing added) for malformed text.
+bool AddToolSpec(const std::string& spec, deform::v1::PoseUpdate* pose, std::string* error);
 // float32 little-endian xyz bytes into floats (3 per vertex).
 std::vector<float> DecodePositions(const std::string& bytes);
 // Nanoseconds of a monotonic clock (for client_timestamp_ns and latency).

@@ -8,6 +8,7 @@
 //                    [--bone-surface FILE:BONE ...] [--bones input|capsules|none]
 //                    [--contacts on|off] [--bone-reach on|off] [--volume on|off]
 //                    [--out-bones DIR]
+//                    [--tool sphere:X,Y,Z,R | capsule:X0,Y0,Z0,X1,Y1,Z1,R ...]
 //                    [--rigid-weight-tolerance X]
 //   deformctl phantom --out FILE [--skeleton-out FILE] [--vertices N]
 //
@@ -15,8 +16,10 @@
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -27,6 +30,7 @@
 #include "core/base/text.h"
 #include "core/constraints/bone_reach.h"
 #include "core/constraints/skin_constraints.h"
+#include "core/constraints/tools.h"
 #include "core/eval/method_comparison.h"
 #include "core/io/bone_surface_io.h"
 #include "core/io/mesh_io.h"
@@ -57,6 +61,7 @@ struct DeformArgs {
   bool bone_reach = true;       // ModelOptions::unanchored_vertices from SkinReachedAcrossJoints
   int unanchored_vertices = 0;  // set once they are found
   std::string out_bones_dir;
+  std::vector<std::string> tools;  // ParseToolSpec's text
   int bone_surface_count = 0;      // set once they are loaded
   std::string joint_nodes = "on";  // off: ModelOptions::use_joint_nodes = false
   std::string material = "on";     // off: ModelOptions::uniform_material = true
@@ -217,6 +222,41 @@ nlohmann::ordered_json DeformReport(const DeformArgs& args, const deform::ModelI
   return out;
 }
 
+// The dent the tools made: the vertices that moved more than 1e-3 of the diagonal from the
+// tool-free frame, and the largest distance (in the tool-free frame, from the nearest tool's
+// surface; 0 inside) at which one did.
+nlohmann::ordered_json ToolDentJson(const deform::ToolSet& tools, const deform::Positions& free,
+                                    const deform::Positions& posed, double diagonal) {
+  constexpr double kDentFraction = 1e-3;
+  int moved = 0;
+  double extent = 0, largest = 0;
+  for (Eigen::Index i = 0; i < free.rows(); ++i) {
+    const double displacement = (posed.row(i) - free.row(i)).norm();
+    largest = std::max(largest, displacement);
+    if (displacement <= kDentFraction * diagonal) continue;
+    ++moved;
+    const Eigen::Vector3d x = free.row(i).transpose();
+    double distance = std::numeric_limits<double>::infinity();
+    for (int t = 0; t < tools.count; ++t) {
+      const deform::Tool& tool = tools.tools[t];
+      Eigen::Vector3d axis_point = tool.a;
+      if (tool.shape == deform::Tool::Shape::kCapsule) {
+        const Eigen::Vector3d segment = tool.b - tool.a;
+        const double length2 = segment.squaredNorm();
+        const double u =
+            length2 > 0 ? std::clamp((x - tool.a).dot(segment) / length2, 0.0, 1.0) : 0;
+        axis_point = tool.a + u * segment;
+      }
+      distance = std::min(distance, std::max(0.0, (x - axis_point).norm() - tool.radius));
+    }
+    extent = std::max(extent, distance);
+  }
+  return {{"threshold", kDentFraction * diagonal},
+          {"vertices", moved},
+          {"max_distance", extent},
+          {"max_displacement", largest}};
+}
+
 int RunDeform(DeformArgs args) {
   auto method = deform::MethodFromName(args.method);
   if (!method.ok()) return Fail(method.status());
@@ -254,7 +294,22 @@ int RunDeform(DeformArgs args) {
   }
   auto constraints = deform::SkinConstraints::Create(**model, bones, constraint_options);
   if (!constraints.ok()) return Fail(constraints.status());
-  auto run = deform::RunMethod(**model, *method, pose, args.repeat, constraints->get());
+  deform::ToolSet tools;
+  for (const std::string& spec : args.tools) {
+    auto tool = deform::ParseToolSpec(spec);
+    if (!tool.ok()) return Fail(tool.status());
+    if (!tools.Add(*tool)) {
+      return Fail(Status::InvalidArgument("at most " + std::to_string(deform::ToolSet::kMaxTools) +
+                                          " --tool"));
+    }
+  }
+  const Eigen::Vector3d lower = input->mesh.vertices.colwise().minCoeff().transpose();
+  const Eigen::Vector3d upper = input->mesh.vertices.colwise().maxCoeff().transpose();
+  if (const Status valid = deform::ValidateToolSet(tools, lower, upper); !valid.ok()) {
+    return Fail(valid);
+  }
+  auto run = deform::RunMethod(**model, *method, pose, args.repeat, constraints->get(),
+                               tools.empty() ? nullptr : &tools);
   if (!run.ok()) return Fail(run.status());
   if (!args.out_bones_dir.empty()) {
     std::vector<deform::RigidTransform> transforms;
@@ -274,7 +329,21 @@ int RunDeform(DeformArgs args) {
   for (const std::string& warning : (*model)->binding_report().warnings) {
     std::cerr << "deformctl: warning: " << warning << "\n";
   }
-  std::cout << DeformReport(args, *input, **model, *method, *run, *clamped).dump() << std::endl;
+  nlohmann::ordered_json report = DeformReport(args, *input, **model, *method, *run, *clamped);
+  if (!tools.empty()) {
+    // The dent: against the same frame without tools.
+    auto free = deform::RunMethod(**model, *method, pose, 1, constraints->get());
+    if (!free.ok()) return Fail(free.status());
+    report["tools"] = static_cast<int>(args.tools.size());
+    report["tool_penetration_max"] = run->constraints.tool_after.max_depth;
+    report["tool_penetration"] = {{"before", PenetrationJson(run->constraints.tool_before)},
+                                  {"after", PenetrationJson(run->constraints.tool_after)},
+                                  {"contacts", run->constraints.tool_contacts},
+                                  {"unresolved", run->constraints.tools_unresolved}};
+    report["tool_dent"] =
+        ToolDentJson(tools, free->posed, run->posed, (*model)->bounding_box_diagonal());
+  }
+  std::cout << report.dump() << std::endl;
   return 0;
 }
 
@@ -358,6 +427,11 @@ CLI::App* AddDeformCommand(CLI::App* app, DeformArgs* args) {
                    "on | off: keep the skin's enclosed volume (paper, paper-linear)")
       ->transform(CLI::CheckedTransformer(OnOff()))
       ->default_str("on");
+  command->add_option("--tool", args->tools,
+                      "A tool pressing the skin (paper, paper-linear), in model units and the "
+                      "posed skin's frame: sphere:X,Y,Z,R or capsule:X0,Y0,Z0,X1,Y1,Z1,R; "
+                      "repeatable, at most " +
+                          std::to_string(deform::ToolSet::kMaxTools));
   command->add_option("--out-bones", args->out_bones_dir,
                       "Write each bone surface, posed, as DIR/NAME.obj");
   AddWithDefault(command, "--joint-nodes", &args->joint_nodes,

@@ -7,7 +7,7 @@
         stream.send_pose("knee:flexion:90"); print(stream.next_frame().positions.shape)
 
 Modules: client (DeformClient, MeshInfo, BoneSurface), stream (DeformStream, Frame), codec (the frame
-decoders), meshopt (meshoptimizer's decoder through ctypes), poses (pose forms), errors
+decoders), meshopt (meshoptimizer's decoder through ctypes), poses (pose forms), tools (tool forms), errors
 (DeformError), stubs (the generated deform.v1 code, `pb`: see stubs.py for where it is found).
 """
 
@@ -15,6 +15,7 @@ from .client import BoneSurface, DeformClient, MeshInfo, client_from_environment
 from .errors import DeformError
 from .stream import DeformStream, Frame
 from .stubs import pb
+from .tools import tool_state
 
 __all__ = ["BoneSurface", "DeformClient", "DeformError", "DeformStream", "Frame", "MeshInfo",
-           "client_from_environment", "pb"]
+           "client_from_environment", "pb", "tool_state"]

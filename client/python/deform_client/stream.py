@@ -26,6 +26,7 @@ from . import codec
 from .errors import DeformError
 from .poses import pose_update
 from .stubs import pb
+from .tools import tool_states
 
 _END = object()
 
@@ -101,15 +102,21 @@ class DeformStream:
 
     # Sending.
 
-    def send_pose(self, pose, sequence=None):
+    def send_pose(self, pose, sequence=None, tools=None):
         """Sends a pose (poses.py: "knee:flexion:90", {"joint":..., "axis":..., "degrees":...},
-        a list of them, or a PoseUpdate, whose own sequence is kept when set). Returns its sequence
-        number (one more than the largest sent so far unless given; the first is 1).
-        RuntimeError once the stream is closed or ended; ValueError for a malformed pose."""
+        a list of them, or a PoseUpdate, whose own sequence is kept when set), with `tools`
+        (tools.py: "sphere:X,Y,Z,R", a list of tools, or None: the PoseUpdate's own, if any; a
+        pose without tools is the tool-free frame). Returns its sequence number (one more than the
+        largest sent so far unless given; the first is 1). RuntimeError once the stream is closed
+        or ended; ValueError for a malformed pose or tool."""
+        states = tool_states(tools)
         with self._lock:
             if sequence is None:
                 sequence = self._next_sequence
             update = pose_update(pose, int(sequence), time.monotonic_ns())
+            if states:
+                del update.tools[:]
+                update.tools.extend(states)
             self._put_locked(pb.DeformRequest(pose=update))
             self._next_sequence = max(self._next_sequence, update.sequence + 1)
             return update.sequence

@@ -67,6 +67,11 @@ StatusOr<std::shared_ptr<const SkinConstraints>> SkinConstraints::Create(
     return Status::InvalidArgument("max_contacts must be in [0, " +
                                    std::to_string(ConstraintOptions::kMaxContacts) + "]");
   }
+  if (options.max_tool_contacts < 0 ||
+      options.max_tool_contacts > ConstraintOptions::kMaxToolContacts) {
+    return Status::InvalidArgument("max_tool_contacts must be in [0, " +
+                                   std::to_string(ConstraintOptions::kMaxToolContacts) + "]");
+  }
   if (!(options.volume_tolerance > 0 && options.volume_tolerance < 1)) {
     return Status::InvalidArgument("volume_tolerance must be in (0, 1)");
   }
@@ -91,7 +96,7 @@ StatusOr<std::shared_ptr<const SkinConstraints>> SkinConstraints::Create(
     any_free = any_free || constraints->volume_free_[i];
   }
   const double cube = std::pow(model.bounding_box_diagonal(), 3);
-  if (constraints->bones_ != nullptr) {
+  if (constraints->ContactCapacity() > 0) {
     model.default_factorization()->factor().LongestUnitSolvePath(&constraints->path_columns_,
                                                                  &constraints->path_supernodes_);
   }
@@ -119,11 +124,15 @@ StatusOr<std::shared_ptr<const SkinConstraints>> SkinConstraints::Create(
   return std::shared_ptr<const SkinConstraints>(std::move(constraints));
 }
 
+int SkinConstraints::ContactCapacity() const {
+  return (bones_ != nullptr ? options_.max_contacts : 0) + options_.max_tool_contacts;
+}
+
 ConstraintScratch SkinConstraints::MakeScratch() const {
   ConstraintScratch s;
   s.owner = this;
   const std::size_t rows = rows_;
-  const std::size_t k = options_.max_contacts;
+  const std::size_t k = ContactCapacity();
   s.base.resize(3 * rows);
   s.correction.resize(3 * rows);
   if (keeps_volume_) {
@@ -132,7 +141,7 @@ ConstraintScratch SkinConstraints::MakeScratch() const {
     s.bone_directions.resize(direction_bones_.size() * 3 * rows);
     s.rotations.resize(model_->skeleton().num_bones());
   }
-  if (bones_ != nullptr && k > 0) {
+  if (k > 0) {
     s.unit_work.assign(rows, 0.0);
     s.paths.resize(k * path_supernodes_);
     s.path_lengths.resize(k);
@@ -150,7 +159,7 @@ ConstraintScratch SkinConstraints::MakeScratch() const {
 
 std::size_t SkinConstraints::ScratchBytes() const {
   const std::size_t rows = rows_;
-  const std::size_t k = options_.max_contacts;
+  const std::size_t k = ContactCapacity();
   std::size_t doubles =
       6 * rows + (k + 1) * (k + 2) + model_->default_factorization()->factor().WorkSize();
   std::size_t bytes = 0;
@@ -158,10 +167,10 @@ std::size_t SkinConstraints::ScratchBytes() const {
     doubles += 6 * rows + direction_bones_.size() * 3 * rows;
     bytes += model_->skeleton().num_bones() * sizeof(Eigen::Matrix3d);
   }
-  if (bones_ != nullptr && k > 0) {
+  if (k > 0) {
     doubles += rows + k * path_columns_ + k * k;
-    bytes += (k * path_supernodes_ + k) * sizeof(int) + 2 * k * sizeof(BonePenetration) +
-             model_->mesh().num_vertices();
+    bytes += (k * path_supernodes_ + k) * sizeof(int) + k * sizeof(BonePenetration) +
+             k * sizeof(HeldContact) + model_->mesh().num_vertices();
   }
   return bytes + doubles * sizeof(double);
 }
@@ -192,13 +201,13 @@ double SkinConstraints::PathDot(const CholeskyFactor& factor, const ConstraintSc
   return dot;
 }
 
-void SkinConstraints::AddContacts(const CholeskyFactor& factor, int count, ConstraintScratch* s,
-                                  ConstraintReport* report) const {
-  const std::size_t k = options_.max_contacts;
+void SkinConstraints::AddContacts(const CholeskyFactor& factor, int count, ObstacleKind kind,
+                                  ConstraintScratch* s, ConstraintReport* report) const {
+  const std::size_t k = ContactCapacity();
   int& set = report->contacts;
   for (int c = 0; c < count; ++c) {
     const int j = set++;
-    s->contacts[j] = s->found[c];
+    s->contacts[j] = HeldContact{s->found[c], kind};
     const int length = factor.ForwardUnitSolve(
         s->found[c].vertex, s->paths.data() + j * static_cast<std::size_t>(path_supernodes_),
         s->path_values.data() + j * static_cast<std::size_t>(path_columns_), path_columns_,
@@ -215,7 +224,7 @@ void SkinConstraints::AddContacts(const CholeskyFactor& factor, int count, Const
 }
 
 void SkinConstraints::MoveContact(int from, int to, int set, ConstraintScratch* s) const {
-  const std::size_t k = options_.max_contacts;
+  const std::size_t k = ContactCapacity();
   s->contacts[to] = s->contacts[from];
   std::copy_n(s->paths.begin() + from * static_cast<std::size_t>(path_supernodes_),
               s->path_lengths[from],
@@ -276,12 +285,17 @@ void SkinConstraints::PoseVolumeDirections(const MaterialFactorization& factoriz
 }
 
 bool SkinConstraints::Apply(const MaterialFactorization& factorization, DeformScratch* frame,
-                            ConstraintScratch* s, ConstraintReport* report) const {
+                            ConstraintScratch* s, ConstraintReport* report,
+                            const ToolSet* tools) const {
   *report = {};
   if (!model_->Owns(factorization, *frame) || s->owner != this) return false;
+  if (tools != nullptr && tools->empty()) tools = nullptr;
+  if (tools != nullptr && !takes_tools()) return false;
   const CholeskyFactor& factor = factorization.factor();
   const std::size_t values = 3 * static_cast<std::size_t>(rows_);
-  const int k_max = options_.max_contacts;
+  const int k_max = ContactCapacity();
+  const int bone_bound = bones_ != nullptr ? options_.max_contacts : 0;
+  const int n = model_->mesh().num_vertices();
   double* x = frame->solution.data();
   std::copy(x, x + values, s->base.begin());
   auto volume_change = [&](double volume) {
@@ -298,37 +312,69 @@ bool SkinConstraints::Apply(const MaterialFactorization& factorization, DeformSc
     known_volume = cubic[0];
   }
   for (int round = 0;; ++round) {
+    // The contacts each kind holds now (a tool contact may have taken a bone's plane).
+    int bone_held = 0;
+    for (int j = 0; j < set; ++j) bone_held += s->contacts[j].kind == ObstacleKind::kBone;
+    const int tool_held = set - bone_held;
     PenetrationSummary summary;
     int found = 0;
     if (bones_ != nullptr) {
-      found = bones_->Find(x, frame->bone_transforms, s->found.data(), k_max - set, &summary,
+      const int capacity = std::max(0, std::min(bone_bound - bone_held, k_max - set));
+      found = bones_->Find(x, frame->bone_transforms, s->found.data(), capacity, &summary,
                            s->in_set.empty() ? nullptr : s->in_set.data());
     }
+    // Bones first: a vertex a bone takes this round is no tool's.
+    for (int c = 0; c < found; ++c) s->in_set[s->found[c].vertex] = 1;
+    PenetrationSummary tool_summary;
+    int tool_found = 0;
+    if (tools != nullptr) {
+      const int capacity =
+          std::max(0, std::min(options_.max_tool_contacts - tool_held, k_max - set - found));
+      tool_found = FindToolPenetrations(*tools, x, n, s->found.data() + found, capacity,
+                                        &tool_summary, s->in_set.data());
+    }
+    for (int c = 0; c < found; ++c) s->in_set[s->found[c].vertex] = 0;
     const double volume = std::isnan(known_volume) ? closure_->Volume(x) : known_volume;
     known_volume = std::numeric_limits<double>::quiet_NaN();
     if (round == 0) {
       report->before = summary;
+      report->tool_before = tool_summary;
       report->volume_change_before = volume_change(volume);
     }
     report->after = summary;
+    report->tool_after = tool_summary;
     report->volume_change_after = volume_change(volume);
     const bool volume_kept =
         !keeps_volume_ ||
         std::abs(volume - rest_volume_) <= options_.volume_tolerance * std::abs(rest_volume_);
     // A held vertex still inside (its plane was tangent where the surface curves away): hold it
     // on the tangent plane at its new nearest point.
+    // Bones win: a tool contact pushed into a bone takes the bone's plane.
     int refreshed = 0;
-    for (int j = 0; j < set && bones_ != nullptr; ++j) {
+    for (int j = 0; j < set; ++j) {
+      HeldContact& held = s->contacts[j];
       BonePenetration now;
-      if (bones_->Deepest(s->contacts[j].vertex, x, frame->bone_transforms, &now)) {
-        s->contacts[j].normal = now.normal;
-        s->contacts[j].surface_point = now.surface_point;
-        ++refreshed;
+      if (bones_ != nullptr && bones_->Deepest(held.at.vertex, x, frame->bone_transforms, &now)) {
+        held.kind = ObstacleKind::kBone;
+      } else if (held.kind != ObstacleKind::kTool ||
+                 !DeepestToolPenetration(*tools, held.at.vertex, x, &now)) {
+        continue;
       }
+      held.at.surface = now.surface;
+      held.at.normal = now.normal;
+      held.at.surface_point = now.surface_point;
+      ++refreshed;
     }
-    if ((found == 0 && refreshed == 0 && volume_kept) || round == options_.max_rounds) break;
-    for (int c = 0; c < found; ++c) s->in_set[s->found[c].vertex] = 1;
-    if (found > 0) AddContacts(factor, found, s, report);
+    if ((found == 0 && tool_found == 0 && refreshed == 0 && volume_kept) ||
+        round == options_.max_rounds) {
+      break;
+    }
+    for (int c = 0; c < found + tool_found; ++c) s->in_set[s->found[c].vertex] = 1;
+    if (found > 0) AddContacts(factor, found, ObstacleKind::kBone, s, report);
+    if (tool_found > 0) {
+      std::copy_n(s->found.begin() + found, tool_found, s->found.begin());
+      AddContacts(factor, tool_found, ObstacleKind::kTool, s, report);
+    }
 
     // The volume row: its gradient as the frame's bones turn the rest gradient, its direction
     // in the solve's metric, and its target relative to x*.
@@ -347,10 +393,10 @@ bool SkinConstraints::Apply(const MaterialFactorization& factorization, DeformSc
     for (;;) {
       const int q = set + (volume_row ? 1 : 0);
       for (int l = 0; l < set; ++l) {
-        const BonePenetration& cl = s->contacts[l];
+        const BonePenetration& cl = s->contacts[l].at;
         for (int j = 0; j <= l; ++j) {
           const double v = s->inverse_block[static_cast<std::size_t>(l) * k_max + j] *
-                           cl.normal.dot(s->contacts[j].normal);
+                           cl.normal.dot(s->contacts[j].at.normal);
           s->system[l * stride + j] = v;
           s->system[j * stride + l] = v;
         }
@@ -375,7 +421,7 @@ bool SkinConstraints::Apply(const MaterialFactorization& factorization, DeformSc
         if (s->multipliers[j] >= 0) continue;
         dropped = true;
         const int last = set - 1;
-        s->in_set[s->contacts[j].vertex] = 0;
+        s->in_set[s->contacts[j].at.vertex] = 0;
         if (j != last) {
           MoveContact(last, j, set, s);
           s->multipliers[j] = s->multipliers[last];
@@ -390,7 +436,7 @@ bool SkinConstraints::Apply(const MaterialFactorization& factorization, DeformSc
     if (set > 0) {
       std::fill(s->correction.begin(), s->correction.end(), 0.0);
       for (int j = 0; j < set; ++j) {
-        const BonePenetration& c = s->contacts[j];
+        const BonePenetration& c = s->contacts[j].at;
         Eigen::Map<Eigen::Vector3d>(s->correction.data() + 3 * c.vertex) +=
             s->multipliers[j] * c.normal;
       }
@@ -422,7 +468,11 @@ bool SkinConstraints::Apply(const MaterialFactorization& factorization, DeformSc
     ++report->rounds;
   }
   report->unresolved = report->after.vertices > 0;
-  for (int j = 0; j < set; ++j) s->in_set[s->contacts[j].vertex] = 0;
+  report->tools_unresolved = report->tool_after.vertices > 0;
+  for (int j = 0; j < set; ++j) {
+    report->tool_contacts += s->contacts[j].kind == ObstacleKind::kTool;
+    s->in_set[s->contacts[j].at.vertex] = 0;
+  }
   return true;
 }
 

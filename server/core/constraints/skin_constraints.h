@@ -24,6 +24,15 @@
 // point's tangent plane (plus a margin), solve again; a contact whose multiplier pulls the skin
 // inward leaves the set, and a held vertex still inside gets the tangent plane of its new nearest
 // point. One contact per vertex: skin caught between two bones is held out of the deeper.
+//
+// Bones and tools (tools.h) are both obstacles of that one active set, each contact tagged with
+// its kind: a skin vertex inside a tool is held on the tool's tangent plane at its nearest surface
+// point (plus the same margin), so the skin slides on the tool. Bones win: a vertex inside a bone
+// and a tool is held out of the bone, and a tool contact whose vertex the solve pushes into a bone
+// takes the bone's plane; what is left inside a tool is reported (tool_after, tools_unresolved).
+// Each kind has its own bound on contacts (max_contacts, max_tool_contacts), so a tool cannot
+// take the bones' budget. Without tools (none given, or an empty set) Apply computes exactly the
+// tool-free frame: nothing of a tool enters the arithmetic.
 #pragma once
 
 #include <cstddef>
@@ -33,6 +42,7 @@
 
 #include "core/base/status.h"
 #include "core/constraints/bone_contacts.h"
+#include "core/constraints/tools.h"
 #include "core/geometry/volume_closure.h"
 #include "core/model/deformation_model.h"
 
@@ -46,6 +56,11 @@ struct ConstraintOptions {
   // needs more is flagged unresolved. In [0, kMaxContacts]. Default: 128.
   int max_contacts = 128;
   static constexpr int kMaxContacts = 256;
+  // At most this many tool contacts in a frame, besides max_contacts, so that a tool never takes
+  // the bones' budget (docs/instruments.md). 0: tools are refused. In [0, kMaxToolContacts].
+  // Default: 64.
+  int max_tool_contacts = 64;
+  static constexpr int kMaxToolContacts = 256;
   // Keep the enclosed volume of the skin (an open skin closed by a fan at each boundary loop)
   // within volume_tolerance of its rest volume, relative. Default: on.
   bool keep_volume = true;
@@ -70,6 +85,21 @@ struct ConstraintReport {
   bool unresolved = false;
   double volume_change_before = 0;  // (V - V_rest) / V_rest
   double volume_change_after = 0;
+  // Skin inside a tool: before (the model's frame) and after, model units; the tool contacts of
+  // the last solve (counted in `contacts` too); vertices left inside a tool (bones won, more than
+  // max_tool_contacts, or rounds exhausted).
+  PenetrationSummary tool_before;
+  PenetrationSummary tool_after;
+  int tool_contacts = 0;
+  bool tools_unresolved = false;
+};
+
+// What holds a contact's vertex: a bone surface or a tool (the contact's `surface` indexes
+// BoneContacts' surfaces or the frame's ToolSet).
+enum class ObstacleKind : std::uint8_t { kBone, kTool };
+struct HeldContact {
+  BonePenetration at;
+  ObstacleKind kind = ObstacleKind::kBone;
 };
 
 // Per-caller buffers of Apply; one per stream, made by MakeScratch.
@@ -90,9 +120,9 @@ struct ConstraintScratch {
   std::vector<int> path_lengths;
   std::vector<double> path_values;  // per contact, y on its path (path_columns each)
   std::vector<double> solve_work;
-  std::vector<BonePenetration> found;
-  std::vector<BonePenetration> contacts;
-  std::vector<double> inverse_block;  // (M^-1)_{i_l i_j}, max_contacts square
+  std::vector<BonePenetration> found;  // a round's new bone contacts, then its tool contacts
+  std::vector<HeldContact> contacts;
+  std::vector<double> inverse_block;  // (M^-1)_{i_l i_j}, (max_contacts + max_tool_contacts) square
   std::vector<double> system;         // the (k + 1)-square system, then its Cholesky factor
   std::vector<double> multipliers;    // its right-hand side, then lambda and mu
   std::vector<char> in_set;           // per vertex: a contact holds it
@@ -112,13 +142,18 @@ class SkinConstraints {
   std::size_t ScratchBytes() const;
 
   // Constrains the frame in `frame` (solved by the model with `factorization`; its
-  // bone_transforms are the frame's) in place. Allocation-free. False, with nothing changed, for
-  // another model's factorization or scratch, or another constraints' scratch.
+  // bone_transforms are the frame's) in place, with the frame's `tools` (may be null: none;
+  // validated by the caller, ValidateToolSet). Allocation-free. False, with nothing changed, for
+  // another model's factorization or scratch, another constraints' scratch, or tools given to
+  // constraints that take none (max_tool_contacts 0).
   bool Apply(const MaterialFactorization& factorization, DeformScratch* frame,
-             ConstraintScratch* scratch, ConstraintReport* report) const;
+             ConstraintScratch* scratch, ConstraintReport* report,
+             const ToolSet* tools = nullptr) const;
 
-  // Whether Apply ever changes a frame.
+  // Whether Apply ever changes a frame without tools.
   bool active() const { return bones_ != nullptr || keeps_volume_; }
+  // Whether Apply takes tools (max_tool_contacts > 0).
+  bool takes_tools() const { return options_.max_tool_contacts > 0; }
   const BoneContacts* bones() const { return bones_.get(); }
   const std::shared_ptr<const BoneContacts>& bones_shared() const { return bones_; }
   const ConstraintOptions& options() const { return options_; }
@@ -126,9 +161,11 @@ class SkinConstraints {
 
  private:
   SkinConstraints() = default;
-  // Adds the contacts found[0, count) to the set and fills their rows and columns of the inverse
-  // block from their paths.
-  void AddContacts(const CholeskyFactor& factor, int count, ConstraintScratch* s,
+  // Contacts the scratch holds: max_contacts with bones, plus max_tool_contacts.
+  int ContactCapacity() const;
+  // Adds the contacts found[0, count) of `kind` to the set and fills their rows and columns of the
+  // inverse block from their paths.
+  void AddContacts(const CholeskyFactor& factor, int count, ObstacleKind kind, ConstraintScratch* s,
                    ConstraintReport* report) const;
   // y_l . y_j of two contacts' paths.
   double PathDot(const CholeskyFactor& factor, const ConstraintScratch& s, int l, int j) const;

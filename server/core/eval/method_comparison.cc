@@ -61,7 +61,8 @@ bool Constrained(Method method) {
 // Paper, paper-linear and laplacian: `repeat` frames of the model's Deform(), constrained (paper
 // and paper-linear) when `constraints` are given.
 Status RunSolvingMethod(const DeformationModel& paper_model, Method method, const Pose& pose,
-                        int repeat, const SkinConstraints* constraints, MethodRun* run) {
+                        int repeat, const SkinConstraints* constraints, const ToolSet* tools,
+                        MethodRun* run) {
   DEFORM_ASSIGN_OR_RETURN(const std::shared_ptr<const DeformationModel> variant,
                           VariantFor(paper_model, method));
   const DeformationModel& model = variant ? *variant : paper_model;
@@ -77,6 +78,11 @@ Status RunSolvingMethod(const DeformationModel& paper_model, Method method, cons
   // The variant solves with its own factorization, so it needs constraints of its own.
   std::shared_ptr<const SkinConstraints> variant_constraints;
   if (constraints != nullptr && !Constrained(method)) constraints = nullptr;
+  if (tools != nullptr && !tools->empty() &&
+      (constraints == nullptr || !constraints->takes_tools())) {
+    return Status::InvalidArgument(std::string("tools need constraints that take them, with ") +
+                                   "paper or paper-linear, not " + MethodName(method));
+  }
   if (constraints != nullptr && variant) {
     DEFORM_ASSIGN_OR_RETURN(
         variant_constraints,
@@ -95,7 +101,7 @@ Status RunSolvingMethod(const DeformationModel& paper_model, Method method, cons
     solve_seconds.push_back(timings.solve);
     if (constraints != nullptr) {
       const auto start = Clock::now();
-      constraints->Apply(factorization, &scratch, &constraint_scratch, &run->constraints);
+      constraints->Apply(factorization, &scratch, &constraint_scratch, &run->constraints, tools);
       constraint_seconds.push_back(std::chrono::duration<double>(Clock::now() - start).count());
     }
   }));
@@ -178,12 +184,18 @@ StatusOr<MethodRun> RunMethod(const TriangleMesh& mesh, const Skeleton& skeleton
 }
 
 StatusOr<MethodRun> RunMethod(const DeformationModel& paper_model, Method method, const Pose& pose,
-                              int repeat, const SkinConstraints* constraints) {
+                              int repeat, const SkinConstraints* constraints,
+                              const ToolSet* tools) {
   repeat = std::max(1, repeat);
   MethodRun run;
   if (Solves(method)) {
-    DEFORM_RETURN_IF_ERROR(RunSolvingMethod(paper_model, method, pose, repeat, constraints, &run));
+    DEFORM_RETURN_IF_ERROR(
+        RunSolvingMethod(paper_model, method, pose, repeat, constraints, tools, &run));
   } else {
+    if (tools != nullptr && !tools->empty()) {
+      return Status::InvalidArgument(std::string("tools need paper or paper-linear, not ") +
+                                     MethodName(method));
+    }
     RunSkinningMethod(paper_model, method, pose, repeat, &run);
   }
   std::vector<RigidTransform> bones;

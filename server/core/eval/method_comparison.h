@@ -61,8 +61,11 @@ StatusOr<MethodRun> RunMethod(const TriangleMesh& mesh, const Skeleton& skeleton
 // As above, on an already built paper model (the comparison reuses it across methods and poses).
 // `constraints` (may be null) were made for `paper_model`: paper and paper-linear frames are
 // constrained with them (the default method's frame), and every method's frame is measured
-// against their bone surfaces.
+// against their bone surfaces. `tools` (may be null; validated by the caller) go with the
+// constraints into paper and paper-linear frames (INVALID_ARGUMENT for other methods, or without
+// constraints that take tools).
 StatusOr<MethodRun> RunMethod(const DeformationModel& paper_model, Method method, const Pose& pose,
-                              int repeat = 1, const SkinConstraints* constraints = nullptr);
+                              int repeat = 1, const SkinConstraints* constraints = nullptr,
+                              const ToolSet* tools = nullptr);
 
 }  // namespace deform

@@ -86,6 +86,9 @@ class DeformStreamReactor final : public StreamHandler,
   // Reactions' helpers (gRPC threads).
   void HandleStart() DEFORM_EXCLUDES(mutex_);
   void HandlePose() DEFORM_EXCLUDES(mutex_);
+  // The pose request's tools into staging_ (ToolsFromProto); INVALID_ARGUMENT for tools on a
+  // mesh whose constraints take none.
+  Status StagedTools();
   void HandleStiffness() DEFORM_EXCLUDES(mutex_);
   void Fail(grpc::StatusCode code, const std::string& message) DEFORM_EXCLUDES(mutex_);
   void FailLocked(grpc::StatusCode code, const std::string& message) DEFORM_REQUIRES(mutex_);
@@ -158,6 +161,9 @@ class DeformStreamReactor final : public StreamHandler,
   // Reader-owned (one read outstanding at a time).
   v1::DeformRequest request_;
   PoseInput staging_;
+  // The rest mesh's bounding box, which tools are checked against (ToolsFromProto).
+  Eigen::Vector3d tool_lower_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d tool_upper_ = Eigen::Vector3d::Zero();
   std::uint64_t last_stiffness_version_ = 0;
 
   // Solve-task-owned (between PendingPoseSlot::BeginRun and EndRun).
@@ -269,6 +275,8 @@ void DeformStreamReactor::HandleStart() {
     return;
   }
   model_ = entry_->model.get();
+  tool_lower_ = model_->mesh().vertices.colwise().minCoeff().transpose();
+  tool_upper_ = model_->mesh().vertices.colwise().maxCoeff().transpose();
   log_context_ += " mesh=" + entry_->id;
   auto encoder = MakeFrameEncoder(request_.start(), *entry_);
   if (!encoder.ok()) {
@@ -321,8 +329,18 @@ void DeformStreamReactor::HandleStart() {
   stiffness_.Reset(model_->default_factorization());
   UpdateBatchKeyLocked();
   outbox_.AllocateFrames(entry_->client_vertex_count(), encoded_bytes, transform_floats,
-                         bone_surface_bytes, constraints != nullptr);
+                         bone_surface_bytes, constraints != nullptr && constraints->active());
   if (!pump_.finish_requested()) StartRead(&request_);
+}
+
+Status DeformStreamReactor::StagedTools() {
+  staging_.tools.count = 0;
+  if (request_.pose().tools_size() == 0) return Status::Ok();
+  const SkinConstraints* constraints = entry_->constraints.constraints.get();
+  if (constraints == nullptr || !constraints->takes_tools()) {
+    return Status::InvalidArgument("this mesh's constraints take no tools");
+  }
+  return ToolsFromProto(request_.pose(), tool_lower_, tool_upper_, &staging_.tools);
 }
 
 void DeformStreamReactor::HandlePose() {
@@ -330,7 +348,8 @@ void DeformStreamReactor::HandlePose() {
     Fail(grpc::StatusCode::INVALID_ARGUMENT, "the first DeformRequest must be `start`");
     return;
   }
-  const Status converted = PoseInputFromProto(request_.pose(), model_->skeleton(), &staging_);
+  Status converted = PoseInputFromProto(request_.pose(), model_->skeleton(), &staging_);
+  if (converted.ok()) converted = StagedTools();
   staging_.arrival = Clock::now();
   bool post = false;
   {

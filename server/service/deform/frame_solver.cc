@@ -41,11 +41,15 @@ void FrameSolver::EnableConstraints(const SkinConstraints* constraints) {
   constraint_scratch_ = constraints->MakeScratch();
 }
 
-double FrameSolver::Constrain(const MaterialFactorization& factorization, v1::DeformFrame* frame) {
+double FrameSolver::Constrain(const MaterialFactorization& factorization, const ToolSet& tools,
+                              v1::DeformFrame* frame) {
   const auto start = Clock::now();
   ConstraintReport report;
-  const bool applied = constraints_->Apply(factorization, &scratch_, &constraint_scratch_, &report);
-  assert(applied && "the constraints, the factorization and the scratch are of one model");
+  const bool applied = constraints_->Apply(factorization, &scratch_, &constraint_scratch_, &report,
+                                           tools.empty() ? nullptr : &tools);
+  assert(applied &&
+         "the constraints, the factorization and the scratch are of one model, and "
+         "the stream takes tools only when the constraints do");
   (void)applied;
   v1::FrameConstraints* out = frame->mutable_constraints();
   out->set_penetrating_before(static_cast<std::uint32_t>(report.before.vertices));
@@ -54,6 +58,11 @@ double FrameSolver::Constrain(const MaterialFactorization& factorization, v1::De
   out->set_unresolved(report.unresolved);
   out->set_contacts(static_cast<std::uint32_t>(report.contacts));
   out->set_volume_change(report.volume_change_after);
+  out->set_tool_penetrating_before(static_cast<std::uint32_t>(report.tool_before.vertices));
+  out->set_tool_penetrating_after(static_cast<std::uint32_t>(report.tool_after.vertices));
+  out->set_tool_max_depth_after(report.tool_after.max_depth);
+  out->set_tool_contacts(static_cast<std::uint32_t>(report.tool_contacts));
+  out->set_tools_unresolved(report.tools_unresolved);
   if (const BoneContacts* bones = constraints_->bones()) {
     std::string* transforms = frame->mutable_bone_transforms();
     transforms->resize(BoneSurfaceTransformBytes(bones));  // no-op when sized by FrameSlots
@@ -182,8 +191,13 @@ void FrameSolver::Finish(const PoseInput& input, const Deformed& deformed, const
   const std::size_t client_vertices = client_order_.empty()
                                           ? static_cast<std::size_t>(scratch_.num_vertices)
                                           : client_order_.size();
+  const bool constrained =
+      constraints_ != nullptr && (constraints_->active() || !input.tools.empty());
   const double constraint_ms =
-      constraints_ != nullptr ? Constrain(*deformed.factorization, frame) : 0.0;
+      constrained ? Constrain(*deformed.factorization, input.tools, frame) : 0.0;
+  // A mesh whose constraints act only with tools: a frame without them reports zeros (its slot
+  // may hold an earlier tool frame's report; cleared, not freed, so no frame allocates).
+  if (!constrained && frame->has_constraints()) frame->mutable_constraints()->Clear();
   if (encoder_) {
     Encode(frame);
   } else {

@@ -66,6 +66,8 @@ class FrameSolver {
   // Constrains every frame with `constraints` (made for the model; must outlive the solver):
   // Finish applies them to the solution before encoding it (SkinConstraints::Apply, on the
   // factorization that solved it), and fills the frame's bone_transforms and constraints.
+  // A frame's tools (PoseInput::tools, checked by ToolsFromProto) go into the same Apply; a
+  // frame with tools is constrained even when the constraints hold nothing else (active()).
   // Allocates the constraints' scratch: ConstraintBytes.
   void EnableConstraints(const SkinConstraints* constraints);
   static std::size_t ConstraintBytes(const SkinConstraints& constraints) {
@@ -110,7 +112,8 @@ class FrameSolver {
   void Encode(v1::DeformFrame* frame);
   // The constraints applied to the solution, their report and the bone transforms in `frame`;
   // their milliseconds.
-  double Constrain(const MaterialFactorization& factorization, v1::DeformFrame* frame);
+  double Constrain(const MaterialFactorization& factorization, const ToolSet& tools,
+                   v1::DeformFrame* frame);
   // Whether this solver's frame (`frames` 1), or a batch of `frames` it leads, is split now
   // (EnableParallel).
   bool SplitsNow(int frames) const;

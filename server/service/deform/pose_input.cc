@@ -58,6 +58,41 @@ Status RootFromProto(const v1::RootTransform& root, RigidTransform* transform) {
   return Status::Ok();
 }
 
+// ToolsFromProto's checks, adding each tool as it passes.
+Status AddTools(const v1::PoseUpdate& update, const Eigen::Vector3d& lower,
+                const Eigen::Vector3d& upper, ToolSet* tools) {
+  tools->count = 0;
+  if (update.tools_size() > ToolSet::kMaxTools) {
+    return Status::InvalidArgument("at most " + std::to_string(ToolSet::kMaxTools) +
+                                   " tools a pose, not " + std::to_string(update.tools_size()));
+  }
+  for (int t = 0; t < update.tools_size(); ++t) {
+    const v1::ToolState& state = update.tools(t);
+    const std::string name = "tool " + std::to_string(t);
+    Tool tool;
+    switch (state.shape()) {
+      case v1::ToolState::SHAPE_SPHERE:
+        tool.shape = Tool::Shape::kSphere;
+        break;
+      case v1::ToolState::SHAPE_CAPSULE:
+        tool.shape = Tool::Shape::kCapsule;
+        if (!state.has_end()) return Status::InvalidArgument(name + ": a capsule needs `end`");
+        break;
+      default:
+        return Status::InvalidArgument(name + ": shape must be SHAPE_SPHERE or SHAPE_CAPSULE");
+    }
+    if (!state.has_center()) return Status::InvalidArgument(name + ": `center` is unset");
+    tool.a = Eigen::Vector3d(state.center().x(), state.center().y(), state.center().z());
+    tool.b = tool.shape == Tool::Shape::kCapsule
+                 ? Eigen::Vector3d(state.end().x(), state.end().y(), state.end().z())
+                 : tool.a;
+    tool.radius = state.radius();
+    DEFORM_RETURN_IF_ERROR(ValidateTool(tool, t, lower, upper));
+    tools->Add(tool);
+  }
+  return Status::Ok();
+}
+
 }  // namespace
 
 Status PoseInputFromProto(const v1::PoseUpdate& update, const Skeleton& skeleton,
@@ -97,6 +132,13 @@ Status PoseInputFromProto(const v1::PoseUpdate& update, const Skeleton& skeleton
     input->angles.push_back(term);
   }
   return RootFromProto(update.root(), &input->root);
+}
+
+Status ToolsFromProto(const v1::PoseUpdate& update, const Eigen::Vector3d& lower,
+                      const Eigen::Vector3d& upper, ToolSet* tools) {
+  Status status = AddTools(update, lower, upper, tools);
+  if (!status.ok()) tools->count = 0;
+  return status;
 }
 
 StatusOr<int> PoseFromInput(const Skeleton& skeleton, const PoseInput& input, Pose* pose) {

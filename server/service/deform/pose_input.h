@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/base/status.h"
+#include "core/constraints/tools.h"
 #include "core/geometry/pose.h"
 #include "core/geometry/skeleton.h"
 #include "deform/v1/deform.pb.h"
@@ -25,6 +26,7 @@ struct PoseInput {
   std::vector<PoseTerm> angles;                               // in the order sent
   std::vector<std::pair<int, Eigen::Quaterniond>> rotations;  // unit quaternions, in order
   RigidTransform root;                                        // the whole body's placement
+  ToolSet tools;  // the frame's tools (ToolsFromProto); empty: none
 };
 
 // Fills `input` from `update` (sequence, timestamp, resolved angles and rotations; `arrival` is
@@ -34,6 +36,12 @@ struct PoseInput {
 // kQuaternionNormTolerance of 1 (within it, it is normalized; huge components are scaled, never
 // squared into infinity), or a root translation that is not finite or beyond 1e9 model units.
 Status PoseInputFromProto(const v1::PoseUpdate& update, const Skeleton& skeleton, PoseInput* input);
+
+// Fills `tools` from `update`'s tools, each checked by ValidateTool against the mesh's rest
+// bounding box [lower, upper]. INVALID_ARGUMENT naming the tool for more than ToolSet::kMaxTools,
+// an unspecified shape, a missing centre (or a capsule's end), or what ValidateTool refuses.
+Status ToolsFromProto(const v1::PoseUpdate& update, const Eigen::Vector3d& lower,
+                      const Eigen::Vector3d& upper, ToolSet* tools);
 
 // The core pose of `input`: per joint, its rotations (composed in order), then its angles
 // (composed in order, named degrees of freedom clamped to their range), and the root transform.

@@ -44,14 +44,14 @@ std::size_t EstimateConstraintBytes(int skin_vertices, const std::vector<BoneSur
 }
 
 // The constraints of `model`: its bone contacts (refusing a surface the rest skin enters, naming
-// it) and the skin constraints over them. None when there is nothing to keep.
+// it) and the skin constraints over them. None when there is nothing to keep and no tool to take.
 StatusOr<MeshConstraints> MakeConstraints(const DeformationModel& model,
                                           std::vector<BoneSurface> surfaces,
                                           const ConstraintOptions& options,
                                           const MeshLimits& limits) {
   MeshConstraints made;
   made.options = options;
-  if (surfaces.empty() && !options.keep_volume) return made;
+  if (surfaces.empty() && !options.keep_volume && options.max_tool_contacts == 0) return made;
   made.bytes = EstimateConstraintBytes(model.mesh().num_vertices(), surfaces);
   std::shared_ptr<const BoneContacts> bones;
   if (!surfaces.empty()) {
@@ -63,7 +63,8 @@ StatusOr<MeshConstraints> MakeConstraints(const DeformationModel& model,
   auto constraints = SkinConstraints::Create(model, std::move(bones), options);
   if (!constraints.ok()) return constraints.status().WithContext("options.constraints");
   made.constraints = std::move(*constraints);
-  if (!made.constraints->active()) made.constraints = nullptr;  // an open skin without bones
+  // An open skin without bones, taking no tools.
+  if (!made.constraints->active() && !made.constraints->takes_tools()) made.constraints = nullptr;
   return made;
 }
 

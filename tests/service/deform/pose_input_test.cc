@@ -124,5 +124,43 @@ TEST_F(PoseInputTest, FramePathIsAllocationFreeOnceWarm) {
   EXPECT_LT(deform::test_support::AllocationCount() - before, kFrames / 4);
 }
 
+TEST_F(PoseInputTest, ToolsAreCheckedAgainstTheMeshBox) {
+  const Eigen::Vector3d lower(0, 0, 0), upper(1, 1, 1);
+  v1::PoseUpdate update;
+  v1::ToolState* sphere = update.add_tools();
+  sphere->set_shape(v1::ToolState::SHAPE_SPHERE);
+  sphere->mutable_center()->set_z(1.1);
+  sphere->set_radius(0.2);
+  v1::ToolState* capsule = update.add_tools();
+  capsule->set_shape(v1::ToolState::SHAPE_CAPSULE);
+  capsule->mutable_center()->set_x(0.5);
+  capsule->mutable_end()->set_x(0.9);
+  capsule->set_radius(0.1);
+  ToolSet tools;
+  ASSERT_TRUE(ToolsFromProto(update, lower, upper, &tools).ok());
+  ASSERT_EQ(tools.count, 2);
+  EXPECT_EQ(tools.tools[0].shape, Tool::Shape::kSphere);
+  EXPECT_EQ(tools.tools[0].a, Eigen::Vector3d(0, 0, 1.1));
+  EXPECT_EQ(tools.tools[1].shape, Tool::Shape::kCapsule);
+  EXPECT_EQ(tools.tools[1].b, Eigen::Vector3d(0.9, 0, 0));
+
+  v1::PoseUpdate bad = update;
+  bad.mutable_tools(1)->clear_end();
+  EXPECT_THAT(ToolsFromProto(bad, lower, upper, &tools).message(), HasSubstr("tool 1"));
+  bad = update;
+  bad.mutable_tools(0)->set_radius(std::numeric_limits<double>::quiet_NaN());
+  EXPECT_THAT(ToolsFromProto(bad, lower, upper, &tools).message(), HasSubstr("finite"));
+  bad = update;
+  bad.mutable_tools(0)->set_shape(v1::ToolState::SHAPE_UNSPECIFIED);
+  EXPECT_THAT(ToolsFromProto(bad, lower, upper, &tools).message(), HasSubstr("shape"));
+  bad = update;
+  bad.mutable_tools(0)->clear_center();
+  EXPECT_FALSE(ToolsFromProto(bad, lower, upper, &tools).ok());
+  bad = update;
+  for (int t = 0; t < ToolSet::kMaxTools; ++t) *bad.add_tools() = update.tools(0);
+  EXPECT_THAT(ToolsFromProto(bad, lower, upper, &tools).message(), HasSubstr("at most 4"));
+  EXPECT_EQ(tools.count, 0);
+}
+
 }  // namespace
 }  // namespace deform::service
