@@ -169,12 +169,14 @@ void BM_ConstrainedFrame(benchmark::State& state, BenchMesh mesh, int degrees) {
 // the skin from +x, -x, +z and -z at its extreme vertices in those directions in the middle fifth
 // of its height (y, the limbs' long axis) in the benchmark frame, like four fingers, all of one
 // radius: the smallest (by bisection) that puts at least `tool_contacts` skin vertices inside them,
-// so the frame holds that many (ConstraintOptions::max_tool_contacts). Compare ToolFrame/tools:0/
-// with ToolFrame/tools:64/ of the same mesh in the same run.
+// so the frame holds that many (ConstraintOptions::max_tool_contacts); on the model built for the
+// bones (BonedModelFor). Compare ToolFrame/tools:0/ with ToolFrame/tools:64/ of the same mesh in
+// the same run.
 void BM_ToolFrame(benchmark::State& state, BenchMesh mesh, int tool_contacts) {
-  auto frames = SetUpFrames(state, mesh);
+  const BonedModel boned = BonedModelFor(mesh);
+  auto frames = SetUpFramesOf(state, mesh, boned.model);
   if (!frames) return;
-  auto bones = BoneContacts::Create(BenchBones(mesh, *frames->model), frames->model->skeleton(),
+  auto bones = BoneContacts::Create(boned.surfaces, frames->model->skeleton(),
                                     frames->model->mesh(), frames->model->rigid_bones());
   if (!bones.ok()) {
     state.SkipWithError(bones.status().ToString().c_str());
