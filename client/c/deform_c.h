@@ -280,6 +280,30 @@ DEFORM_C_API deform_status
 deform_stream_send_pose(deform_stream* stream, const deform_joint_angle* angles, size_t angle_count,
                         const deform_joint_rotation* rotations, size_t rotation_count,
                         const deform_root_transform* root, uint64_t* sequence);
+/* A surgical tool pressed on the skin (docs/instruments.md): a sphere, or a capsule (the points
+ * within `radius` of the segment from `center` to `end`), in model units and the posed skin's
+ * frame. Skin it would enter slides on its surface; the rest follows the method. */
+typedef enum deform_tool_shape {
+  DEFORM_TOOL_SPHERE = 1,
+  DEFORM_TOOL_CAPSULE = 2
+} deform_tool_shape;
+typedef struct deform_tool {
+  int shape;        /* deform_tool_shape */
+  double center[3]; /* a sphere's centre, a capsule's first end */
+  double end[3];    /* a capsule's second end; unused for a sphere */
+  double radius;
+} deform_tool;
+
+/* deform_stream_send_pose with up to 4 tools (`tools` may be NULL when tool_count is 0). The tools
+ * are part of the pose: latest wins for both, and a pose without tools lifts them (its frame is
+ * the tool-free frame). INVALID_ARGUMENT for an unknown shape; the server checks the rest (a
+ * radius in (0, half the mesh's diagonal], finite values, at most 4) and refuses a bad tool with
+ * a DEFORM_NOTICE_POSE_REJECTED notice, the stream going on. */
+DEFORM_C_API deform_status
+deform_stream_send_pose_with_tools(deform_stream* stream, const deform_joint_angle* angles,
+                                   size_t angle_count, const deform_joint_rotation* rotations,
+                                   size_t rotation_count, const deform_root_transform* root,
+                                   const deform_tool* tools, size_t tool_count, uint64_t* sequence);
 /* The same pose written as text, "JOINT:AXIS:DEGREES[,JOINT:AXIS:DEGREES...]" (deformctl's
  * syntax, e.g. "knee:flexion:90,knee:varus:5"); INVALID_ARGUMENT for malformed text. */
 DEFORM_C_API deform_status deform_stream_send_pose_text(deform_stream* stream, const char* pose,
@@ -362,6 +386,19 @@ typedef struct deform_frame_constraints {
 DEFORM_C_API deform_status deform_stream_frame_bones(deform_stream* stream, float* transforms,
                                                      size_t capacity_floats,
                                                      deform_frame_constraints* constraints);
+
+/* What the tools did to the frame the last deform_stream_next_frame handed out (the server's
+ * FrameConstraints.tool_*; all zero for a frame without tools). Never waits. DEFORM_NO_DATA
+ * before any frame was handed out. */
+typedef struct deform_frame_tools {
+  uint32_t penetrating_before; /* skin vertices inside a tool as the model solved them */
+  uint32_t penetrating_after;  /* ... in the frame handed out */
+  double max_depth_after;      /* the deepest of those, model units */
+  uint32_t contacts;           /* tool contacts in the frame's last solve */
+  int unresolved;              /* non-zero: skin was left inside a tool */
+} deform_frame_tools;
+DEFORM_C_API deform_status deform_stream_frame_tools(deform_stream* stream,
+                                                     deform_frame_tools* tools);
 
 typedef enum deform_notice_kind {
   DEFORM_NOTICE_POSE_REJECTED = 1,      /* `sequence` names the pose; the message says why */

@@ -193,16 +193,27 @@ deform_status deform_stream_send_pose(deform_stream* stream, const deform_joint_
                                       size_t angle_count, const deform_joint_rotation* rotations,
                                       size_t rotation_count, const deform_root_transform* root,
                                       uint64_t* sequence) {
-  return Guarded(__func__, {{stream, "stream"}}, [&] {
-    if ((angles == nullptr && angle_count > 0) || (rotations == nullptr && rotation_count > 0)) {
+  return deform_stream_send_pose_with_tools(stream, angles, angle_count, rotations, rotation_count,
+                                            root, nullptr, 0, sequence);
+}
+
+deform_status deform_stream_send_pose_with_tools(
+    deform_stream* stream, const deform_joint_angle* angles, size_t angle_count,
+    const deform_joint_rotation* rotations, size_t rotation_count,
+    const deform_root_transform* root, const deform_tool* tools, size_t tool_count,
+    uint64_t* sequence) {
+  const char* const fn = tool_count > 0 ? __func__ : "deform_stream_send_pose";
+  return Guarded(fn, {{stream, "stream"}}, [&] {
+    if ((angles == nullptr && angle_count > 0) || (rotations == nullptr && rotation_count > 0) ||
+        (tools == nullptr && tool_count > 0)) {
       return Fail(DEFORM_INVALID_ARGUMENT,
-                  "deform_stream_send_pose: an array is NULL but its count is not 0");
+                  std::string(fn) + ": an array is NULL but its count is not 0");
     }
     deform::v1::PoseUpdate pose;
     for (size_t k = 0; k < angle_count; ++k) {
       if (angles[k].joint == nullptr || angles[k].axis == nullptr) {
-        return Fail(DEFORM_INVALID_ARGUMENT, "deform_stream_send_pose: angles[" +
-                                                 std::to_string(k) + "] has a NULL joint or axis");
+        return Fail(DEFORM_INVALID_ARGUMENT, std::string(fn) + ": angles[" + std::to_string(k) +
+                                                 "] has a NULL joint or axis");
       }
       deform::v1::JointAngle* angle = pose.add_angles();
       angle->set_joint(angles[k].joint);
@@ -211,8 +222,8 @@ deform_status deform_stream_send_pose(deform_stream* stream, const deform_joint_
     }
     for (size_t k = 0; k < rotation_count; ++k) {
       if (rotations[k].joint == nullptr) {
-        return Fail(DEFORM_INVALID_ARGUMENT, "deform_stream_send_pose: rotations[" +
-                                                 std::to_string(k) + "] has a NULL joint");
+        return Fail(DEFORM_INVALID_ARGUMENT,
+                    std::string(fn) + ": rotations[" + std::to_string(k) + "] has a NULL joint");
       }
       deform::v1::JointRotation* rotation = pose.add_rotations();
       rotation->set_joint(rotations[k].joint);
@@ -231,7 +242,20 @@ deform_status deform_stream_send_pose(deform_stream* stream, const deform_joint_
       placement->mutable_rotation()->set_y(root->qy);
       placement->mutable_rotation()->set_z(root->qz);
     }
-    return deform::c_api::SendPose(stream, &pose, sequence, "deform_stream_send_pose");
+    for (size_t k = 0; k < tool_count; ++k) {
+      const deform_tool& tool = tools[k];
+      if (tool.shape == DEFORM_TOOL_SPHERE) {
+        deform::client::AddSphereTool(tool.center[0], tool.center[1], tool.center[2], tool.radius,
+                                      &pose);
+      } else if (tool.shape == DEFORM_TOOL_CAPSULE) {
+        deform::client::AddCapsuleTool(tool.center, tool.end, tool.radius, &pose);
+      } else {
+        return Fail(DEFORM_INVALID_ARGUMENT, std::string(fn) + ": tools[" + std::to_string(k) +
+                                                 "] has shape " + std::to_string(tool.shape) +
+                                                 ", neither DEFORM_TOOL_SPHERE nor _CAPSULE");
+      }
+    }
+    return deform::c_api::SendPose(stream, &pose, sequence, fn);
   });
 }
 
@@ -381,6 +405,24 @@ deform_status deform_stream_frame_bones(deform_stream* stream, float* transforms
     constraints->contacts = c.contacts();
     constraints->volume_change = c.volume_change();
     constraints->constraint_ms = inbox.handed_out_constraint_ms;
+    return Succeed();
+  });
+}
+
+deform_status deform_stream_frame_tools(deform_stream* stream, deform_frame_tools* tools) {
+  return Guarded(__func__, {{stream, "stream"}, {tools, "tools"}}, [&] {
+    deform::c_api::StreamInbox& inbox = *stream->inbox;
+    std::lock_guard<std::mutex> lock(inbox.mutex);
+    if (!inbox.handed_out) {
+      return Fail(DEFORM_NO_DATA, "deform_stream_frame_tools: no frame was handed out yet");
+    }
+    const deform::v1::FrameConstraints& c = inbox.handed_out_constraints;
+    *tools = {};
+    tools->penetrating_before = c.tool_penetrating_before();
+    tools->penetrating_after = c.tool_penetrating_after();
+    tools->max_depth_after = c.tool_max_depth_after();
+    tools->contacts = c.tool_contacts();
+    tools->unresolved = c.tools_unresolved() ? 1 : 0;
     return Succeed();
   });
 }

@@ -550,6 +550,41 @@ static void test_phantom_session(const char* target) {
       (unsigned long long)taken, (unsigned long long)dropped);
   CHECK(taken > 0);
 
+  /* A sphere tool pressed into the outside of the bent knee: the skin it would enter slides on
+   * its surface, and the same pose without it gives back the tool-free frame bit for bit. */
+  CHECK(deform_stream_send_pose(stream, &flexion, 1, NULL, 0, NULL, &sequence) == DEFORM_OK);
+  frame_for(stream, sequence, bent, floats, &info);
+  uint32_t outermost = 0;
+  for (uint32_t i = 1; i < n; ++i) {
+    if (bent[3 * i] > bent[3 * outermost]) outermost = i;
+  }
+  deform_tool sphere = {DEFORM_TOOL_SPHERE, {0, 0, 0}, {0, 0, 0}, 0.3};
+  for (int c = 0; c < 3; ++c) sphere.center[c] = bent[3 * outermost + c];
+  sphere.center[0] += 0.15; /* half its radius inside the skin */
+  CHECK(deform_stream_send_pose_with_tools(stream, &flexion, 1, NULL, 0, NULL, &sphere, 1,
+                                           &sequence) == DEFORM_OK);
+  frame_for(stream, sequence, frame, floats, &info);
+  deform_frame_tools tool_report;
+  CHECK(deform_stream_frame_tools(stream, &tool_report) == DEFORM_OK);
+  CHECK(tool_report.penetrating_before > 0 && tool_report.contacts > 0);
+  CHECK(tool_report.penetrating_after == 0 && !tool_report.unresolved);
+  for (uint32_t i = 0; i < n; ++i) {
+    double d2 = 0;
+    for (int c = 0; c < 3; ++c) d2 += pow(frame[3 * i + c] - sphere.center[c], 2);
+    CHECK(sqrt(d2) > 0.3 - 1e-3); /* every vertex outside the tool, within the margin */
+  }
+  deform_tool unknown_shape = sphere;
+  unknown_shape.shape = 7;
+  CHECK(deform_stream_send_pose_with_tools(stream, &flexion, 1, NULL, 0, NULL, &unknown_shape, 1,
+                                           NULL) == DEFORM_INVALID_ARGUMENT);
+  CHECK(deform_stream_send_pose_with_tools(stream, &flexion, 1, NULL, 0, NULL, NULL, 1, NULL) ==
+        DEFORM_INVALID_ARGUMENT);
+  CHECK(deform_stream_send_pose(stream, &flexion, 1, NULL, 0, NULL, &sequence) == DEFORM_OK);
+  frame_for(stream, sequence, frame, floats, &info);
+  CHECK(memcmp(frame, bent, sizeof(float) * floats) == 0);
+  CHECK(deform_stream_frame_tools(stream, &tool_report) == DEFORM_OK);
+  CHECK(tool_report.penetrating_before == 0 && tool_report.contacts == 0);
+
   /* Closing ends the stream: no more poses, frames report the end. */
   CHECK(deform_stream_close(stream, 5000) == DEFORM_OK);
   CHECK(deform_stream_send_pose(stream, &flexion, 1, NULL, 0, NULL, NULL) == DEFORM_STREAM_ENDED);
