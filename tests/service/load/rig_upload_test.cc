@@ -304,7 +304,8 @@ TEST_F(RigUploadTest, AGltfRigsBoneNodesAreItsBoneSurfaces) {
   ASSERT_TRUE(recorder.WaitForFrameWithSequence(1));
   stream->Close();
   EXPECT_TRUE(stream->Wait().ok());
-  const v1::FrameConstraints& constraints = recorder.last_frame().constraints();
+  const v1::DeformFrame frame = recorder.last_frame();  // a copy: last_frame() returns one
+  const v1::FrameConstraints& constraints = frame.constraints();
   EXPECT_EQ(constraints.penetrating_after(), 0u);
   EXPECT_FALSE(constraints.unresolved());
 
