@@ -162,6 +162,7 @@ void BM_ConstrainedFrame(benchmark::State& state, BenchMesh mesh, int degrees) {
   state.counters["inside_after"] = report.after.vertices;
   state.counters["contacts"] = report.contacts;
   state.counters["solves"] = report.solves;
+  state.counters["backward_passes"] = report.backward_passes;
 }
 
 // A whole frame with the constraints and `tool_contacts` tool constraints (0: no tool, the same

@@ -205,6 +205,7 @@ nlohmann::ordered_json DeformReport(const DeformArgs& args, const deform::ModelI
                           {"active_contacts", c.contacts},
                           {"rounds", c.rounds},
                           {"solves", c.solves},
+                          {"backward_passes", c.backward_passes},
                           {"unit_solves", c.unit_solves},
                           {"unresolved", c.unresolved},
                           {"volume_change_before", c.volume_change_before},

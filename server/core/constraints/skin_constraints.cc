@@ -142,7 +142,8 @@ ConstraintScratch SkinConstraints::MakeScratch() const {
     s.rotations.resize(model_->skeleton().num_bones());
   }
   if (k > 0) {
-    s.unit_work.assign(rows, 0.0);
+    s.unit_work.assign(model_->default_factorization()->factor().UnitSolvesWorkSize(), 0.0);
+    s.unit_columns.resize(k);
     s.paths.resize(k * path_supernodes_);
     s.path_lengths.resize(k);
     s.path_values.resize(k * path_columns_);
@@ -168,8 +169,9 @@ std::size_t SkinConstraints::ScratchBytes() const {
     bytes += model_->skeleton().num_bones() * sizeof(Eigen::Matrix3d);
   }
   if (k > 0) {
-    doubles += rows + k * path_columns_ + k * k;
-    bytes += (k * path_supernodes_ + k) * sizeof(int) + k * sizeof(BonePenetration) +
+    doubles +=
+        model_->default_factorization()->factor().UnitSolvesWorkSize() + k * path_columns_ + k * k;
+    bytes += (k * path_supernodes_ + 2 * k) * sizeof(int) + k * sizeof(BonePenetration) +
              k * sizeof(HeldContact) + model_->mesh().num_vertices();
   }
   return bytes + doubles * sizeof(double);
@@ -205,16 +207,20 @@ void SkinConstraints::AddContacts(const CholeskyFactor& factor, int count, Obsta
                                   ConstraintScratch* s, ConstraintReport* report) const {
   const std::size_t k = ContactCapacity();
   int& set = report->contacts;
+  const int first = set;
   for (int c = 0; c < count; ++c) {
-    const int j = set++;
-    s->contacts[j] = HeldContact{s->found[c], kind};
-    const int length = factor.ForwardUnitSolve(
-        s->found[c].vertex, s->paths.data() + j * static_cast<std::size_t>(path_supernodes_),
-        s->path_values.data() + j * static_cast<std::size_t>(path_columns_), path_columns_,
-        s->unit_work.data());
-    assert(length > 0);  // path_columns_ is the longest path's
-    s->path_lengths[j] = length;
-    ++report->unit_solves;
+    s->contacts[first + c] = HeldContact{s->found[c], kind};
+    s->unit_columns[c] = s->found[c].vertex;
+  }
+  // The round's paths together: the top supernodes, on every path, are read once a block.
+  factor.ForwardUnitSolves(s->unit_columns.data(), count,
+                           s->paths.data() + first * static_cast<std::size_t>(path_supernodes_),
+                           path_supernodes_, s->path_lengths.data() + first,
+                           s->path_values.data() + first * static_cast<std::size_t>(path_columns_),
+                           path_columns_, s->unit_work.data());
+  report->unit_solves += count;
+  set += count;
+  for (int j = first; j < set; ++j) {
     for (int l = 0; l <= j; ++l) {
       const double v = PathDot(factor, *s, l, j);
       s->inverse_block[l * k + j] = v;
@@ -434,14 +440,28 @@ bool SkinConstraints::Apply(const MaterialFactorization& factorization, DeformSc
     // x = x* + M^-1 sum_j lambda_j e_{i_j} n_j^T + mu M^-1 g.
     std::copy(s->base.begin(), s->base.end(), x);
     if (set > 0) {
+      // M^-1 e_i = P^T L^-T y_i: the contacts' forward passes are known, so the correction is
+      // the backward pass of sum_j lambda_j y_j n_j^T (on their paths), half a solve.
       std::fill(s->correction.begin(), s->correction.end(), 0.0);
       for (int j = 0; j < set; ++j) {
         const BonePenetration& c = s->contacts[j].at;
-        Eigen::Map<Eigen::Vector3d>(s->correction.data() + 3 * c.vertex) +=
-            s->multipliers[j] * c.normal;
+        const Eigen::Vector3d weight = s->multipliers[j] * c.normal;
+        const int* path = s->paths.data() + static_cast<std::size_t>(j) * path_supernodes_;
+        const double* y = s->path_values.data() + static_cast<std::size_t>(j) * path_columns_;
+        for (int p = 0; p < s->path_lengths[j]; ++p) {
+          const int width = factor.SupernodeWidth(path[p]);
+          double* z = s->correction.data() + 3 * factor.SupernodeFirstColumn(path[p]);
+          for (int q = 0; q < width; ++q) {
+            z[3 * q] += weight.x() * y[q];
+            z[3 * q + 1] += weight.y() * y[q];
+            z[3 * q + 2] += weight.z() * y[q];
+          }
+          y += width;
+        }
       }
-      Solved(factor.Solve3(s->correction.data(), s->correction.data(), s->solve_work.data()));
-      ++report->solves;
+      Solved(
+          factor.SolveBackward3(s->correction.data(), s->correction.data(), s->solve_work.data()));
+      ++report->backward_passes;
       for (std::size_t v = 0; v < values; ++v) x[v] += s->correction[v];
     }
     if (volume_row && set == 0) {

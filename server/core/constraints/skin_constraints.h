@@ -17,13 +17,15 @@
 //
 // With M = A^T A = P^T L L^T P, the one factorization: x = x* + sum_j lambda_j M^-1 e_{i_j} n_j^T +
 // mu M^-1 g. The contacts need (M^-1)_{i_l i_j} = y_l . y_j with y_j = L^-1 P e_{i_j}, each a
-// forward pass along one path of the elimination tree (CholeskyFactor::ForwardUnitSolve: a
-// fraction of a solve), then a (k + 1)-square dense system and one three-column solve for the
-// correction: low-rank terms on the one factorization, never a refactorization. Contacts come
-// from an active set: solve, find the vertices inside a bone, hold each on its nearest surface
-// point's tangent plane (plus a margin), solve again; a contact whose multiplier pulls the skin
-// inward leaves the set, and a held vertex still inside gets the tangent plane of its new nearest
-// point. One contact per vertex: skin caught between two bones is held out of the deeper.
+// forward pass along one path of the elimination tree (CholeskyFactor::ForwardUnitSolves, a
+// round's paths together: a fraction of a solve), then a (k + 1)-square dense system and, for the
+// correction P^T L^-T sum_j lambda_j y_j n_j^T, one backward pass (half a solve: the forward half
+// is the y_j already made): low-rank terms on the one factorization, never a
+// refactorization. Contacts come from an active set: solve, find the vertices inside a bone, hold
+// each on its nearest surface point's tangent plane (plus a margin), solve again; a contact whose
+// multiplier pulls the skin inward leaves the set, and a held vertex still inside gets the tangent
+// plane of its new nearest point. One contact per vertex: skin caught between two bones is held out
+// of the deeper.
 //
 // Bones and tools (tools.h) are both obstacles of that one active set, each contact tagged with
 // its kind: a skin vertex inside a tool is held on the tool's tangent plane at its nearest surface
@@ -80,7 +82,8 @@ struct ConstraintReport {
   int contacts = 0;           // contact constraints in the last solve
   int rounds = 0;             // constrained solves
   int solves = 0;             // three-column solves with the factor (a frame's is one)
-  int unit_solves = 0;        // forward passes along one path (ForwardUnitSolve), one a contact
+  int backward_passes = 0;    // backward halves of a solve (SolveBackward3), one a round
+  int unit_solves = 0;        // unit right-hand sides (ForwardUnitSolves), one a contact
   // Vertices left inside a bone (more contacts than max_contacts, or rounds exhausted).
   bool unresolved = false;
   double volume_change_before = 0;  // (V - V_rest) / V_rest
@@ -115,7 +118,8 @@ struct ConstraintScratch {
   std::uint64_t directions_serial = 0;
   std::vector<Eigen::Matrix3d> rotations;  // the frame's bone rotations, K
   std::vector<double> correction;          // right-hand side, then M^-1 sum lambda_j e_{i_j} n_j^T
-  std::vector<double> unit_work;           // ForwardUnitSolve's, n + m zeros
+  std::vector<double> unit_work;           // ForwardUnitSolves', zeros
+  std::vector<int> unit_columns;           // a round's new contacts' vertices
   std::vector<int> paths;  // per contact, its path's supernodes (path_supernodes each)
   std::vector<int> path_lengths;
   std::vector<double> path_values;  // per contact, y on its path (path_columns each)

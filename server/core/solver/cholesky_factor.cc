@@ -178,6 +178,12 @@ Status CholeskyFactor::Solve3(const double* b, double* x, double* work, SolveKer
   return Status::Ok();
 }
 
+Status CholeskyFactor::SolveBackward3(const double* z, double* x, double* work) const {
+  if (!symbolic_) return Status::FailedPrecondition("the Cholesky factor is empty");
+  SolveKernelFunctionsFor(BestSolveKernel()).solve_backward3(View(), z, x, work);
+  return Status::Ok();
+}
+
 std::size_t CholeskyFactor::WorkSizeMany(int columns) const {
   return symbolic_ ? static_cast<std::size_t>(SolveManyWorkSize(symbolic_->n_, columns)) : 0;
 }
@@ -261,9 +267,22 @@ int CholeskyFactor::ForwardUnitSolve(int i, int* path, double* values, std::int6
   return deform::ForwardUnitSolve(View(), i, path, values, max_values, work);
 }
 
+void CholeskyFactor::ForwardUnitSolves(const int* vertices, int count, int* paths, int path_stride,
+                                       int* lengths, double* values, std::int64_t value_stride,
+                                       double* work) const {
+  deform::ForwardUnitSolves(View(), vertices, count, paths, path_stride, lengths, values,
+                            value_stride, work);
+}
+
+std::size_t CholeskyFactor::UnitSolvesWorkSize() const {
+  return static_cast<std::size_t>(size()) * kUnitSolveBlock;
+}
+
 void CholeskyFactor::LongestUnitSolvePath(std::int64_t* columns, int* supernodes) const {
   deform::LongestUnitSolvePath(View(), columns, supernodes);
 }
+
+int CholeskyFactor::SupernodeFirstColumn(int s) const { return symbolic_->supernode_columns_[s]; }
 
 int CholeskyFactor::SupernodeWidth(int s) const {
   return symbolic_->supernode_columns_[s + 1] - symbolic_->supernode_columns_[s];

@@ -112,6 +112,22 @@ class CholeskyFactor {
   // `work`: size() doubles, zero on entry and left zero. Allocation-free; const and thread-safe.
   int ForwardUnitSolve(int i, int* path, double* values, std::int64_t max_values,
                        double* work) const;
+  // ForwardUnitSolve for e_{vertices[t]}, t < count, several at a time so that each supernode on
+  // their paths is read once for the group rather than once a path: path t into
+  // paths[t * path_stride ...] (path_stride at least the longest path's supernodes), its length
+  // into lengths[t], its values into values[t * value_stride ...] (at least the longest path's
+  // columns). The same values as ForwardUnitSolve. `work`: UnitSolvesWorkSize() doubles, zero on
+  // entry and left zero. Allocation-free; const and thread-safe.
+  void ForwardUnitSolves(const int* vertices, int count, int* paths, int path_stride, int* lengths,
+                         double* values, std::int64_t value_stride, double* work) const;
+  std::size_t UnitSolvesWorkSize() const;
+  // The backward half of Solve3: x = P^T L^-T z for three columns z given in the factor's order
+  // (z[3 c + k], c a column of L), so that M^-1 sum_j e_{i_j} w_j^T = P^T L^-T sum_j y_j w_j^T
+  // costs one pass once the forward passes y_j are known (ForwardUnitSolve). `x` may equal `z`;
+  // `work` holds WorkSize() doubles.
+  Status SolveBackward3(const double* z, double* x, double* work) const;
+  // Supernode s's first column (in the factor's order).
+  int SupernodeFirstColumn(int s) const;
   // The most columns and the most supernodes on one path (what ForwardUnitSolve may write).
   void LongestUnitSolvePath(std::int64_t* columns, int* supernodes) const;
   // Supernode s's columns (in the factor's order): [first, first + width).

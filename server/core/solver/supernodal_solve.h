@@ -151,6 +151,7 @@ struct SolveKernelFunctions {
   int batch_lanes;  // doubles per batch vector (at most kSolveBatchLanes)
   SupernodeListManyPass forward_list_many;
   SupernodeListManyPass backward_list_many;
+  Solve3Function solve_backward3;  // x = P^T L^-T z, z in the factor's order
 };
 // The kernel's passes; it must be available.
 const SolveKernelFunctions& SolveKernelFunctionsFor(SolveKernel kernel);

@@ -124,6 +124,111 @@ TEST_P(SparseCholeskyTest, SupernodalFactorMatchesTheUpLookingOne) {
   }
 }
 
+TEST_P(SparseCholeskyTest, UnitSolvesTogetherEqualOneAtATimeAndGiveTheInverse) {
+  const int n = 1200;
+  const ColMajorMatrix a = RandomSpdMatrix(n, 3, 21);
+  auto symbolic = SymbolicCholesky::Analyze(a, GetParam());
+  ASSERT_TRUE(symbolic.ok());
+  auto factor = CholeskyFactor::Factorize(*symbolic, a);
+  ASSERT_TRUE(factor.ok()) << factor.status().ToString();
+  std::int64_t columns = 0;
+  int supernodes = 0;
+  factor->LongestUnitSolvePath(&columns, &supernodes);
+  // 19 right-hand sides: two full blocks and a partial one, with a repeated column.
+  std::vector<int> at;
+  for (int t = 0; t < 19; ++t) at.push_back((t * 331 + 17) % n);
+  at.push_back(at[3]);
+  const int count = static_cast<int>(at.size());
+  std::vector<int> paths(count * supernodes), lengths(count);
+  std::vector<double> values(count * columns, -1.0);
+  std::vector<double> work(factor->UnitSolvesWorkSize(), 0.0);
+  factor->ForwardUnitSolves(at.data(), count, paths.data(), supernodes, lengths.data(),
+                            values.data(), columns, work.data());
+  EXPECT_TRUE(std::all_of(work.begin(), work.end(), [](double v) { return v == 0; }));
+
+  std::vector<int> path(supernodes);
+  std::vector<double> one(columns), single_work(n, 0.0);
+  std::vector<std::vector<double>> dense(count, std::vector<double>(n, 0.0));
+  for (int t = 0; t < count; ++t) {
+    const int length =
+        factor->ForwardUnitSolve(at[t], path.data(), one.data(), columns, single_work.data());
+    ASSERT_EQ(length, lengths[t]) << t;
+    std::int64_t offset = 0;
+    for (int p = 0; p < length; ++p) {
+      ASSERT_EQ(path[p], paths[t * supernodes + p]) << t;
+      const int width = factor->SupernodeWidth(path[p]);
+      for (int q = 0; q < width; ++q) {
+        // Bit for bit: the same sums in the same order.
+        ASSERT_EQ(one[offset + q], values[t * columns + offset + q]) << t << " " << p;
+      }
+      offset += width;
+    }
+    // Scatter y onto the factor's columns, to check y_l . y_j = (A^-1)_{i_l i_j}.
+    std::int64_t column = 0;
+    offset = 0;
+    for (int p = 0; p < length; ++p) {
+      const int width = factor->SupernodeWidth(path[p]);
+      column = 0;
+      for (int s = 0; s < path[p]; ++s) column += factor->SupernodeWidth(s);
+      for (int q = 0; q < width; ++q) dense[t][column + q] = one[offset + q];
+      offset += width;
+    }
+  }
+  const Eigen::MatrixXd inverse = Eigen::MatrixXd(a).inverse();
+  for (int l = 0; l < count; ++l) {
+    for (int j = 0; j < count; ++j) {
+      double dot = 0;
+      for (int c = 0; c < n; ++c) dot += dense[l][c] * dense[j][c];
+      EXPECT_NEAR(dot, inverse(at[l], at[j]), 1e-12 * inverse.diagonal().maxCoeff());
+    }
+  }
+}
+
+TEST_P(SparseCholeskyTest, TheBackwardHalfOfForwardUnitSolvesIsTheSolve) {
+  // M^-1 sum_j e_{i_j} w_j^T = P^T L^-T sum_j y_j w_j^T with y_j the unit forward passes.
+  const int n = 900;
+  const ColMajorMatrix a = RandomSpdMatrix(n, 3, 23);
+  auto symbolic = SymbolicCholesky::Analyze(a, GetParam());
+  ASSERT_TRUE(symbolic.ok());
+  auto factor = CholeskyFactor::Factorize(*symbolic, a);
+  ASSERT_TRUE(factor.ok()) << factor.status().ToString();
+  std::int64_t columns = 0;
+  int supernodes = 0;
+  factor->LongestUnitSolvePath(&columns, &supernodes);
+  const std::vector<int> at = {5, 140, 141, 600, 899, 77, 312, 450, 451, 2};
+  const int count = static_cast<int>(at.size());
+  std::vector<int> paths(count * supernodes), lengths(count);
+  std::vector<double> values(count * columns);
+  std::vector<double> unit_work(factor->UnitSolvesWorkSize(), 0.0);
+  factor->ForwardUnitSolves(at.data(), count, paths.data(), supernodes, lengths.data(),
+                            values.data(), columns, unit_work.data());
+  std::mt19937 rng(3);
+  std::normal_distribution<double> normal;
+  std::vector<double> b(3 * n, 0.0), z(3 * n, 0.0);
+  for (int t = 0; t < count; ++t) {
+    const double w[3] = {normal(rng), normal(rng), normal(rng)};
+    const double* y = values.data() + t * columns;
+    for (int p = 0; p < lengths[t]; ++p) {
+      const int s = paths[t * supernodes + p];
+      for (int q = 0; q < factor->SupernodeWidth(s); ++q) {
+        for (int c = 0; c < 3; ++c) z[3 * (factor->SupernodeFirstColumn(s) + q) + c] += w[c] * y[q];
+      }
+      y += factor->SupernodeWidth(s);
+    }
+    for (int c = 0; c < 3; ++c) b[3 * at[t] + c] += w[c];
+  }
+  std::vector<double> work(factor->WorkSize()), solved(3 * n), halved(3 * n);
+  ASSERT_TRUE(factor->Solve3(b.data(), solved.data(), work.data()).ok());
+  ASSERT_TRUE(factor->SolveBackward3(z.data(), halved.data(), work.data()).ok());
+  double largest = 0, difference = 0;
+  for (int v = 0; v < 3 * n; ++v) {
+    largest = std::max(largest, std::abs(solved[v]));
+    difference = std::max(difference, std::abs(solved[v] - halved[v]));
+  }
+  EXPECT_GT(largest, 0);
+  EXPECT_LT(difference, 1e-12 * largest);
+}
+
 TEST_P(SparseCholeskyTest, TwoThreadsFactorizeExactlyAsOne) {
   const ColMajorMatrix a = RandomSpdMatrix(2500, 3, 21);
   auto symbolic = SymbolicCholesky::Analyze(a, GetParam());

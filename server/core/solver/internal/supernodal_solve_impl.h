@@ -789,6 +789,35 @@ void Solve3Impl(const SupernodalFactorView& f, const double* b, double* x, doubl
   }
 }
 
+// The backward half of Solve3: x = P^T L^-T z for z given in the factor's order (z[3 c + k], c a
+// column of L), e.g. a combination of forward passes already made (CholeskyFactor::SolveBackward3).
+void SolveBackward3Impl(const SupernodalFactorView& f, const double* z, double* x, double* work) {
+  const int n = f.size;
+  double* __restrict y = AlignedTo(work, kRowStride);
+  double* const planar_buffer = y + kRowStride * static_cast<std::ptrdiff_t>(n);
+  for (int column = 0; column < n; ++column) {
+    const double* source = z + 3 * static_cast<std::ptrdiff_t>(column);
+    double* t = Row(y, column);
+    t[0] = source[0];
+    t[1] = source[1];
+    t[2] = source[2];
+    t[3] = 0;
+  }
+  WithValueType(f, [&](auto value) {
+    using Value = decltype(value);
+    for (int sn = f.num_supernodes - 1; sn >= 0; --sn) {
+      BackwardSupernode<Value>(f, sn, y, planar_buffer);
+    }
+  });
+  for (int unknown = 0; unknown < n; ++unknown) {
+    double* target = x + 3 * static_cast<std::ptrdiff_t>(unknown);
+    const double* t = Row(y, f.inverse_permutation[unknown]);
+    target[0] = t[0];
+    target[1] = t[1];
+    target[2] = t[2];
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Many right-hand sides at once (CholeskyFactor::SolveMany): one pass over the factor serves every
 // column, so the factor's bytes are read once per batch instead of once per frame. The solution
