@@ -92,6 +92,11 @@ DEFORM_C_API const char* deform_last_error(void);
  * string. Does not change deform_last_error(). */
 DEFORM_C_API const char* deform_status_name(int status);
 
+/* The library's version, "MAJOR.MINOR.PATCH" (e.g. "0.1.0"): the project's version, the one
+ * `deformd --version` prints. The library's file name carries MAJOR (its SONAME is
+ * libdeform_c.so.MAJOR). A static string. Does not change deform_last_error(). */
+DEFORM_C_API const char* deform_version(void);
+
 /* ---- Client ------------------------------------------------------------------------------- */
 
 typedef struct deform_client deform_client;
