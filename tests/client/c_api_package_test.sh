@@ -1,0 +1,87 @@
+#!/usr/bin/env bash
+# The installed C API as a program outside the project sees it: `cmake --install` of the build's
+# deform_c component into a temporary prefix, then tests/client/c_api_consumer.c built twice from
+# that prefix alone, with `cc` and pkg-config's flags (deform_c.pc), and as a CMake project using
+# find_package(deform_c) (deform_cConfig.cmake, deform_c::deform_c); both run against a real
+# deformd. Also checks the installed files, the SONAME (libdeform_c.so.MAJOR) and that the
+# package's version file refuses another major version.
+# Usage: c_api_package_test.sh CMAKE BUILD_DIR DEFORMD SOURCE_DIR VERSION
+set -euo pipefail
+cmake="$1"
+build_dir="$2"
+deformd="$3"
+source_dir="$4"
+version="$5"
+major="${version%%.*}"
+# shellcheck source=scripts/deformd-process.sh
+source "$source_dir/scripts/deformd-process.sh"
+deformd_make_work
+
+fail() {
+  echo "c_api_package_test: $*" >&2
+  [ -f "$WORK/deformd.log" ] && sed 's/^/  deformd: /' "$WORK/deformd.log" >&2
+  exit 1
+}
+
+prefix="$WORK/prefix"
+"$cmake" --install "$build_dir" --component deform_c --prefix "$prefix" >"$WORK/install.log" ||
+  fail "cmake --install failed: $(cat "$WORK/install.log")"
+pc_file="$(find "$prefix" -name deform_c.pc)"
+[ -n "$pc_file" ] || fail "no deform_c.pc installed"
+libdir="$(dirname "$(dirname "$pc_file")")"
+for file in include/deform_c.h "${libdir#"$prefix"/}/libdeform_c.so.$version"; do
+  [ -f "$prefix/$file" ] || fail "not installed: $file"
+done
+[ "$(readlink "$libdir/libdeform_c.so.$major")" = "libdeform_c.so.$version" ] ||
+  fail "libdeform_c.so.$major is not a link to libdeform_c.so.$version"
+[ "$(readlink "$libdir/libdeform_c.so")" = "libdeform_c.so.$major" ] ||
+  fail "libdeform_c.so is not a link to libdeform_c.so.$major"
+soname="$(readelf -d "$libdir/libdeform_c.so.$version" | sed -n 's/.*(SONAME).*\[\(.*\)\]/\1/p')"
+[ "$soname" = "libdeform_c.so.$major" ] || fail "SONAME is '$soname', not libdeform_c.so.$major"
+
+# pkg-config alone: the compile line the docs give.
+export PKG_CONFIG_PATH="$libdir/pkgconfig"
+[ "$(pkg-config --modversion deform_c)" = "$version" ] || fail "pkg-config --modversion differs"
+# shellcheck disable=SC2046  # pkg-config's flags are words
+cc -o "$WORK/consumer_pkgconfig" "$source_dir/tests/client/c_api_consumer.c" \
+  $(pkg-config --cflags --libs deform_c) || fail "cc with pkg-config's flags failed"
+unset PKG_CONFIG_PATH
+# It loads the installed library (no rpath: LD_LIBRARY_PATH, as for any non-system prefix).
+resolved="$(LD_LIBRARY_PATH="$libdir" ldd "$WORK/consumer_pkgconfig" |
+  sed -n 's/.*libdeform_c\.so\.[0-9]* => \([^ ]*\).*/\1/p')"
+[ "$resolved" = "$libdir/libdeform_c.so.$major" ] ||
+  fail "the program would load '$resolved', not $libdir/libdeform_c.so.$major"
+
+# CMake: find_package(deform_c VERSION) and the imported target, in a C-only project.
+project="$WORK/cmake_consumer"
+mkdir -p "$project"
+cp "$source_dir/tests/client/c_api_consumer.c" "$project/"
+cat >"$project/CMakeLists.txt" <<CMAKE
+cmake_minimum_required(VERSION 3.16)
+project(consumer LANGUAGES C)
+find_package(deform_c \${REQUIRED_VERSION} REQUIRED CONFIG)
+add_executable(consumer c_api_consumer.c)
+target_link_libraries(consumer PRIVATE deform_c::deform_c)
+CMAKE
+"$cmake" -S "$project" -B "$project/build" -DCMAKE_PREFIX_PATH="$prefix" \
+  -DREQUIRED_VERSION="$version" >"$WORK/cmake.log" 2>&1 ||
+  fail "configuring the find_package project failed: $(cat "$WORK/cmake.log")"
+"$cmake" --build "$project/build" >"$WORK/cmake-build.log" 2>&1 ||
+  fail "building the find_package project failed: $(cat "$WORK/cmake-build.log")"
+if "$cmake" -S "$project" -B "$WORK/other_major" -DCMAKE_PREFIX_PATH="$prefix" \
+  -DREQUIRED_VERSION="$((major + 1)).0" >"$WORK/other-major.log" 2>&1; then
+  fail "find_package(deform_c $((major + 1)).0) accepted version $version"
+fi
+grep -q "version: $version" "$WORK/other-major.log" ||
+  fail "find_package($((major + 1)).0) failed, but not on the version: $(cat "$WORK/other-major.log")"
+
+# Both programs against a real deformd.
+deformd_start "$WORK/deformd.log" "$deformd" --listen 127.0.0.1:0 --workers 2 ||
+  fail "deformd did not start"
+LD_LIBRARY_PATH="$libdir" "$WORK/consumer_pkgconfig" "$DEFORMD_ADDRESS" "$version" ||
+  fail "the pkg-config build failed against deformd"
+# CMake's build tree carries an rpath to the imported library: no LD_LIBRARY_PATH.
+"$project/build/consumer" "$DEFORMD_ADDRESS" "$version" ||
+  fail "the find_package build failed against deformd"
+echo "c_api_package_test: installed libdeform_c $version (SONAME $soname) built with pkg-config" \
+  "and find_package, both streamed from deformd"
