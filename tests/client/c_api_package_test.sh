@@ -3,8 +3,9 @@
 # deform_c component into a temporary prefix, then tests/client/c_api_consumer.c built twice from
 # that prefix alone, with `cc` and pkg-config's flags (deform_c.pc), and as a CMake project using
 # find_package(deform_c) (deform_cConfig.cmake, deform_c::deform_c); both run against a real
-# deformd. Also checks the installed files, the SONAME (libdeform_c.so.MAJOR) and that the
-# package's version file refuses another major version.
+# deformd, and a third time from a plugin folder made by scripts/bundle-c-api.sh (every library
+# but the C and C++ runtimes loaded from the folder). Also checks the installed files, the SONAME (libdeform_c.so.MAJOR) and
+# that the package's version file refuses another major version.
 # Usage: c_api_package_test.sh CMAKE BUILD_DIR DEFORMD SOURCE_DIR VERSION
 set -euo pipefail
 cmake="$1"
@@ -52,6 +53,26 @@ resolved="$(LD_LIBRARY_PATH="$libdir" ldd "$WORK/consumer_pkgconfig" |
 [ "$resolved" = "$libdir/libdeform_c.so.$major" ] ||
   fail "the program would load '$resolved', not $libdir/libdeform_c.so.$major"
 
+# A plugin folder (scripts/bundle-c-api.sh): the library with copies of its dependencies, which
+# the loader takes from the folder, not from the system, through the library's $ORIGIN.
+plugin="$WORK/plugin"
+"$source_dir/scripts/bundle-c-api.sh" "$plugin" "$libdir/libdeform_c.so" >"$WORK/bundle.log" ||
+  fail "bundle-c-api.sh failed: $(cat "$WORK/bundle.log")"
+system='^(linux-vdso|ld-linux.*|libc|libm|libdl|libpthread|librt|libstdc\+\+|libgcc_s)\.so'
+# A program shipped in the folder with it finds the library beside itself (its own $ORIGIN), and
+# the library finds the rest; no LD_LIBRARY_PATH.
+# shellcheck disable=SC2016,SC2046  # $ORIGIN is the loader's; pkg-config's flags are words
+cc -o "$plugin/consumer" "$source_dir/tests/client/c_api_consumer.c" -Wl,-rpath,'$ORIGIN' \
+  $(PKG_CONFIG_PATH="$libdir/pkgconfig" pkg-config --cflags --libs deform_c) ||
+  fail "cc of the plugin folder's program failed"
+shipped=0
+while read -r name path; do
+  [[ "$name" =~ $system ]] && continue
+  [ "$path" = "$plugin/$name" ] || fail "the plugin's library takes $name from $path"
+  shipped=$((shipped + 1))
+done < <(ldd "$plugin/consumer" | awk '/=>/ {print $1, $3}')
+[ "$shipped" -gt 10 ] || fail "only $shipped libraries resolved in the plugin folder"
+
 # CMake: find_package(deform_c VERSION) and the imported target, in a C-only project.
 project="$WORK/cmake_consumer"
 mkdir -p "$project"
@@ -80,8 +101,10 @@ deformd_start "$WORK/deformd.log" "$deformd" --listen 127.0.0.1:0 --workers 2 ||
   fail "deformd did not start"
 LD_LIBRARY_PATH="$libdir" "$WORK/consumer_pkgconfig" "$DEFORMD_ADDRESS" "$version" ||
   fail "the pkg-config build failed against deformd"
+"$plugin/consumer" "$DEFORMD_ADDRESS" "$version" ||
+  fail "the plugin folder's program failed against deformd"
 # CMake's build tree carries an rpath to the imported library: no LD_LIBRARY_PATH.
 "$project/build/consumer" "$DEFORMD_ADDRESS" "$version" ||
   fail "the find_package build failed against deformd"
 echo "c_api_package_test: installed libdeform_c $version (SONAME $soname) built with pkg-config" \
-  "and find_package, both streamed from deformd"
+  "and find_package, both streamed from deformd, and from a plugin folder of $shipped libraries"
