@@ -6,13 +6,18 @@
 # deformd, and a third time from a plugin folder made by scripts/bundle-c-api.sh (every library
 # but the C and C++ runtimes loaded from the folder). Also checks the installed files, the SONAME (libdeform_c.so.MAJOR) and
 # that the package's version file refuses another major version.
-# Usage: c_api_package_test.sh CMAKE BUILD_DIR DEFORMD SOURCE_DIR VERSION
+# Usage: c_api_package_test.sh CMAKE BUILD_DIR DEFORMD SOURCE_DIR VERSION CC [C_FLAGS]
+# CC and C_FLAGS are the build's C compiler and CMAKE_C_FLAGS: none in a Release build (the
+# compile line is then `cc` and pkg-config's flags alone); a sanitizer build's library needs its
+# programs built with the same sanitizers.
 set -euo pipefail
 cmake="$1"
 build_dir="$2"
 deformd="$3"
 source_dir="$4"
 version="$5"
+cc="$6"
+read -r -a c_flags <<<"${7:-}"
 major="${version%%.*}"
 # shellcheck source=scripts/deformd-process.sh
 source "$source_dir/scripts/deformd-process.sh"
@@ -44,7 +49,7 @@ soname="$(readelf -d "$libdir/libdeform_c.so.$version" | sed -n 's/.*(SONAME).*\
 export PKG_CONFIG_PATH="$libdir/pkgconfig"
 [ "$(pkg-config --modversion deform_c)" = "$version" ] || fail "pkg-config --modversion differs"
 # shellcheck disable=SC2046  # pkg-config's flags are words
-cc -o "$WORK/consumer_pkgconfig" "$source_dir/tests/client/c_api_consumer.c" \
+"$cc" "${c_flags[@]}" -o "$WORK/consumer_pkgconfig" "$source_dir/tests/client/c_api_consumer.c" \
   $(pkg-config --cflags --libs deform_c) || fail "cc with pkg-config's flags failed"
 unset PKG_CONFIG_PATH
 # It loads the installed library (no rpath: LD_LIBRARY_PATH, as for any non-system prefix).
@@ -62,7 +67,8 @@ system='^(linux-vdso|ld-linux.*|libc|libm|libdl|libpthread|librt|libstdc\+\+|lib
 # A program shipped in the folder with it finds the library beside itself (its own $ORIGIN), and
 # the library finds the rest; no LD_LIBRARY_PATH.
 # shellcheck disable=SC2016,SC2046  # $ORIGIN is the loader's; pkg-config's flags are words
-cc -o "$plugin/consumer" "$source_dir/tests/client/c_api_consumer.c" -Wl,-rpath,'$ORIGIN' \
+"$cc" "${c_flags[@]}" -o "$plugin/consumer" "$source_dir/tests/client/c_api_consumer.c" \
+  -Wl,-rpath,'$ORIGIN' \
   $(PKG_CONFIG_PATH="$libdir/pkgconfig" pkg-config --cflags --libs deform_c) ||
   fail "cc of the plugin folder's program failed"
 shipped=0
@@ -85,7 +91,8 @@ add_executable(consumer c_api_consumer.c)
 target_link_libraries(consumer PRIVATE deform_c::deform_c)
 CMAKE
 "$cmake" -S "$project" -B "$project/build" -DCMAKE_PREFIX_PATH="$prefix" \
-  -DREQUIRED_VERSION="$version" >"$WORK/cmake.log" 2>&1 ||
+  -DCMAKE_C_COMPILER="$cc" -DCMAKE_C_FLAGS="${c_flags[*]}" \
+  -DCMAKE_EXE_LINKER_FLAGS="${c_flags[*]}" -DREQUIRED_VERSION="$version" >"$WORK/cmake.log" 2>&1 ||
   fail "configuring the find_package project failed: $(cat "$WORK/cmake.log")"
 "$cmake" --build "$project/build" >"$WORK/cmake-build.log" 2>&1 ||
   fail "building the find_package project failed: $(cat "$WORK/cmake-build.log")"
