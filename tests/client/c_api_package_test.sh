@@ -6,10 +6,10 @@
 # deformd, and a third time from a plugin folder made by scripts/bundle-c-api.sh (every library
 # but the C and C++ runtimes loaded from the folder). Also checks the installed files, the SONAME (libdeform_c.so.MAJOR) and
 # that the package's version file refuses another major version.
-# Usage: c_api_package_test.sh CMAKE BUILD_DIR DEFORMD SOURCE_DIR VERSION CC [C_FLAGS]
-# CC and C_FLAGS are the build's C compiler and CMAKE_C_FLAGS: none in a Release build (the
-# compile line is then `cc` and pkg-config's flags alone); a sanitizer build's library needs its
-# programs built with the same sanitizers.
+# Usage: c_api_package_test.sh CMAKE BUILD_DIR DEFORMD SOURCE_DIR VERSION CC [C_FLAGS [CXX]]
+# CC and C_FLAGS are the build's C compiler and CMAKE_C_FLAGS, none in a Release build: the
+# compile line is then `cc` and pkg-config's flags alone. A sanitizer build's library needs its
+# programs built with the same sanitizers and linked by the C++ driver CXX (UBSan's C++ runtime).
 set -euo pipefail
 cmake="$1"
 build_dir="$2"
@@ -18,10 +18,26 @@ source_dir="$4"
 version="$5"
 cc="$6"
 read -r -a c_flags <<<"${7:-}"
+cxx="${8:-}"
 major="${version%%.*}"
 # shellcheck source=scripts/deformd-process.sh
 source "$source_dir/scripts/deformd-process.sh"
 deformd_make_work
+
+# build_consumer OUTPUT [LINK_FLAG...]: tests/client/c_api_consumer.c with pkg-config's flags
+# ($PKG_CONFIG_PATH), in one step with CC, or compiled by CC and linked by CXX.
+build_consumer() {
+  local output="$1"
+  shift
+  local source="$source_dir/tests/client/c_api_consumer.c"
+  # shellcheck disable=SC2046  # pkg-config's flags are words
+  if [ -z "$cxx" ]; then
+    "$cc" "${c_flags[@]}" -o "$output" "$source" "$@" $(pkg-config --cflags --libs deform_c)
+  else
+    "$cc" "${c_flags[@]}" -c -o "$output.o" "$source" $(pkg-config --cflags deform_c) &&
+      "$cxx" "${c_flags[@]}" -o "$output" "$output.o" "$@" $(pkg-config --libs deform_c)
+  fi
+}
 
 fail() {
   echo "c_api_package_test: $*" >&2
@@ -48,10 +64,7 @@ soname="$(readelf -d "$libdir/libdeform_c.so.$version" | sed -n 's/.*(SONAME).*\
 # pkg-config alone: the compile line the docs give.
 export PKG_CONFIG_PATH="$libdir/pkgconfig"
 [ "$(pkg-config --modversion deform_c)" = "$version" ] || fail "pkg-config --modversion differs"
-# shellcheck disable=SC2046  # pkg-config's flags are words
-"$cc" "${c_flags[@]}" -o "$WORK/consumer_pkgconfig" "$source_dir/tests/client/c_api_consumer.c" \
-  $(pkg-config --cflags --libs deform_c) || fail "cc with pkg-config's flags failed"
-unset PKG_CONFIG_PATH
+build_consumer "$WORK/consumer_pkgconfig" || fail "cc with pkg-config's flags failed"
 # It loads the installed library (no rpath: LD_LIBRARY_PATH, as for any non-system prefix).
 resolved="$(LD_LIBRARY_PATH="$libdir" ldd "$WORK/consumer_pkgconfig" |
   sed -n 's/.*libdeform_c\.so\.[0-9]* => \([^ ]*\).*/\1/p')"
@@ -66,11 +79,10 @@ plugin="$WORK/plugin"
 system='^(linux-vdso|ld-linux.*|libc|libm|libdl|libpthread|librt|libstdc\+\+|libgcc_s)\.so'
 # A program shipped in the folder with it finds the library beside itself (its own $ORIGIN), and
 # the library finds the rest; no LD_LIBRARY_PATH.
-# shellcheck disable=SC2016,SC2046  # $ORIGIN is the loader's; pkg-config's flags are words
-"$cc" "${c_flags[@]}" -o "$plugin/consumer" "$source_dir/tests/client/c_api_consumer.c" \
-  -Wl,-rpath,'$ORIGIN' \
-  $(PKG_CONFIG_PATH="$libdir/pkgconfig" pkg-config --cflags --libs deform_c) ||
+# shellcheck disable=SC2016  # $ORIGIN is the loader's
+build_consumer "$plugin/consumer" -Wl,-rpath,'$ORIGIN' ||
   fail "cc of the plugin folder's program failed"
+unset PKG_CONFIG_PATH
 shipped=0
 while read -r name path; do
   [[ "$name" =~ $system ]] && continue
@@ -89,10 +101,17 @@ project(consumer LANGUAGES C)
 find_package(deform_c \${REQUIRED_VERSION} REQUIRED CONFIG)
 add_executable(consumer c_api_consumer.c)
 target_link_libraries(consumer PRIVATE deform_c::deform_c)
+if(LINK_WITH_CXX)
+  enable_language(CXX)
+  set_target_properties(consumer PROPERTIES LINKER_LANGUAGE CXX)
+endif()
 CMAKE
+cxx_options=()
+[ -z "$cxx" ] || cxx_options=(-DLINK_WITH_CXX=ON -DCMAKE_CXX_COMPILER="$cxx")
 "$cmake" -S "$project" -B "$project/build" -DCMAKE_PREFIX_PATH="$prefix" \
   -DCMAKE_C_COMPILER="$cc" -DCMAKE_C_FLAGS="${c_flags[*]}" \
-  -DCMAKE_EXE_LINKER_FLAGS="${c_flags[*]}" -DREQUIRED_VERSION="$version" >"$WORK/cmake.log" 2>&1 ||
+  -DCMAKE_EXE_LINKER_FLAGS="${c_flags[*]}" "${cxx_options[@]}" -DREQUIRED_VERSION="$version" \
+  >"$WORK/cmake.log" 2>&1 ||
   fail "configuring the find_package project failed: $(cat "$WORK/cmake.log")"
 "$cmake" --build "$project/build" >"$WORK/cmake-build.log" 2>&1 ||
   fail "building the find_package project failed: $(cat "$WORK/cmake-build.log")"
