@@ -1,7 +1,9 @@
-/* deform_c.h: the C API of the deformd client, for game engines (Unity through P/Invoke, Unreal
- * through a plain C link) and any language with a C foreign-function interface. One shared
- * library, libdeform_c.so, built over the C++ client library (client/lib/deform_client.h); it
- * exports the deform_* functions below and nothing else.
+/* deform_c.h: the C API of the deformd client, for game engines (Unity through P/Invoke, with
+ * client/csharp/Deform.cs; Unreal through a plain C link) and any language with a C
+ * foreign-function interface. One shared library, libdeform_c.so (SONAME libdeform_c.so.MAJOR),
+ * built over the C++ client library (client/lib/deform_client.h); it exports the deform_*
+ * functions below and nothing else. Installed, pkg-config's deform_c and CMake's
+ * find_package(deform_c) give the flags (docs/clients/c-api.md).
  *
  * Error contract
  *   Every function that can fail returns a deform_status: DEFORM_OK (0), one of the gRPC status
@@ -91,6 +93,11 @@ DEFORM_C_API const char* deform_last_error(void);
 /* The name of a status, e.g. "NOT_FOUND", "NO_DATA"; "UNKNOWN_STATUS" for other values. A static
  * string. Does not change deform_last_error(). */
 DEFORM_C_API const char* deform_status_name(int status);
+
+/* The library's version, "MAJOR.MINOR.PATCH" (e.g. "0.1.0"): the project's version, the one
+ * `deformd --version` prints. The library's file name carries MAJOR (its SONAME is
+ * libdeform_c.so.MAJOR). A static string. Does not change deform_last_error(). */
+DEFORM_C_API const char* deform_version(void);
 
 /* ---- Client ------------------------------------------------------------------------------- */
 

@@ -123,8 +123,8 @@ const v1::BoneSurfaceInfo* FindBoneSurface(const deform_mesh* mesh, std::uint32_
 }
 
 static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "the wire format is little-endian");
-// The C# ConnectOptions of docs/clients/c-api.md (P/Invoke, LayoutKind.Sequential) relies on this
-// layout.
+// The C# ConnectOptions of client/csharp/Deform.cs (P/Invoke, LayoutKind.Sequential) relies on this
+// layout (the ctest csharp_binding compares every struct's layout with the C compiler's).
 static_assert(sizeof(deform_connect_options) == 88, "deform_connect_options' layout changed");
 
 }  // namespace

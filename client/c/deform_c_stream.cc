@@ -20,8 +20,8 @@ namespace {
 
 constexpr std::size_t kMaxNotices = 64;
 
-// The C# declarations of docs/clients/c-api.md (P/Invoke, LayoutKind.Sequential) rely on these
-// layouts.
+// The C# declarations of client/csharp/Deform.cs (P/Invoke, LayoutKind.Sequential) rely on these
+// layouts (the ctest csharp_binding compares every struct's layout with the C compiler's).
 static_assert(sizeof(deform_frame_info) == 80, "deform_frame_info's layout changed");
 static_assert(sizeof(deform_joint_angle) == 24, "deform_joint_angle's layout changed");
 static_assert(sizeof(deform_root_transform) == 56, "deform_root_transform's layout changed");

@@ -259,6 +259,9 @@ static void test_arguments_without_a_server(void) {
   CHECK(strcmp(deform_status_name(DEFORM_NOT_FOUND), "NOT_FOUND") == 0);
   CHECK(strcmp(deform_status_name(DEFORM_NO_DATA), "NO_DATA") == 0);
   CHECK(strcmp(deform_status_name(-3), "UNKNOWN_STATUS") == 0);
+  /* The project's version (CMake's project()), leaving the last error as it was. */
+  CHECK(strcmp(deform_version(), DEFORM_EXPECTED_VERSION) == 0);
+  CHECK(strstr(deform_last_error(), "/nonexistent/client.crt") != NULL);
   CHECK(deform_stream_next_frame(NULL, NULL, 0, 0, NULL) == DEFORM_INVALID_ARGUMENT);
   CHECK(strcmp(deform_last_error(), "deform_stream_next_frame: stream is NULL") == 0);
   uint32_t count = 7;

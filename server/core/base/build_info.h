@@ -10,7 +10,8 @@
 
 namespace deform {
 
-// The version, e.g. "0.1.0".
+// The version, e.g. "0.1.0": a view of a NUL-terminated string with static storage, so its data()
+// may be handed out as a C string (the C API's deform_version()).
 std::string_view BuildVersion();
 
 // The commit checked out when the program was built, abbreviated as `git rev-parse --short HEAD`
