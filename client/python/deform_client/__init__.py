@@ -8,7 +8,8 @@
 
 Modules: client (DeformClient, MeshInfo, BoneSurface), stream (DeformStream, Frame), codec (the frame
 decoders), meshopt (meshoptimizer's decoder through ctypes), poses (pose forms), tools (tool forms), errors
-(DeformError), stubs (the generated deform.v1 code, `pb`: see stubs.py for where it is found).
+(DeformError), stubs (the generated deform.v1 code shipped in _proto/, `pb`), version
+(`__version__`, deformd's).
 """
 
 from .client import BoneSurface, DeformClient, MeshInfo, client_from_environment
@@ -16,6 +17,7 @@ from .errors import DeformError
 from .stream import DeformStream, Frame
 from .stubs import pb
 from .tools import tool_state
+from .version import __version__
 
-__all__ = ["BoneSurface", "DeformClient", "DeformError", "DeformStream", "Frame", "MeshInfo",
+__all__ = ["__version__", "BoneSurface", "DeformClient", "DeformError", "DeformStream", "Frame", "MeshInfo",
            "client_from_environment", "pb", "tool_state"]
