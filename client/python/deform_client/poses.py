@@ -7,7 +7,10 @@ name ("flexion"); the server resolves both. "" and "rest" are the rest pose. Val
 offending term for malformed input (the same rules as core/base/pose_spec.h).
 """
 
+from __future__ import annotations
+
 import math
+from typing import List
 
 from .stubs import pb
 
@@ -61,7 +64,7 @@ def _fields(text):
     return fields
 
 
-def parse_pose_spec(spec):
+def parse_pose_spec(spec: str) -> List[pb.JointAngle]:
     """deformctl's syntax -> a list of JointAngle messages."""
     spec = spec.strip()
     if spec in ("", "rest"):
@@ -74,7 +77,7 @@ def parse_pose_spec(spec):
     return angles
 
 
-def angles_of(pose):
+def angles_of(pose: object) -> List[pb.JointAngle]:
     """Any accepted pose form except a PoseUpdate -> a list of JointAngle messages."""
     if isinstance(pose, str):
         return parse_pose_spec(pose)
@@ -95,7 +98,7 @@ def angles_of(pose):
                      f"tuple or a list of them, not {type(pose).__name__}")
 
 
-def pose_update(pose, sequence, timestamp_ns):
+def pose_update(pose: object, sequence: int, timestamp_ns: int) -> pb.PoseUpdate:
     """A PoseUpdate with `sequence` and `timestamp_ns` from any accepted form (a PoseUpdate is
     copied, its sequence and timestamp kept when set)."""
     if isinstance(pose, pb.PoseUpdate):

@@ -9,9 +9,18 @@ Model units, the posed skin's frame. A ToolState message is used as is. ValueErr
 input (the syntax of core/base/tool_spec.h); the server checks the values against the mesh.
 """
 
+from __future__ import annotations
+
 import math
+from typing import List, Sequence, Tuple, Union
 
 from .stubs import pb
+
+Point = Sequence[float]
+# One tool ("sphere:...", a ("sphere", centre, r) or ("capsule", end0, end1, r) tuple, a
+# ToolState), or a list of them.
+Tool = Union[str, pb.ToolState, Tuple[object, ...]]
+ToolSpec = Union[Tool, Sequence[Tool]]
 
 MAX_TOOLS = 4  # ToolSet::kMaxTools: the server rejects a pose with more
 
@@ -33,7 +42,7 @@ def _vector(values, text):
     return pb.Vector3(x=values[0], y=values[1], z=values[2])
 
 
-def tool_state(tool):
+def tool_state(tool: Tool) -> pb.ToolState:
     """A ToolState from any accepted form (see the module's docstring)."""
     if isinstance(tool, pb.ToolState):
         return tool
@@ -57,7 +66,7 @@ def tool_state(tool):
     raise ValueError(f"tool {tool!r}: not a tool form")
 
 
-def tool_states(tools):
+def tool_states(tools: Union[ToolSpec, None]) -> List[pb.ToolState]:
     """A list of ToolState from one tool or a list of them (None: no tool)."""
     if tools is None:
         return []
