@@ -23,7 +23,7 @@ ends it now and quietly; `async with` closes, or cancels when the block raised.
 from __future__ import annotations
 
 import asyncio
-from typing import AsyncIterator, Iterable, List, Optional, Sequence, Tuple, Union
+from typing import Any, AsyncIterator, Iterable, List, Literal, Optional, Sequence, Tuple, Union
 
 import grpc
 import grpc.aio
@@ -179,7 +179,7 @@ class AsyncDeformStream:
     async def __aenter__(self) -> "AsyncDeformStream":
         return self
 
-    async def __aexit__(self, exc_type: object, exc: object, traceback: object) -> bool:
+    async def __aexit__(self, exc_type: object, exc: object, traceback: object) -> "Literal[False]":
         if exc_type is None:
             await self.close()
         else:
@@ -226,7 +226,7 @@ class AsyncDeformClient:
     async def __aenter__(self) -> "AsyncDeformClient":
         return self
 
-    async def __aexit__(self, *exc: object) -> bool:
+    async def __aexit__(self, *exc: object) -> "Literal[False]":
         await self.close()
         return False
 
@@ -267,7 +267,7 @@ class AsyncDeformClient:
 
     # Inspecting.
 
-    async def _unary(self, method, request, timeout: Timeout):
+    async def _unary(self, method: Any, request: Any, timeout: Timeout) -> Any:
         try:
             return await method(request, metadata=self._metadata,
                                 timeout=calls.deadline(timeout, self._unary_timeout))

@@ -10,7 +10,8 @@ past its deadline fails with DeformError DEADLINE_EXCEEDED.
 from __future__ import annotations
 
 import pathlib
-from typing import Callable, Iterable, Iterator, List, Optional, Sequence, Tuple, Union
+from typing import (Callable, Iterable, Iterator, List, Optional, Sequence, Tuple, Union,
+                    cast)
 
 import grpc
 
@@ -164,7 +165,9 @@ def stream_start(mesh_id: str, encoding: int, max_error: float,
                                      info.response.prediction_weights)
     else:
         decoder = codec.FrameDecoder(info.summary.vertex_count)
-    return pb.DeformStart(mesh_id=mesh_id, encoding=encoding, max_error=max_error), decoder
+    start = pb.DeformStart(mesh_id=mesh_id, encoding=cast(pb.FrameEncoding, encoding),
+                           max_error=max_error)
+    return start, decoder
 
 
 def metadata(token: Optional[str]) -> Sequence[Tuple[str, str]]:

@@ -22,7 +22,7 @@ async_client.py is the same client on asyncio.
 from __future__ import annotations
 
 import os
-from typing import Iterable, List, Optional, Union
+from typing import Any, Iterable, List, Literal, Optional, Union
 
 import grpc
 
@@ -76,7 +76,7 @@ class DeformClient:
     def __enter__(self) -> "DeformClient":
         return self
 
-    def __exit__(self, *exc: object) -> bool:
+    def __exit__(self, *exc: object) -> "Literal[False]":
         self.close()
         return False
 
@@ -127,7 +127,7 @@ class DeformClient:
 
     # Inspecting.
 
-    def _unary(self, method, request, timeout: Timeout):
+    def _unary(self, method: Any, request: Any, timeout: Timeout) -> Any:
         try:
             return method(request, metadata=self._metadata,
                           timeout=calls.deadline(timeout, self._unary_timeout))

@@ -10,12 +10,12 @@ offending term for malformed input (the same rules as core/base/pose_spec.h).
 from __future__ import annotations
 
 import math
-from typing import List
+from typing import Any, List
 
 from .stubs import pb
 
 
-def _term(joint, axis, degrees, text):
+def _term(joint: object, axis: object, degrees: Any, text: object) -> pb.JointAngle:
     joint = str(joint).strip()
     axis = str(axis).strip()
     if not joint or not axis:
@@ -30,7 +30,7 @@ def _term(joint, axis, degrees, text):
     return pb.JointAngle(joint=joint, axis=axis, degrees=value)
 
 
-def _split_terms(spec):
+def _split_terms(spec: str) -> List[str]:
     """`spec` split at the commas outside double quotes."""
     terms, start, quoted = [], 0, False
     for i, char in enumerate(spec):
@@ -45,7 +45,7 @@ def _split_terms(spec):
     return terms
 
 
-def _fields(text):
+def _fields(text: str) -> List[str]:
     """A term's joint, axis and degrees: the axis and the angle are the last two fields, the joint
     everything before them (names may hold colons) or a double-quoted name."""
     malformed = ValueError(f"pose term {text!r} is not JOINT:AXIS:DEGREES")
@@ -57,7 +57,7 @@ def _fields(text):
         if not rest.startswith(":") or rest[1:].count(":") != 1:
             raise malformed
         axis, degrees = rest[1:].split(":")
-        return text[1:close], axis, degrees
+        return [text[1:close], axis, degrees]
     fields = text.rsplit(":", 2)
     if len(fields) != 3:
         raise malformed

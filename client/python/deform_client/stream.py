@@ -20,7 +20,7 @@ import dataclasses
 import queue
 import threading
 import time
-from typing import Iterator, List, Optional, Sequence, Tuple, Union
+from typing import Iterator, List, Literal, Optional, Sequence, Tuple, Union
 
 import grpc
 import numpy as np
@@ -262,7 +262,7 @@ class DeformStream:
     def __enter__(self) -> "DeformStream":
         return self
 
-    def __exit__(self, exc_type: object, exc: object, traceback: object) -> bool:
+    def __exit__(self, exc_type: object, exc: object, traceback: object) -> "Literal[False]":
         if exc_type is None:
             self.close()
         else:

@@ -9,7 +9,7 @@ Enums are given by name without their prefix ("QUATERNION", "THROUGH_BODY").
 from __future__ import annotations
 
 import dataclasses
-from typing import Optional, Tuple
+from typing import Any, Optional, Tuple
 
 import numpy as np
 
@@ -17,7 +17,7 @@ from . import codec
 from .stubs import pb
 
 
-def _enum_name(enum, value: int, prefix: str) -> str:
+def _enum_name(enum: Any, value: int, prefix: str) -> str:
     try:
         return str(enum.Name(value)).removeprefix(prefix)
     except ValueError:

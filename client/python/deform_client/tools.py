@@ -12,20 +12,20 @@ input (the syntax of core/base/tool_spec.h); the server checks the values agains
 from __future__ import annotations
 
 import math
-from typing import List, Sequence, Tuple, Union
+from typing import Any, Iterable, List, Sequence, Tuple, Union, cast
 
 from .stubs import pb
 
 Point = Sequence[float]
 # One tool ("sphere:...", a ("sphere", centre, r) or ("capsule", end0, end1, r) tuple, a
 # ToolState), or a list of them.
-Tool = Union[str, pb.ToolState, Tuple[object, ...]]
+Tool = Union[str, pb.ToolState, Tuple[Any, ...]]
 ToolSpec = Union[Tool, Sequence[Tool]]
 
 MAX_TOOLS = 4  # ToolSet::kMaxTools: the server rejects a pose with more
 
 
-def _finite(value, text):
+def _finite(value: Any, text: object) -> float:
     try:
         number = float(value)
     except (TypeError, ValueError):
@@ -35,7 +35,7 @@ def _finite(value, text):
     return number
 
 
-def _vector(values, text):
+def _vector(values: Iterable[Any], text: object) -> pb.Vector3:
     values = [_finite(v, text) for v in values]
     if len(values) != 3:
         raise ValueError(f"tool {text!r}: a point needs 3 coordinates")
@@ -72,5 +72,5 @@ def tool_states(tools: Union[ToolSpec, None]) -> List[pb.ToolState]:
         return []
     if isinstance(tools, (str, pb.ToolState)) or (
             isinstance(tools, tuple) and tools and isinstance(tools[0], str)):
-        tools = [tools]
-    return [tool_state(tool) for tool in tools]
+        return [tool_state(tools)]
+    return [tool_state(tool) for tool in cast(Sequence[Tool], tools)]
