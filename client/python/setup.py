@@ -42,4 +42,6 @@ class BuildPyWithVersion(build_py):
         target.write_text(f'"""Written by setup.py."""\n\nVERSION = "{VERSION}"\n')
 
 
-setup(version=VERSION, cmdclass={"build_py": BuildPyWithVersion})
+setup(version=VERSION, packages=["deform_client", "deform_client._proto"],
+      package_data={"deform_client": ["py.typed"], "deform_client._proto": ["*.pyi"]},
+      cmdclass={"build_py": BuildPyWithVersion})
