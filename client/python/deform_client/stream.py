@@ -11,7 +11,10 @@ frames (next_frame, next_event, iteration) from one thread at a time.
 Errors: the call's failure (NOT_FOUND for an unknown mesh id, INVALID_ARGUMENT for a bad start,
 UNAVAILABLE when the server shuts down, ...) is raised as DeformError by whatever takes the next
 event after it; a frame that does not decode cancels the call and raises DeformError(INTERNAL)
-naming the problem. A cancel() by the caller ends the stream quietly.
+naming the problem. A cancel() by the caller ends the stream quietly. A stream opened with a
+deadline (DeformClient.stream(timeout=)) fails with DEADLINE_EXCEEDED past it.
+
+event_from and PoseNumbering are shared with the asyncio stream (async_client.py).
 """
 
 from __future__ import annotations
