@@ -6,16 +6,27 @@
     with client.stream(mesh.mesh_id, encoding="predicted") as stream:
         stream.send_pose("knee:flexion:90"); print(stream.next_frame().positions.shape)
 
-Modules: client (DeformClient, MeshInfo, BoneSurface), stream (DeformStream, Frame), codec (the frame
-decoders), meshopt (meshoptimizer's decoder through ctypes), poses (pose forms), tools (tool forms), errors
-(DeformError), stubs (the generated deform.v1 code, `pb`: see stubs.py for where it is found).
+Modules: client (DeformClient), async_client (AsyncDeformClient, AsyncDeformStream: the same on
+asyncio), summary (MeshSummary, MeshInfo, Joint, Bone, BoneSurface...), stream (DeformStream,
+Frame), calls (what both clients send; timeouts: DEFAULT), channel (TLS), codec (the frame
+decoders), meshopt (meshoptimizer's decoder through ctypes), poses (pose forms), tools (tool
+forms), errors (DeformError), stubs (the generated deform.v1 code shipped in _proto/, `pb`),
+version (`__version__`, deformd's).
 """
 
-from .client import BoneSurface, DeformClient, MeshInfo, client_from_environment
+from .async_client import AsyncDeformClient, AsyncDeformStream, async_client_from_environment
+from .calls import DEFAULT, DEFAULT_LOAD_TIMEOUT, DEFAULT_UNARY_TIMEOUT
+from .client import DeformClient, client_from_environment
 from .errors import DeformError
 from .stream import DeformStream, Frame
 from .stubs import pb
+from .summary import (Bone, BoneSurface, BoneSurfaceInfo, DegreeOfFreedom, Joint, MeshInfo,
+                      MeshSummary)
 from .tools import tool_state
+from .version import __version__
 
-__all__ = ["BoneSurface", "DeformClient", "DeformError", "DeformStream", "Frame", "MeshInfo",
-           "client_from_environment", "pb", "tool_state"]
+__all__ = ["__version__", "AsyncDeformClient", "AsyncDeformStream", "Bone", "BoneSurface",
+           "BoneSurfaceInfo", "DEFAULT", "DEFAULT_LOAD_TIMEOUT", "DEFAULT_UNARY_TIMEOUT",
+           "DegreeOfFreedom", "DeformClient", "DeformError", "DeformStream", "Frame", "Joint",
+           "MeshInfo", "MeshSummary", "async_client_from_environment", "client_from_environment",
+           "pb", "tool_state"]

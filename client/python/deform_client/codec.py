@@ -21,11 +21,17 @@ nothing. Thread safety: its arrays are read-only after construction, so decode()
 several threads at once.
 """
 
+from __future__ import annotations
+
 import math
+from typing import TYPE_CHECKING, Optional, Union
 
 import numpy as np
 
 from . import meshopt
+
+if TYPE_CHECKING:
+    from .stubs import pb
 
 FLOAT32 = 1
 QUANTIZED = 2
@@ -36,7 +42,7 @@ BONES_PER_VERTEX = 4
 FLOATS_PER_BONE_TRANSFORM = 12
 
 
-def encoding_from_name(encoding):
+def encoding_from_name(encoding: Union[str, int]) -> int:
     """'float32' | 'quantized' | 'predicted' (or the enum value) -> the FrameEncoding value."""
     if isinstance(encoding, int) and encoding in ENCODING_NAMES:
         return encoding
@@ -46,7 +52,7 @@ def encoding_from_name(encoding):
     raise ValueError(f"unknown frame encoding {encoding!r} (float32, quantized or predicted)")
 
 
-def decode_float32(positions, vertex_count):
+def decode_float32(positions: bytes, vertex_count: int) -> np.ndarray:
     """Little-endian float32 x, y, z bytes -> (V, 3) float32."""
     if len(positions) != 12 * vertex_count:
         raise ValueError(f"a float32 frame of {len(positions)} bytes; {vertex_count} vertices "
@@ -54,20 +60,21 @@ def decode_float32(positions, vertex_count):
     return np.frombuffer(positions, dtype="<f4").astype(np.float32).reshape(vertex_count, 3)
 
 
-def decode_records(data, vertex_count):
+def decode_records(data: bytes, vertex_count: int) -> np.ndarray:
     """meshoptimizer's vertex codec -> (V, 4) uint16 records."""
     records = np.empty((vertex_count, 4), dtype=np.uint16)
     meshopt.decode_vertex_buffer(data, records)
     return records
 
 
-def unzigzag(records):
+def unzigzag(records: np.ndarray) -> np.ndarray:
     """uint16 zigzag codes -> int32 residuals ((a >> 1) ^ -(a & 1))."""
     codes = records.astype(np.int32)
     return (codes >> 1) ^ -(codes & 1)
 
 
-def predict_positions(rest, bones, weights, transforms):
+def predict_positions(rest: np.ndarray, bones: np.ndarray, weights: np.ndarray,
+                      transforms: np.ndarray) -> np.ndarray:
     """The proto's prediction, float32 with every operation rounded, in the proto's order.
 
     rest (V, 3) float32, bones (V, 4) integer, weights (V, 4) float32, transforms (B, 12)
@@ -90,7 +97,8 @@ def predict_positions(rest, bones, weights, transforms):
 class FrameDecoder:
     """Decodes one mesh's frames (any encoding) into (V, 3) float32 positions."""
 
-    def __init__(self, vertex_count, rest_positions=None, prediction_weights=None):
+    def __init__(self, vertex_count: int, rest_positions: Optional[bytes] = None,
+                 prediction_weights: Optional[pb.PredictionWeights] = None):
         """vertex_count: the mesh's (MeshSummary.vertex_count). For PREDICTED frames also the
         rest positions (GetMeshInfoResponse.rest_positions bytes) and PredictionWeights message
         (GetMeshInfoRequest.include_prediction_weights); ValueError when their sizes do not match
@@ -120,16 +128,16 @@ class FrameDecoder:
         self._num_bones = num_bones
 
     @property
-    def can_predict(self):
+    def can_predict(self) -> bool:
         return self._rest is not None
 
-    def decode(self, frame):
+    def decode(self, frame: pb.DeformFrame) -> np.ndarray:
         """A DeformFrame message -> (V, 3) float32 positions."""
         if not frame.HasField("encoded"):
             return decode_float32(frame.positions, self.vertex_count)
         return self.decode_encoded(frame.encoded)
 
-    def decode_encoded(self, encoded):
+    def decode_encoded(self, encoded: pb.EncodedPositions) -> np.ndarray:
         """An EncodedPositions message -> (V, 3) float32 positions."""
         step = encoded.step
         if not math.isfinite(step) or step <= 0:
@@ -151,6 +159,8 @@ class FrameDecoder:
             records = decode_records(encoded.data, self.vertex_count)
             transforms = np.array(encoded.bone_transforms, dtype=np.float32).reshape(
                 self._num_bones, FLOATS_PER_BONE_TRANSFORM)
+            assert self._rest is not None and self._bones is not None \
+                and self._weights is not None  # can_predict
             predicted = predict_positions(self._rest, self._bones, self._weights, transforms)
             residual = unzigzag(records[:, :3]).astype(np.float64)
             values = predicted.astype(np.float64) + residual * step

@@ -5,10 +5,16 @@ write_ply(path, positions, triangles): binary little-endian PLY ("vertex" x, y, 
 < V; ValueError otherwise. Readable by deformd's own PLY reader, MeshLab, Blender, three.js.
 """
 
+from __future__ import annotations
+
+import os
+from typing import Union
+
 import numpy as np
 
 
-def write_ply(path, positions, triangles):
+def write_ply(path: Union[str, os.PathLike], positions: np.ndarray,
+              triangles: np.ndarray) -> None:
     positions = np.ascontiguousarray(positions, dtype="<f4")
     triangles = np.asarray(triangles)
     if positions.ndim != 2 or positions.shape[1] != 3:

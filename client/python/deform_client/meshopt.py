@@ -9,18 +9,23 @@ was tried when no library loads. Thread safety: the decoder keeps no state, so a
 threads may call it.
 """
 
+from __future__ import annotations
+
 import ctypes
 import ctypes.util
 import os
 import threading
+from typing import List, Optional
+
+import numpy as np
 
 _LIBRARY_NAMES = ("libmeshoptimizer.so.2d", "libmeshoptimizer.so")
-_library = None
+_library: Optional[ctypes.CDLL] = None
 _library_lock = threading.Lock()
 
 
-def _load_library():
-    tried = []
+def _load_library() -> ctypes.CDLL:
+    tried: List[str] = []
     override = os.environ.get("DEFORM_MESHOPTIMIZER_LIB")
     names = [override] if override else list(_LIBRARY_NAMES)
     if not override:
@@ -42,7 +47,7 @@ def _load_library():
                   "or set DEFORM_MESHOPTIMIZER_LIB): " + "; ".join(tried))
 
 
-def library():
+def library() -> ctypes.CDLL:
     """The loaded library (loads it on first call)."""
     global _library
     with _library_lock:
@@ -51,7 +56,7 @@ def library():
         return _library
 
 
-def decode_vertex_buffer(data, destination):
+def decode_vertex_buffer(data: bytes, destination: np.ndarray) -> None:
     """Decodes meshopt_encodeVertexBuffer's bytes into `destination` (shape (vertices, k))."""
     if destination.ndim != 2 or not destination.flags.c_contiguous or \
             not destination.flags.writeable:

@@ -7,12 +7,15 @@ name ("flexion"); the server resolves both. "" and "rest" are the rest pose. Val
 offending term for malformed input (the same rules as core/base/pose_spec.h).
 """
 
+from __future__ import annotations
+
 import math
+from typing import Any, List
 
 from .stubs import pb
 
 
-def _term(joint, axis, degrees, text):
+def _term(joint: object, axis: object, degrees: Any, text: object) -> pb.JointAngle:
     joint = str(joint).strip()
     axis = str(axis).strip()
     if not joint or not axis:
@@ -27,7 +30,7 @@ def _term(joint, axis, degrees, text):
     return pb.JointAngle(joint=joint, axis=axis, degrees=value)
 
 
-def _split_terms(spec):
+def _split_terms(spec: str) -> List[str]:
     """`spec` split at the commas outside double quotes."""
     terms, start, quoted = [], 0, False
     for i, char in enumerate(spec):
@@ -42,7 +45,7 @@ def _split_terms(spec):
     return terms
 
 
-def _fields(text):
+def _fields(text: str) -> List[str]:
     """A term's joint, axis and degrees: the axis and the angle are the last two fields, the joint
     everything before them (names may hold colons) or a double-quoted name."""
     malformed = ValueError(f"pose term {text!r} is not JOINT:AXIS:DEGREES")
@@ -54,14 +57,14 @@ def _fields(text):
         if not rest.startswith(":") or rest[1:].count(":") != 1:
             raise malformed
         axis, degrees = rest[1:].split(":")
-        return text[1:close], axis, degrees
+        return [text[1:close], axis, degrees]
     fields = text.rsplit(":", 2)
     if len(fields) != 3:
         raise malformed
     return fields
 
 
-def parse_pose_spec(spec):
+def parse_pose_spec(spec: str) -> List[pb.JointAngle]:
     """deformctl's syntax -> a list of JointAngle messages."""
     spec = spec.strip()
     if spec in ("", "rest"):
@@ -74,7 +77,7 @@ def parse_pose_spec(spec):
     return angles
 
 
-def angles_of(pose):
+def angles_of(pose: object) -> List[pb.JointAngle]:
     """Any accepted pose form except a PoseUpdate -> a list of JointAngle messages."""
     if isinstance(pose, str):
         return parse_pose_spec(pose)
@@ -95,7 +98,7 @@ def angles_of(pose):
                      f"tuple or a list of them, not {type(pose).__name__}")
 
 
-def pose_update(pose, sequence, timestamp_ns):
+def pose_update(pose: object, sequence: int, timestamp_ns: int) -> pb.PoseUpdate:
     """A PoseUpdate with `sequence` and `timestamp_ns` from any accepted form (a PoseUpdate is
     copied, its sequence and timestamp kept when set)."""
     if isinstance(pose, pb.PoseUpdate):

@@ -11,13 +11,19 @@ frames (next_frame, next_event, iteration) from one thread at a time.
 Errors: the call's failure (NOT_FOUND for an unknown mesh id, INVALID_ARGUMENT for a bad start,
 UNAVAILABLE when the server shuts down, ...) is raised as DeformError by whatever takes the next
 event after it; a frame that does not decode cancels the call and raises DeformError(INTERNAL)
-naming the problem. A cancel() by the caller ends the stream quietly.
+naming the problem. A cancel() by the caller ends the stream quietly. A stream opened with a
+deadline (DeformClient.stream(timeout=)) fails with DEADLINE_EXCEEDED past it.
+
+event_from and PoseNumbering are shared with the asyncio stream (async_client.py).
 """
+
+from __future__ import annotations
 
 import dataclasses
 import queue
 import threading
 import time
+from typing import Iterator, List, Literal, Optional, Sequence, Tuple, Union
 
 import grpc
 import numpy as np
@@ -26,9 +32,10 @@ from . import codec
 from .errors import DeformError
 from .poses import pose_update
 from .stubs import pb
-from .tools import tool_states
+from .tools import ToolSpec, tool_states
 
 _END = object()
+Event = Union["Frame", pb.Notice]
 
 
 @dataclasses.dataclass
@@ -45,16 +52,16 @@ class Frame:
     mesh_unloaded: bool
     stiffness_version: int
     client_timestamp_ns: int
-    message: object = dataclasses.field(repr=False)  # the DeformFrame as received
+    message: pb.DeformFrame = dataclasses.field(repr=False)  # the DeformFrame as received
     # The bone surfaces' rigid motions, (S, 3, 4) float32 [R | t] (posed = R rest + t), in the
     # order of MeshInfo.bone_surfaces; (0, 3, 4) for a mesh without bones.
-    bone_transforms: np.ndarray = dataclasses.field(default=None, repr=False)
+    bone_transforms: Optional[np.ndarray] = dataclasses.field(default=None, repr=False)
     # What the constraints did (FrameConstraints: penetrating_before, penetrating_after,
     # max_depth_after, unresolved, contacts, volume_change), or None for a mesh without them.
-    constraints: object = None
+    constraints: Optional[pb.FrameConstraints] = None
 
 
-def _frame_from(message, decoder):
+def _frame_from(message: pb.DeformFrame, decoder: codec.FrameDecoder) -> Frame:
     started = time.perf_counter()
     positions = decoder.decode(message)
     decode_ms = (time.perf_counter() - started) * 1e3
@@ -73,7 +80,7 @@ def _frame_from(message, decoder):
                  constraints=message.constraints if message.HasField("constraints") else None)
 
 
-def decode_bone_transforms(data):
+def decode_bone_transforms(data: bytes) -> np.ndarray:
     """DeformFrame.bone_transforms (12 float32 per surface: row-major R, then t) as an (S, 3, 4)
     float32 array [R | t]."""
     values = np.frombuffer(data, dtype="<f4").astype(np.float32).reshape(-1, 12)
@@ -81,57 +88,88 @@ def decode_bone_transforms(data):
                           axis=2)
 
 
+def event_from(response: pb.DeformResponse, decoder: codec.FrameDecoder,
+               notices: List[pb.Notice]) -> Event:
+    """A DeformResponse as the Frame or the Notice (also appended to `notices`) it carries;
+    DeformError(INTERNAL) naming the problem for a frame that does not decode."""
+    if response.HasField("notice"):
+        notices.append(response.notice)
+        return response.notice
+    try:
+        return _frame_from(response.frame, decoder)
+    except ValueError as error:
+        raise DeformError(grpc.StatusCode.INTERNAL, f"a frame did not decode: {error}") \
+            from None
+
+
+class PoseNumbering:
+    """Turns send_pose's arguments into a DeformRequest and numbers the poses: one more than the
+    largest sent so far unless given, the first 1. Callers serialize their calls."""
+
+    def __init__(self) -> None:
+        self._next_sequence = 1
+
+    def request(self, pose: object, sequence: Optional[int],
+                tools: Optional[ToolSpec]) -> Tuple[pb.DeformRequest, int]:
+        states = tool_states(tools)
+        update = pose_update(pose, int(self._next_sequence if sequence is None else sequence),
+                             time.monotonic_ns())
+        if states:
+            del update.tools[:]
+            update.tools.extend(states)
+        self._next_sequence = max(self._next_sequence, update.sequence + 1)
+        return pb.DeformRequest(pose=update), update.sequence
+
+
 class DeformStream:
-    def __init__(self, stub, start, metadata, decoder):
+    def __init__(self, stub: object, start: pb.DeformStart, metadata: Sequence[Tuple[str, str]],
+                 decoder: codec.FrameDecoder, timeout: Optional[float] = None):
         """stub: a DeformServiceStub; start: the DeformStart message; metadata: call metadata;
-        decoder: a codec.FrameDecoder for the mesh."""
+        decoder: a codec.FrameDecoder for the mesh; timeout: the call's deadline in seconds
+        (None: none)."""
         self._decoder = decoder
-        self._requests = queue.Queue()
-        self._events = queue.Queue()
+        self._requests: queue.Queue = queue.Queue()
+        self._events: queue.Queue = queue.Queue()
         self._lock = threading.Lock()
         self._closing = False
         self._cancelled = False
         self._ended = False
-        self._next_sequence = 1
-        self.notices = []  # every Notice taken so far (pose or stiffness rejections, switches)
+        self._numbering = PoseNumbering()
+        self.notices: List[pb.Notice] = []  # every Notice taken so far (rejections, switches)
         self._requests.put(pb.DeformRequest(start=start))
-        self._call = stub.Deform(self._request_iterator(), metadata=metadata)
+        self._call = stub.Deform(self._request_iterator(), metadata=metadata,  # type: ignore
+                                 timeout=timeout)
         self._reader = threading.Thread(target=self._read, name="deform-stream-reader",
                                         daemon=True)
         self._reader.start()
 
     # Sending.
 
-    def send_pose(self, pose, sequence=None, tools=None):
+    def send_pose(self, pose: object, sequence: Optional[int] = None,
+                  tools: Optional[ToolSpec] = None) -> int:
         """Sends a pose (poses.py: "knee:flexion:90", {"joint":..., "axis":..., "degrees":...},
         a list of them, or a PoseUpdate, whose own sequence is kept when set), with `tools`
         (tools.py: "sphere:X,Y,Z,R", a list of tools, or None: the PoseUpdate's own, if any; a
         pose without tools is the tool-free frame). Returns its sequence number (one more than the
         largest sent so far unless given; the first is 1). RuntimeError once the stream is closed
         or ended; ValueError for a malformed pose or tool."""
-        states = tool_states(tools)
         with self._lock:
-            if sequence is None:
-                sequence = self._next_sequence
-            update = pose_update(pose, int(sequence), time.monotonic_ns())
-            if states:
-                del update.tools[:]
-                update.tools.extend(states)
-            self._put_locked(pb.DeformRequest(pose=update))
-            self._next_sequence = max(self._next_sequence, update.sequence + 1)
-            return update.sequence
+            self._check_open_locked()
+            request, sequence = self._numbering.request(pose, sequence, tools)
+            self._requests.put(request)
+            return sequence
 
-    def send_stiffness(self, stiffness):
+    def send_stiffness(self, stiffness: pb.StiffnessUpdate) -> None:
         """Sends a StiffnessUpdate message (replaces the stream's stiffness)."""
         with self._lock:
-            self._put_locked(pb.DeformRequest(stiffness=stiffness))
+            self._check_open_locked()
+            self._requests.put(pb.DeformRequest(stiffness=stiffness))
 
-    def _put_locked(self, request):
+    def _check_open_locked(self) -> None:
         if self._closing or self._cancelled or self._ended:
             raise RuntimeError("the stream is closed")
-        self._requests.put(request)
 
-    def _request_iterator(self):
+    def _request_iterator(self) -> Iterator[pb.DeformRequest]:
         while True:
             request = self._requests.get()
             if request is None:
@@ -140,7 +178,7 @@ class DeformStream:
 
     # Receiving.
 
-    def _read(self):
+    def _read(self) -> None:
         try:
             for response in self._call:
                 self._events.put(response)
@@ -153,7 +191,7 @@ class DeformStream:
         finally:
             self._requests.put(None)  # lets gRPC's request thread finish
 
-    def next_event(self, timeout=None):
+    def next_event(self, timeout: Optional[float] = None) -> Optional[Event]:
         """The next Frame or Notice, or None once the stream has ended well. Raises DeformError
         when it failed, TimeoutError after `timeout` seconds without an event."""
         if self._ended:
@@ -168,18 +206,14 @@ class DeformStream:
         if isinstance(event, DeformError):
             self._ended = True
             raise event
-        if event.HasField("notice"):
-            self.notices.append(event.notice)
-            return event.notice
         try:
-            return _frame_from(event.frame, self._decoder)
-        except ValueError as error:
+            return event_from(event, self._decoder, self.notices)
+        except DeformError:
             self._ended = True
             self.cancel()
-            raise DeformError(grpc.StatusCode.INTERNAL, f"a frame did not decode: {error}") \
-                from None
+            raise
 
-    def next_frame(self, timeout=None):
+    def next_frame(self, timeout: Optional[float] = None) -> Optional[Frame]:
         """The next Frame (notices in between go to self.notices), or None once the stream has
         ended well. A rejected pose has no frame: watch self.notices or use events()."""
         while True:
@@ -187,7 +221,7 @@ class DeformStream:
             if event is None or isinstance(event, Frame):
                 return event
 
-    def __iter__(self):
+    def __iter__(self) -> Iterator[Frame]:
         """Frames until the stream ends (after close(), or the server ends it)."""
         while True:
             frame = self.next_frame()
@@ -195,7 +229,7 @@ class DeformStream:
                 return
             yield frame
 
-    def events(self):
+    def events(self) -> Iterator[Event]:
         """Frames and Notices until the stream ends."""
         while True:
             event = self.next_event()
@@ -205,7 +239,7 @@ class DeformStream:
 
     # Ending.
 
-    def close(self, timeout=30.0):
+    def close(self, timeout: float = 30.0) -> None:
         """Half-closes (no more sends), then waits up to `timeout` s for the server to end the
         stream, dropping frames not taken yet. Raises DeformError if the stream failed,
         TimeoutError (after cancelling the call) if it did not end in time."""
@@ -221,17 +255,17 @@ class DeformStream:
             self.cancel()
             raise
 
-    def cancel(self):
+    def cancel(self) -> None:
         """Cancels the call now; the stream ends quietly."""
         with self._lock:
             self._cancelled = True
         self._call.cancel()
         self._requests.put(None)
 
-    def __enter__(self):
+    def __enter__(self) -> "DeformStream":
         return self
 
-    def __exit__(self, exc_type, exc, traceback):
+    def __exit__(self, exc_type: object, exc: object, traceback: object) -> "Literal[False]":
         if exc_type is None:
             self.close()
         else:

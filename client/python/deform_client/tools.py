@@ -9,14 +9,23 @@ Model units, the posed skin's frame. A ToolState message is used as is. ValueErr
 input (the syntax of core/base/tool_spec.h); the server checks the values against the mesh.
 """
 
+from __future__ import annotations
+
 import math
+from typing import Any, Iterable, List, Sequence, Tuple, Union, cast
 
 from .stubs import pb
+
+Point = Sequence[float]
+# One tool ("sphere:...", a ("sphere", centre, r) or ("capsule", end0, end1, r) tuple, a
+# ToolState), or a list of them.
+Tool = Union[str, pb.ToolState, Tuple[Any, ...]]
+ToolSpec = Union[Tool, Sequence[Tool]]
 
 MAX_TOOLS = 4  # ToolSet::kMaxTools: the server rejects a pose with more
 
 
-def _finite(value, text):
+def _finite(value: Any, text: object) -> float:
     try:
         number = float(value)
     except (TypeError, ValueError):
@@ -26,14 +35,14 @@ def _finite(value, text):
     return number
 
 
-def _vector(values, text):
+def _vector(values: Iterable[Any], text: object) -> pb.Vector3:
     values = [_finite(v, text) for v in values]
     if len(values) != 3:
         raise ValueError(f"tool {text!r}: a point needs 3 coordinates")
     return pb.Vector3(x=values[0], y=values[1], z=values[2])
 
 
-def tool_state(tool):
+def tool_state(tool: Tool) -> pb.ToolState:
     """A ToolState from any accepted form (see the module's docstring)."""
     if isinstance(tool, pb.ToolState):
         return tool
@@ -57,11 +66,11 @@ def tool_state(tool):
     raise ValueError(f"tool {tool!r}: not a tool form")
 
 
-def tool_states(tools):
+def tool_states(tools: Union[ToolSpec, None]) -> List[pb.ToolState]:
     """A list of ToolState from one tool or a list of them (None: no tool)."""
     if tools is None:
         return []
     if isinstance(tools, (str, pb.ToolState)) or (
             isinstance(tools, tuple) and tools and isinstance(tools[0], str)):
-        tools = [tools]
-    return [tool_state(tool) for tool in tools]
+        return [tool_state(tools)]
+    return [tool_state(tool) for tool in cast(Sequence[Tool], tools)]

@@ -14,7 +14,10 @@ import argparse
 import pathlib
 import sys
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))  # deform_client
+try:  # the installed package, else the one beside this directory
+    import deform_client  # noqa: F401
+except ImportError:
+    sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 
 from deform_client import DeformError, client_from_environment  # noqa: E402
 from deform_client.mesh_files import write_ply  # noqa: E402

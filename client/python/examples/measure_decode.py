@@ -17,7 +17,10 @@ import pathlib
 import statistics
 import sys
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))  # deform_client
+try:  # the installed package, else the one beside this directory
+    import deform_client  # noqa: F401
+except ImportError:
+    sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 
 from deform_client import DeformError, client_from_environment  # noqa: E402
 

@@ -5,9 +5,11 @@ build; default <repository>/build/server/deformd/deformd) with --listen 127.0.0.
 its output into a temporary file, and waits (up to 60 s) for its "listening on HOST:PORT" line.
 RuntimeError with the log when the program is missing, exits or never listens: a missing server
 fails the tests, it never skips them. stop() sends SIGTERM (SIGKILL after 10 s); also on leaving
-a `with` block.
+a `with` block. paused() stops the process (SIGSTOP) for a `with` block and then continues it
+(SIGCONT): a server that answers nothing, for the deadline tests.
 """
 
+import contextlib
 import os
 import pathlib
 import re
@@ -58,6 +60,20 @@ class DeformdProcess:
                 self._process.kill()
                 self._process.wait()
         return self._process.returncode
+
+    @contextlib.contextmanager
+    def paused(self):
+        self._process.send_signal(signal.SIGSTOP)
+        stat = pathlib.Path(f"/proc/{self._process.pid}/stat")
+        deadline = time.monotonic() + 10
+        while stat.read_text().rsplit(")", 1)[1].split()[0] != "T":  # every thread stopped
+            if time.monotonic() > deadline:
+                raise RuntimeError("deformd did not stop on SIGSTOP")
+            time.sleep(0.005)
+        try:
+            yield
+        finally:
+            self._process.send_signal(signal.SIGCONT)
 
     def __enter__(self):
         return self
