@@ -14,6 +14,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstddef>
 #include <memory>
 #include <vector>
 
@@ -71,6 +72,15 @@ class SkinContactQuery {
   // sum of the faces' normals at a corner; unit length. Its sign separates inside from outside
   // exactly for a closed, outward-oriented mesh.
   Eigen::Vector3d PseudoNormal(int triangle, const Eigen::Vector3d& point) const;
+
+  // An upper bound on the bytes a query over a mesh of this size holds: the tree (positions,
+  // triangles, order, at most one node per triangle), the vertices' faces and weights.
+  static std::size_t BytesFor(int vertices, int triangles) {
+    return static_cast<std::size_t>(vertices) *
+               (3 * sizeof(double) + sizeof(double) + sizeof(int)) +
+           static_cast<std::size_t>(triangles) *
+               (3 * sizeof(int) + sizeof(int) + 3 * sizeof(int) + 64);
+  }
 
   int num_vertices() const { return bvh_.num_vertices(); }
   double rest_diagonal() const { return rest_diagonal_; }
