@@ -6,16 +6,18 @@
     with client.stream(mesh.mesh_id, encoding="predicted") as stream:
         stream.send_pose("knee:flexion:90"); print(stream.next_frame().positions.shape)
 
-Modules: client (DeformClient, MeshInfo, BoneSurface), stream (DeformStream, Frame), codec (the frame
+Modules: client (DeformClient, MeshInfo, BoneSurface), stream (DeformStream, Frame), contact
+(ContactQuery), codec (the frame
 decoders), meshopt (meshoptimizer's decoder through ctypes), poses (pose forms), tools (tool forms), errors
 (DeformError), stubs (the generated deform.v1 code, `pb`: see stubs.py for where it is found).
 """
 
+from .contact import ContactQuery
 from .client import BoneSurface, DeformClient, MeshInfo, client_from_environment
 from .errors import DeformError
 from .stream import DeformStream, Frame
 from .stubs import pb
 from .tools import tool_state
 
-__all__ = ["BoneSurface", "DeformClient", "DeformError", "DeformStream", "Frame", "MeshInfo",
+__all__ = ["BoneSurface", "ContactQuery", "DeformClient", "DeformError", "DeformStream", "Frame", "MeshInfo",
            "client_from_environment", "pb", "tool_state"]

@@ -26,6 +26,7 @@ import grpc
 import numpy as np
 
 from . import codec
+from .contact import ContactQuery
 from .errors import DeformError
 from .stream import DeformStream
 from .stubs import grpc_stubs, pb
@@ -262,6 +263,15 @@ class DeformClient:
             decoder = codec.FrameDecoder(info.summary.vertex_count)
         start = pb.DeformStart(mesh_id=mesh_id, encoding=encoding, max_error=max_error)
         return DeformStream(self._stub, start, self._metadata, decoder)
+
+    def contact(self, mesh_id, deform_stream_id=0, stiffness=0.0):
+        """Opens a QueryContact stream on `mesh_id` (contact.py) against the latest frame of the
+        Deform stream `deform_stream_id` (a frame's message.stream_id; the same tenant's) or, with
+        0, the rest pose; `stiffness` of the force model, 0 = 100. Waits for the server's answer:
+        DeformError NOT_FOUND for an unknown mesh or stream."""
+        start = pb.ContactQueryStart(mesh_id=mesh_id, deform_stream_id=deform_stream_id,
+                                     stiffness=stiffness)
+        return ContactQuery(self._stub, start, self._metadata)
 
 
 def client_from_environment(target=None):
