@@ -23,6 +23,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -33,6 +34,7 @@
 #include "core/base/build_info.h"
 #include "core/base/median.h"
 #include "core/constraints/skin_constraints.h"
+#include "core/constraints/tool_contact.h"
 #include "core/geometry/bone_surface.h"
 #include "core/io/model_input.h"
 #include "core/io/phantom.h"
@@ -647,6 +649,61 @@ void BM_Precompute(benchmark::State& state, BenchMesh mesh) {
   state.counters["precompute_ms"] = Median(precompute) * 1e3;  // before the first factorization
 }
 
+// The contact query of QueryContact (core/constraints/tool_contact.h) on the benchmark pose's
+// skin: the tree built at rest and refitted to the posed skin once, then spheres of 1% of the
+// diagonal centred within 1% of the diagonal of the posed vertices (in contact or near it, as a
+// haptic tool is), 256 per iteration. median_us: one query.
+void BM_ContactQuery(benchmark::State& state, BenchMesh mesh) {
+  auto frames = SetUpFrames(state, mesh);
+  if (!frames) return;
+  const DeformationModel& model = *frames->model;
+  model.Deform(*frames->factorization, frames->pose, &frames->scratch);
+  const Positions posed = frames->scratch.positions();
+  auto query = SkinContactQuery::Create(model.mesh(), {});
+  if (!query.ok()) {
+    state.SkipWithError(query.status().ToString().c_str());
+    return;
+  }
+  (*query)->Refit(posed.data());
+  const double diagonal = model.bounding_box_diagonal();
+  constexpr int kQueries = 256;
+  std::vector<Tool> tools(kQueries);
+  std::mt19937 random(1);
+  std::uniform_int_distribution<int> vertex(0, model.mesh().num_vertices() - 1);
+  std::uniform_real_distribution<double> offset(-0.01 * diagonal, 0.01 * diagonal);
+  for (Tool& tool : tools) {
+    tool.radius = 0.01 * diagonal;
+    tool.a = posed.row(vertex(random)).transpose() +
+             Eigen::Vector3d(offset(random), offset(random), offset(random));
+    tool.b = tool.a;
+  }
+  double depth = 0;
+  const auto seconds = TimeEach(state, [&] {
+    for (const Tool& tool : tools) depth += (*query)->Query(tool, {}).depth;
+  });
+  benchmark::DoNotOptimize(depth);
+  state.counters["median_us"] = Median(seconds) / kQueries * 1e6;
+  state.counters["triangles"] = model.mesh().num_triangles();
+}
+
+// The refit of the contact query's tree (SkinContactQuery::Refit) to the benchmark pose's skin:
+// what a query pays once after each newer frame.
+void BM_ContactRefit(benchmark::State& state, BenchMesh mesh) {
+  auto frames = SetUpFrames(state, mesh);
+  if (!frames) return;
+  const DeformationModel& model = *frames->model;
+  model.Deform(*frames->factorization, frames->pose, &frames->scratch);
+  const Positions posed = frames->scratch.positions();
+  auto query = SkinContactQuery::Create(model.mesh(), {});
+  if (!query.ok()) {
+    state.SkipWithError(query.status().ToString().c_str());
+    return;
+  }
+  const auto seconds = TimeEach(state, [&] { (*query)->Refit(posed.data()); });
+  state.counters["median_ms"] = Median(seconds) * 1e3;
+  state.counters["triangles"] = model.mesh().num_triangles();
+}
+
 // Registers benchmark `name`/<mesh> of `function`(state, mesh, extra...), timed in milliseconds.
 template <typename Function, typename... Extra>
 benchmark::internal::Benchmark* RegisterFor(const BenchMesh& mesh, const std::string& name,
@@ -679,6 +736,8 @@ void RegisterBenchmarks(const BenchMesh& mesh) {
                 tool_contacts)
         ->MinTime(1.0);
   }
+  RegisterFor(mesh, "ContactQuery", BM_ContactQuery)->MinTime(0.5);
+  RegisterFor(mesh, "ContactRefit", BM_ContactRefit)->MinTime(0.5);
   RegisterFor(mesh, "LinearBlendFrame", BM_LinearBlendFrame)->MinTime(1.0);
   RegisterFor(mesh, "RightHandSide", BM_RightHandSide)->MinTime(0.5);
   RegisterFor(mesh, "TriangularSolve", BM_TriangularSolve, BestSolveKernel())->MinTime(1.0);

@@ -59,7 +59,8 @@ declare -A SERVICE_LAYERS=(
   [context]="base metrics access workers registry context"
   [load]="base metrics access workers registry transport messages context load"
   [deform]="base metrics access workers registry transport messages context deform"
-  [rpc]="base metrics access workers registry transport messages context load deform rpc"
+  [contact]="base metrics access workers registry transport messages context contact"
+  [rpc]="base metrics access workers registry transport messages context load deform contact rpc"
 )
 check_layers server/service service SERVICE_LAYERS
 

@@ -20,7 +20,8 @@ BUILD_DIR="${DEFORM_TSA_BUILD_DIR:-build-tsa}"
 # The targets whose sources carry annotations.
 ANNOTATED_TARGETS=(deform_service_base deform_service_metrics deform_service_access
   deform_service_workers deform_service_registry deform_service_transport deform_service_messages
-  deform_service_context deform_service_load deform_service_deform deform_service_rpc)
+  deform_service_context deform_service_load deform_service_deform deform_service_contact
+  deform_service_rpc)
 
 scripts/install-deps.sh scripts/packages/build.txt scripts/packages/checks.txt
 

@@ -370,6 +370,10 @@ DEFORM_C_API deform_status deform_stream_next_frame(deform_stream* stream, float
                                                     size_t capacity_floats, int timeout_ms,
                                                     deform_frame_info* info);
 
+/* The server's id of this stream (DeformFrame.stream_id), which deform_contact_open names to query
+ * against its latest frame. DEFORM_NO_DATA until the stream's first frame has arrived. */
+DEFORM_C_API deform_status deform_stream_id(deform_stream* stream, uint64_t* id);
+
 /* What a frame's constraints did (the server's FrameConstraints), on a mesh with bone surfaces or
  * its volume kept. Vertices are the solved mesh's. */
 typedef struct deform_frame_constraints {
@@ -435,6 +439,47 @@ DEFORM_C_API deform_status deform_stream_next_notice(deform_stream* stream,
 DEFORM_C_API deform_status deform_stream_close(deform_stream* stream, int timeout_ms);
 /* Cancels the stream if it is still open and frees it. */
 DEFORM_C_API void deform_stream_free(deform_stream* stream);
+
+/* ---- Contact queries ---------------------------------------------------------------------- */
+
+/* A QueryContact stream (docs/instruments.md): a tool's contact with the skin, one blocking round
+ * trip a query, for a haptic loop. One thread at a time per handle. */
+typedef struct deform_contact deform_contact;
+
+/* Opens a contact query on `mesh_id` against the latest frame of the Deform stream
+ * `deform_stream_id` (deform_stream_id(); the same tenant's) or, with 0, the rest pose.
+ * `stiffness`: the force of a press one bounding-box diagonal deep into material of weight 1, in
+ * the caller's force unit; 0 = 100. Waits for the server's answer: NOT_FOUND for an unknown mesh
+ * or stream, INVALID_ARGUMENT for a bad stiffness, RESOURCE_EXHAUSTED beyond the stream limits.
+ * End with deform_contact_close. */
+DEFORM_C_API deform_status deform_contact_open(deform_client* client, const char* mesh_id,
+                                               uint64_t deform_stream_id, double stiffness,
+                                               deform_contact** out);
+
+typedef struct deform_contact_result {
+  uint64_t sequence;      /* this query's, 1, 2, ... per handle */
+  double point[3];        /* the skin point closest to the tool's axis */
+  double normal[3];       /* the skin's outward unit normal there */
+  double depth;           /* radius - signed_distance, at least 0: > 0 inside the skin */
+  double force[3];        /* on the tool: stiffness * material_weight * depth / diagonal * normal */
+  double signed_distance; /* the axis's distance from the skin, negative inside */
+  double material_weight; /* at `point` */
+  uint64_t frame_number;  /* the Deform stream's frame queried (1 = its first); 0 = rest pose */
+  uint64_t frame_sequence; /* the pose that frame answered; 0 at rest */
+} deform_contact_result;
+
+/* The contact of `tool` (deform_tool, as in a pose) with the skin as it stands now. Blocks for one
+ * round trip. A bad tool ends the query stream with INVALID_ARGUMENT (every later call returns
+ * it); INVALID_ARGUMENT without contacting the server for an unknown shape. */
+DEFORM_C_API deform_status deform_contact_query(deform_contact* contact, const deform_tool* tool,
+                                                deform_contact_result* result);
+
+/* The bounding-box diagonal of the rest skin (the force model's length), model units. */
+DEFORM_C_API deform_status deform_contact_diagonal(const deform_contact* contact, double* diagonal);
+
+/* Ends the query stream, returns its final status (DEFORM_OK after a clean end, or the error that
+ * ended it) and frees the handle; NULL does nothing (DEFORM_OK). */
+DEFORM_C_API deform_status deform_contact_close(deform_contact* contact);
 
 #ifdef __cplusplus
 } /* extern "C" */

@@ -42,6 +42,7 @@ struct StreamInbox {
   v1::DeformFrame frame;             // its fields, positions cleared
   std::int64_t arrival_ns = 0;       // when it arrived (client::MonotonicNanos)
   std::uint64_t frames_dropped = 0;  // replaced before being handed out, since the last one
+  std::uint64_t stream_id = 0;       // the server's id of the stream (DeformFrame.stream_id)
   // The last frame handed out: its bone surface transforms and constraint report.
   bool handed_out = false;
   std::string handed_out_bones;
@@ -58,6 +59,7 @@ struct StreamInbox {
     if (has_frame) ++frames_dropped;
     positions.assign(incoming.positions());
     frame.CopyFrom(incoming);
+    stream_id = incoming.stream_id();
     frame.clear_positions();
     frame.clear_encoded();
     arrival_ns = now;
@@ -187,6 +189,18 @@ deform_status deform_stream_open(deform_client* client, const char* mesh_id,
 deform_status deform_stream_vertex_count(const deform_stream* stream, uint32_t* count) {
   return Get(__func__, stream, "stream", count, "count",
              [](const deform_stream& s) { return s.vertex_count; });
+}
+
+deform_status deform_stream_id(deform_stream* stream, uint64_t* id) {
+  return Guarded(__func__, {{stream, "stream"}, {id, "id"}}, [&] {
+    deform::c_api::StreamInbox& inbox = *stream->inbox;
+    std::lock_guard<std::mutex> lock(inbox.mutex);
+    if (inbox.stream_id == 0) {
+      return Fail(DEFORM_NO_DATA, "deform_stream_id: no frame has arrived yet");
+    }
+    *id = inbox.stream_id;
+    return Succeed();
+  });
 }
 
 deform_status deform_stream_send_pose(deform_stream* stream, const deform_joint_angle* angles,

@@ -277,6 +277,13 @@ grpc::Status DeformClient::UnloadMesh(const std::string& mesh_id) {
   return stub_->UnloadMesh(&context, request, &response);
 }
 
+grpc::Status DeformClient::OpenContactQuery(const deform::v1::ContactQueryStart& start,
+                                            std::unique_ptr<ContactQuery>* query) {
+  auto context = std::make_unique<grpc::ClientContext>();
+  AddCallCredentials(options_, context.get());
+  return ContactQuery::Open(stub_.get(), std::move(context), start, query);
+}
+
 std::unique_ptr<DeformStream> DeformClient::OpenStream(const std::string& mesh_id,
                                                        StreamCallbacks callbacks) {
   return OpenStream(mesh_id, std::move(callbacks), StreamOptions{});

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "contact_query.h"
 #include "deform/v1/deform.grpc.pb.h"
 
 namespace deform::client {
@@ -133,6 +134,10 @@ class DeformClient {
   std::unique_ptr<DeformStream> OpenStream(const std::string& mesh_id, StreamCallbacks callbacks,
                                            const StreamOptions& stream_options);
 
+  // Opens a QueryContact stream (contact_query.h) with `start` (the mesh, optionally a Deform
+  // stream's id: DeformFrame.stream_id) and waits for the server's `started`.
+  grpc::Status OpenContactQuery(const deform::v1::ContactQueryStart& start,
+                                std::unique_ptr<ContactQuery>* query);
   // GetMeshInfo with every field of the request (prediction weights included).
   grpc::Status GetMeshInfo(const deform::v1::GetMeshInfoRequest& request,
                            deform::v1::GetMeshInfoResponse* info);

@@ -588,6 +588,35 @@ static void test_phantom_session(const char* target) {
   CHECK(deform_stream_frame_tools(stream, &tool_report) == DEFORM_OK);
   CHECK(tool_report.penetrating_before == 0 && tool_report.contacts == 0);
 
+  /* The contact query against this stream's latest frame (the bent knee, no tool): the same sphere
+   * is half its radius inside the skin there, pushed out along +x. */
+  uint64_t stream_id = 0;
+  CHECK(deform_stream_id(stream, &stream_id) == DEFORM_OK && stream_id > 0);
+  deform_contact* contact = NULL;
+  CHECK(deform_contact_open(client, mesh_id, stream_id, 0, &contact) == DEFORM_OK);
+  double diagonal = 0;
+  CHECK(deform_contact_diagonal(contact, &diagonal) == DEFORM_OK && diagonal > 1);
+  deform_contact_result touch;
+  CHECK(deform_contact_query(contact, &sphere, &touch) == DEFORM_OK);
+  CHECK(touch.sequence == 1 && touch.frame_sequence == sequence && touch.frame_number > 0);
+  CHECK(touch.depth > 0.1 && touch.depth <= 0.3 + 1e-9);
+  CHECK(fabs(touch.depth - (0.3 - touch.signed_distance)) < 1e-9);
+  CHECK(touch.normal[0] > 0.5 && touch.force[0] > 0);
+  CHECK(fabs(sqrt(pow(touch.force[0], 2) + pow(touch.force[1], 2) + pow(touch.force[2], 2)) -
+             100 * touch.material_weight * touch.depth / diagonal) < 1e-9);
+  deform_tool away = sphere;
+  away.center[0] += 1;
+  deform_contact_result apart;
+  CHECK(deform_contact_query(contact, &away, &apart) == DEFORM_OK);
+  CHECK(apart.sequence == 2 && apart.depth == 0 && apart.force[0] == 0);
+  CHECK(deform_contact_query(contact, &unknown_shape, &apart) == DEFORM_INVALID_ARGUMENT);
+  CHECK(deform_contact_close(contact) == DEFORM_OK);
+  printf("c_api_test: contact at the bent knee: depth %.4f, force %.4f along +x\n", touch.depth,
+         touch.force[0]);
+  CHECK(deform_contact_open(client, mesh_id, stream_id + 1000, 0, &contact) == DEFORM_NOT_FOUND);
+  CHECK(strstr(deform_last_error(), "no open Deform stream") != NULL);
+  CHECK(deform_contact_close(NULL) == DEFORM_OK);
+
   /* Closing ends the stream: no more poses, frames report the end. */
   CHECK(deform_stream_close(stream, 5000) == DEFORM_OK);
   CHECK(deform_stream_send_pose(stream, &flexion, 1, NULL, 0, NULL, NULL) == DEFORM_STREAM_ENDED);

@@ -8,7 +8,7 @@
 
 Modules: client (DeformClient), async_client (AsyncDeformClient, AsyncDeformStream: the same on
 asyncio), summary (MeshSummary, MeshInfo, Joint, Bone, BoneSurface...), stream (DeformStream,
-Frame), calls (what both clients send; timeouts: DEFAULT), channel (TLS), codec (the frame
+Frame), contact (ContactQuery: a tool's contact at haptic rate), calls (what both clients send; timeouts: DEFAULT), channel (TLS), codec (the frame
 decoders), meshopt (meshoptimizer's decoder through ctypes), poses (pose forms), tools (tool
 forms), errors (DeformError), stubs (the generated deform.v1 code shipped in _proto/, `pb`),
 version (`__version__`, deformd's).
@@ -17,6 +17,7 @@ version (`__version__`, deformd's).
 from .async_client import AsyncDeformClient, AsyncDeformStream, async_client_from_environment
 from .calls import DEFAULT, DEFAULT_LOAD_TIMEOUT, DEFAULT_UNARY_TIMEOUT
 from .client import DeformClient, client_from_environment
+from .contact import ContactQuery
 from .errors import DeformError
 from .stream import DeformStream, Frame
 from .stubs import pb
@@ -26,7 +27,7 @@ from .tools import tool_state
 from .version import __version__
 
 __all__ = ["__version__", "AsyncDeformClient", "AsyncDeformStream", "Bone", "BoneSurface",
-           "BoneSurfaceInfo", "DEFAULT", "DEFAULT_LOAD_TIMEOUT", "DEFAULT_UNARY_TIMEOUT",
+           "BoneSurfaceInfo", "ContactQuery", "DEFAULT", "DEFAULT_LOAD_TIMEOUT", "DEFAULT_UNARY_TIMEOUT",
            "DegreeOfFreedom", "DeformClient", "DeformError", "DeformStream", "Frame", "Joint",
            "MeshInfo", "MeshSummary", "async_client_from_environment", "client_from_environment",
            "pb", "tool_state"]

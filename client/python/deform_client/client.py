@@ -29,6 +29,7 @@ import grpc
 from . import calls
 from .calls import DEFAULT, BoneSurfaceSpec, PathLike, Progress, Timeout
 from .channel import DEFAULT_MAX_RECEIVE_MESSAGE_BYTES, Pem, channel_settings
+from .contact import ContactQuery
 from .errors import DeformError
 from .stream import DeformStream
 from .stubs import grpc_stubs, pb
@@ -167,6 +168,16 @@ class DeformClient:
         start, decoder = calls.stream_start(mesh_id, value, max_error, info)
         return DeformStream(self._stub, start, self._metadata, decoder,
                             timeout=calls.deadline(timeout, None))
+
+    def contact(self, mesh_id: str, deform_stream_id: int = 0,
+                stiffness: float = 0.0) -> ContactQuery:
+        """Opens a QueryContact stream on `mesh_id` (contact.py) against the latest frame of the
+        Deform stream `deform_stream_id` (a frame's message.stream_id; the same tenant's) or, with
+        0, the rest pose; `stiffness` of the force model, 0 = 100. Waits for the server's answer:
+        DeformError NOT_FOUND for an unknown mesh or stream."""
+        start = pb.ContactQueryStart(mesh_id=mesh_id, deform_stream_id=deform_stream_id,
+                                     stiffness=stiffness)
+        return ContactQuery(self._stub, start, self._metadata)
 
 
 def client_from_environment(target: Optional[str] = None) -> DeformClient:

@@ -87,6 +87,109 @@ bool SegmentMeetsTriangle(const Eigen::Vector3d& from, const Eigen::Vector3d& to
   return t > kProperCrossing && t < 1 - kProperCrossing;
 }
 
+// The closest points of segments [p1, q1] and [p2, q2] (Ericson, 5.1.9); returns the squared
+// distance between them.
+double ClosestPointsOfSegments(const Eigen::Vector3d& p1, const Eigen::Vector3d& q1,
+                               const Eigen::Vector3d& p2, const Eigen::Vector3d& q2,
+                               Eigen::Vector3d* c1, Eigen::Vector3d* c2) {
+  constexpr double kDegenerate = 1e-300;
+  const Eigen::Vector3d d1 = q1 - p1, d2 = q2 - p2, r = p1 - p2;
+  const double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(r);
+  double s = 0, t = 0;
+  if (a <= kDegenerate && e <= kDegenerate) {
+    s = t = 0;
+  } else if (a <= kDegenerate) {
+    t = std::clamp(f / e, 0.0, 1.0);
+  } else {
+    const double c = d1.dot(r);
+    if (e <= kDegenerate) {
+      s = std::clamp(-c / a, 0.0, 1.0);
+    } else {
+      const double b = d1.dot(d2);
+      const double denominator = a * e - b * b;
+      s = denominator > 0 ? std::clamp((b * f - c * e) / denominator, 0.0, 1.0) : 0.0;
+      t = (b * s + f) / e;
+      if (t < 0) {
+        t = 0;
+        s = std::clamp(-c / a, 0.0, 1.0);
+      } else if (t > 1) {
+        t = 1;
+        s = std::clamp((b - c) / a, 0.0, 1.0);
+      }
+    }
+  }
+  *c1 = p1 + d1 * s;
+  *c2 = p2 + d2 * t;
+  return (*c1 - *c2).squaredNorm();
+}
+
+// The closest pair between segment [from, to] and triangle abc: the triangle's point, the
+// segment's point; returns their squared distance. A segment through the triangle gives 0 at the
+// crossing.
+double ClosestSegmentTrianglePair(const Eigen::Vector3d& from, const Eigen::Vector3d& to,
+                                  const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                  const Eigen::Vector3d& c, Eigen::Vector3d* on_triangle,
+                                  Eigen::Vector3d* on_segment) {
+  const Eigen::Vector3d direction = to - from;
+  if (direction.squaredNorm() > 0) {
+    // A crossing (Moller-Trumbore, closed barycentric and segment ranges).
+    const Eigen::Vector3d e1 = b - a, e2 = c - a;
+    const Eigen::Vector3d p = direction.cross(e2);
+    const double determinant = e1.dot(p);
+    if (std::abs(determinant) > 1e-300) {
+      const double inverse = 1.0 / determinant;
+      const Eigen::Vector3d s = from - a;
+      const double u = s.dot(p) * inverse;
+      const Eigen::Vector3d q = s.cross(e1);
+      const double v = direction.dot(q) * inverse;
+      const double t = e2.dot(q) * inverse;
+      if (u >= 0 && v >= 0 && u + v <= 1 && t >= 0 && t <= 1) {
+        *on_segment = from + t * direction;
+        *on_triangle = *on_segment;
+        return 0;
+      }
+    }
+  }
+  // Otherwise the minimum lies at an end of the segment against the triangle or on an edge.
+  *on_segment = from;
+  *on_triangle = ClosestPointOnTriangle(from, a, b, c);
+  double best = (*on_triangle - from).squaredNorm();
+  if (direction.squaredNorm() == 0) return best;
+  const Eigen::Vector3d at_to = ClosestPointOnTriangle(to, a, b, c);
+  if ((at_to - to).squaredNorm() < best) {
+    best = (at_to - to).squaredNorm();
+    *on_segment = to;
+    *on_triangle = at_to;
+  }
+  const std::array<std::pair<const Eigen::Vector3d*, const Eigen::Vector3d*>, 3> edges = {
+      {{&a, &b}, {&b, &c}, {&c, &a}}};
+  for (const auto& [start, end] : edges) {
+    Eigen::Vector3d on_edge, on_axis;
+    const double squared = ClosestPointsOfSegments(from, to, *start, *end, &on_axis, &on_edge);
+    if (squared < best) {
+      best = squared;
+      *on_segment = on_axis;
+      *on_triangle = on_edge;
+    }
+  }
+  return best;
+}
+
+// A lower bound on the squared distance from segment [from, to] to the box: the larger of the
+// distance between the segment's own box and the box, and the distance from its midpoint less
+// its half length.
+double SegmentBoxLowerBound(const Eigen::Vector3d& from, const Eigen::Vector3d& to,
+                            const Eigen::Vector3d& lower, const Eigen::Vector3d& upper) {
+  const Eigen::Vector3d segment_lower = from.cwiseMin(to);
+  const Eigen::Vector3d segment_upper = from.cwiseMax(to);
+  const Eigen::Vector3d gap = (lower - segment_upper).cwiseMax(segment_lower - upper).cwiseMax(0.0);
+  const double boxes = gap.squaredNorm();
+  const Eigen::Vector3d middle = 0.5 * (from + to);
+  const double from_middle = std::max(
+      0.0, std::sqrt(SquaredDistanceToBox(middle, lower, upper)) - 0.5 * (to - from).norm());
+  return std::max(boxes, from_middle * from_middle);
+}
+
 bool BoxesOverlap(const Eigen::Vector3d& lower_a, const Eigen::Vector3d& upper_a,
                   const Eigen::Vector3d& lower_b, const Eigen::Vector3d& upper_b) {
   return (lower_a.array() <= upper_b.array()).all() && (lower_b.array() <= upper_a.array()).all();
@@ -229,6 +332,66 @@ bool TriangleBvh::Contains(const Eigen::Vector3d& point) const {
     inside += CountRayCrossings(point, direction) % 2;
   }
   return inside >= 2;
+}
+
+TriangleBvh::SegmentSurfacePoint TriangleBvh::ClosestPointToSegment(
+    const Eigen::Vector3d& from, const Eigen::Vector3d& to) const {
+  SegmentSurfacePoint best;
+  best.distance = std::numeric_limits<double>::infinity();
+  if (triangles_.rows() == 0) return best;
+  double best_squared = best.distance;
+  std::array<int, kMaxDepth> stack;
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& node = nodes_[stack[--top]];
+    if (SegmentBoxLowerBound(from, to, node.lower, node.upper) >= best_squared) continue;
+    if (node.count > 0) {
+      for (int p = node.first; p < node.first + node.count; ++p) {
+        const int f = order_[p];
+        Eigen::Vector3d on_triangle, on_segment;
+        const double squared = ClosestSegmentTrianglePair(
+            from, to, positions_.row(triangles_(f, 0)).transpose(),
+            positions_.row(triangles_(f, 1)).transpose(),
+            positions_.row(triangles_(f, 2)).transpose(), &on_triangle, &on_segment);
+        if (squared < best_squared) {
+          best_squared = squared;
+          best = {on_triangle, on_segment, f, std::sqrt(squared)};
+        }
+      }
+    } else {
+      // Nearer child last, so it is popped first.
+      const double left =
+          SegmentBoxLowerBound(from, to, nodes_[node.left].lower, nodes_[node.left].upper);
+      const double right =
+          SegmentBoxLowerBound(from, to, nodes_[node.right].lower, nodes_[node.right].upper);
+      stack[top++] = left < right ? node.right : node.left;
+      stack[top++] = left < right ? node.left : node.right;
+    }
+  }
+  return best;
+}
+
+void TriangleBvh::Refit(const double* xyz) {
+  std::copy(xyz, xyz + positions_.size(), positions_.data());
+  // Build pushes a node before its children, so every child's index exceeds its parent's.
+  for (int n = static_cast<int>(nodes_.size()) - 1; n >= 0; --n) {
+    Node& node = nodes_[n];
+    if (node.count > 0) {
+      node.lower = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+      node.upper = -node.lower;
+      for (int p = node.first; p < node.first + node.count; ++p) {
+        for (int c = 0; c < 3; ++c) {
+          const Eigen::Vector3d v = positions_.row(triangles_(order_[p], c)).transpose();
+          node.lower = node.lower.cwiseMin(v);
+          node.upper = node.upper.cwiseMax(v);
+        }
+      }
+    } else {
+      node.lower = nodes_[node.left].lower.cwiseMin(nodes_[node.right].lower);
+      node.upper = nodes_[node.left].upper.cwiseMax(nodes_[node.right].upper);
+    }
+  }
 }
 
 double TriangleBvh::DistanceToSurface(const Eigen::Vector3d& point) const {

@@ -4,7 +4,9 @@
 //
 // Built once in O(F log F) (axis-aligned boxes, median split on the longest axis, at most
 // kLeafTriangles per leaf); holds its own copy of the positions and triangles. Queries are const,
-// allocate nothing beyond a small fixed stack, and are safe from any number of threads.
+// allocate nothing beyond a small fixed stack, and are safe from any number of threads. Refit
+// moves the vertices (same topology) and recomputes the boxes in O(F) without allocating, for a
+// surface that deforms frame by frame; the tree's split stays the one built at rest.
 #pragma once
 
 #include <Eigen/Core>
@@ -46,6 +48,26 @@ class TriangleBvh {
     double distance = 0;
   };
   SurfacePoint ClosestPoint(const Eigen::Vector3d& point) const;
+  // The closest pair between the segment [from, to] (from == to: a point) and the surface: the
+  // surface point, the triangle it lies on, the segment's point and their distance (exact, by
+  // descending the tree; 0 when the segment crosses the surface). For an empty mesh: triangle
+  // -1, distance infinity.
+  struct SegmentSurfacePoint {
+    Eigen::Vector3d point = Eigen::Vector3d::Zero();    // on the surface
+    Eigen::Vector3d segment = Eigen::Vector3d::Zero();  // on the segment
+    int triangle = -1;
+    double distance = 0;
+  };
+  SegmentSurfacePoint ClosestPointToSegment(const Eigen::Vector3d& from,
+                                            const Eigen::Vector3d& to) const;
+
+  // Moves the vertices to `xyz` (row i at xyz[3 i], as many vertices as the tree was built with)
+  // and refits every box to them, children before parents. O(F), no allocation. Not safe
+  // while another thread queries this tree.
+  void Refit(const double* xyz);
+  int num_vertices() const { return static_cast<int>(positions_.rows()); }
+  const Positions& positions() const { return positions_; }
+  const Triangles& triangles() const { return triangles_; }
   // The unit normal of triangle f, by its winding (counter-clockwise seen from outside for an
   // outward-oriented mesh).
   Eigen::Vector3d TriangleNormal(int f) const;

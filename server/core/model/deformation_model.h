@@ -53,6 +53,8 @@ namespace deform {
 class MaterialFactorization {
  public:
   const CholeskyFactor& factor() const { return factor_; }
+  // The squared material weight w_i^2 of each vertex row (n) for the stiffness it was built for.
+  const Eigen::VectorXd& row_weights_squared() const { return row_weights_squared_; }
   // With RotationBlend::kLinear, the precomputed response that replaces the per-frame solve, when
   // a frame reads less from it than a solve reads from the factor (its doubles against twice the
   // factor's non-zeros: two triangular passes); otherwise, and with kQuaternion, null and frames

@@ -1,5 +1,6 @@
 // What every handler of the service shares (ServiceContext): who may call (the authenticator),
-// admission, the mesh registry and store, the worker pool, the upload watchdog, the open streams,
+// admission, the mesh registry and store, the worker pool, the upload watchdog, the open streams
+// and their latest frames,
 // the metrics, and the shutdown signal. The RPC classes and the stream handlers of both
 // transports look things up here; no gRPC types here.
 //
@@ -22,6 +23,7 @@
 #include "service/base/annotated_mutex.h"
 #include "service/base/service_options.h"
 #include "service/base/thread_annotations.h"
+#include "service/context/latest_frames.h"
 #include "service/metrics/service_metrics.h"
 #include "service/registry/mesh_registry.h"
 #include "service/registry/mesh_store.h"
@@ -86,6 +88,8 @@ class ServiceContext {
   WorkerPool& pool() { return pool_; }
   UploadWatchdog& uploads() { return uploads_; }
   ActiveStreams& streams() { return streams_; }
+  // Every open Deform stream's latest solved frame, for the contact queries.
+  LatestFrames& latest_frames() { return latest_frames_; }
   // Where loaded meshes are kept across restarts (--store); null: nowhere.
   MeshStore* store() const { return store_.get(); }
   // Before serving only.
@@ -108,6 +112,7 @@ class ServiceContext {
   WorkerPool pool_;
   UploadWatchdog uploads_;
   ActiveStreams streams_;
+  LatestFrames latest_frames_;
   std::unique_ptr<MeshStore> store_;
   CancelToken shutting_down_;
   std::atomic<std::uint64_t> next_stream_id_{1};

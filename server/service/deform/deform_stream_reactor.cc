@@ -156,7 +156,10 @@ class DeformStreamReactor final : public StreamHandler,
   std::shared_ptr<const MeshEntry> entry_;
   const DeformationModel* model_ = nullptr;  // non-null once started
   bool registered_ = false;                  // in context_->streams()
-  bool counted_ = false;                     // in context_->admission()'s streams
+  // The latest solved frame, for contact queries (context_->latest_frames(), under stream_id_);
+  // set by HandleStart before any solve, published by the solve task.
+  std::shared_ptr<LatestFrame> latest_;
+  bool counted_ = false;  // in context_->admission()'s streams
 
   // Reader-owned (one read outstanding at a time).
   v1::DeformRequest request_;
@@ -301,6 +304,7 @@ void DeformStreamReactor::HandleStart() {
         bone_surface_bytes;
     MutexLock lock(&mutex_);
     buffer_bytes_ = model_->ScratchBytes() + 3 * frame_bytes + constraint_bytes +
+                    LatestFrame::Bytes(model_->mesh().num_vertices()) +
                     (encoded_bytes > 0 ? encoded_bytes + vertices * 8 : 0) +
                     (entry_->solve.parallel_plan != nullptr
                          ? FrameSolver::ParallelWorkBytes(*model_, *entry_->solve.parallel_plan)
@@ -313,6 +317,9 @@ void DeformStreamReactor::HandleStart() {
       return;
     }
   }
+  latest_ =
+      std::make_shared<LatestFrame>(caller_.tenant, entry_->id, model_->mesh().num_vertices());
+  context_->latest_frames().Add(stream_id_, latest_);
   // Everything a solve needs, sized once; frames in the client's vertex order.
   solver_.emplace(*model_, entry_->file_metadata.file_vertex_to_mesh, std::move(*encoder));
   if (entry_->solve.parallel_plan != nullptr) {
@@ -534,6 +541,7 @@ void DeformStreamReactor::RunUrgentBatch(FrameTask* const* others, int count) {
       DeformStreamReactor* member = group[i];
       member->solver_->Finish(member->solving_, deformed, member->solve_stamp_,
                               member->solve_frame_);
+      member->latest_->Publish(member->solver_->solved_positions(), member->solving_.sequence);
       member->EndSolveRun(true);
     }
   }
@@ -551,6 +559,7 @@ bool DeformStreamReactor::BeginSolveRun() {
   solve_stamp_.skipped_poses = *skipped;
   solve_stamp_.mesh_unloaded = entry_->unloaded.load(std::memory_order_relaxed);
   solve_frame_ = outbox_.working_frame()->mutable_frame();
+  solve_frame_->set_stream_id(stream_id_);
   return true;
 }
 
@@ -644,6 +653,7 @@ void DeformStreamReactor::FinishRevokedLocked() {
 
 void DeformStreamReactor::OnDone() {
   if (registered_) context_->streams().Remove(this);
+  if (latest_ != nullptr) context_->latest_frames().Remove(stream_id_);
   if (counted_) context_->admission().ReleaseStream(caller_.tenant);
   if (entry_ != nullptr) context_->registry().DetachStream(*entry_);
   {

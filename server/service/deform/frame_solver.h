@@ -105,6 +105,9 @@ class FrameSolver {
   // constrains and encodes its frames one after the other).
   void Finish(const PoseInput& input, const Deformed& deformed, const FrameStamp& stamp,
               v1::DeformFrame* frame);
+  // The last finished frame's positions in the solved order, constraints applied: row i at
+  // [3 i], the model's num_vertices rows. Valid until the next solve.
+  const double* solved_positions() const { return scratch_.solution.data(); }
 
  private:
   const DeformationModel& model_;

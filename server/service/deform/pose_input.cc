@@ -7,6 +7,7 @@
 #include <string>
 
 #include "service/base/request_limits.h"
+#include "service/messages/proto_conversion.h"
 
 namespace deform::service {
 namespace {
@@ -67,27 +68,8 @@ Status AddTools(const v1::PoseUpdate& update, const Eigen::Vector3d& lower,
                                    " tools a pose, not " + std::to_string(update.tools_size()));
   }
   for (int t = 0; t < update.tools_size(); ++t) {
-    const v1::ToolState& state = update.tools(t);
-    const std::string name = "tool " + std::to_string(t);
     Tool tool;
-    switch (state.shape()) {
-      case v1::ToolState::SHAPE_SPHERE:
-        tool.shape = Tool::Shape::kSphere;
-        break;
-      case v1::ToolState::SHAPE_CAPSULE:
-        tool.shape = Tool::Shape::kCapsule;
-        if (!state.has_end()) return Status::InvalidArgument(name + ": a capsule needs `end`");
-        break;
-      default:
-        return Status::InvalidArgument(name + ": shape must be SHAPE_SPHERE or SHAPE_CAPSULE");
-    }
-    if (!state.has_center()) return Status::InvalidArgument(name + ": `center` is unset");
-    tool.a = Eigen::Vector3d(state.center().x(), state.center().y(), state.center().z());
-    tool.b = tool.shape == Tool::Shape::kCapsule
-                 ? Eigen::Vector3d(state.end().x(), state.end().y(), state.end().z())
-                 : tool.a;
-    tool.radius = state.radius();
-    DEFORM_RETURN_IF_ERROR(ValidateTool(tool, t, lower, upper));
+    DEFORM_RETURN_IF_ERROR(ToolFromProto(update.tools(t), t, lower, upper, &tool));
     tools->Add(tool);
   }
   return Status::Ok();

@@ -50,6 +50,29 @@ StatusOr<int> RegionJointOf(const DeformationModel& model, const std::string& na
 
 }  // namespace
 
+Status ToolFromProto(const v1::ToolState& state, int index, const Eigen::Vector3d& lower,
+                     const Eigen::Vector3d& upper, Tool* tool) {
+  const std::string name = "tool " + std::to_string(index);
+  switch (state.shape()) {
+    case v1::ToolState::SHAPE_SPHERE:
+      tool->shape = Tool::Shape::kSphere;
+      break;
+    case v1::ToolState::SHAPE_CAPSULE:
+      tool->shape = Tool::Shape::kCapsule;
+      if (!state.has_end()) return Status::InvalidArgument(name + ": a capsule needs `end`");
+      break;
+    default:
+      return Status::InvalidArgument(name + ": shape must be SHAPE_SPHERE or SHAPE_CAPSULE");
+  }
+  if (!state.has_center()) return Status::InvalidArgument(name + ": `center` is unset");
+  tool->a = Eigen::Vector3d(state.center().x(), state.center().y(), state.center().z());
+  tool->b = tool->shape == Tool::Shape::kCapsule
+                ? Eigen::Vector3d(state.end().x(), state.end().y(), state.end().z())
+                : tool->a;
+  tool->radius = state.radius();
+  return ValidateTool(*tool, index, lower, upper);
+}
+
 StatusOr<ModelOptions> ModelOptionsFromProto(const v1::MethodOptions& proto,
                                              const Skeleton& skeleton) {
   DEFORM_RETURN_IF_ERROR(CheckMethodOptionStrings(proto));

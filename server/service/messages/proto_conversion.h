@@ -8,6 +8,7 @@
 
 #include "core/base/status.h"
 #include "core/constraints/skin_constraints.h"
+#include "core/constraints/tools.h"
 #include "core/geometry/skeleton.h"
 #include "core/model/deformation_model.h"
 #include "core/model/stiffness.h"
@@ -28,6 +29,13 @@ StatusOr<ModelOptions> ModelOptionsFromProto(const v1::MethodOptions& proto,
 StatusOr<ConstraintOptions> ConstraintOptionsFromProto(const v1::Constraints& proto);
 // The options back as the proto states them, every field set.
 void ConstraintOptionsToProto(const ConstraintOptions& options, v1::Constraints* proto);
+
+// Tool `index` of a request (a pose's, a contact query's) into the core's Tool, checked by
+// ValidateTool against the mesh's rest bounding box [lower, upper]. INVALID_ARGUMENT naming
+// "tool <index>" for an unspecified shape, a missing centre (or a capsule's end), or what
+// ValidateTool refuses; `tool` is then unspecified.
+Status ToolFromProto(const v1::ToolState& state, int index, const Eigen::Vector3d& lower,
+                     const Eigen::Vector3d& upper, Tool* tool);
 
 // A StiffnessUpdate into the core's Stiffness for `model`. Zero fields of a joint material mean
 // the model's default profile. INVALID_ARGUMENT naming the problem for unknown joints, joints

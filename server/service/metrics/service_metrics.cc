@@ -20,7 +20,7 @@ constexpr std::array<const char*, ServiceMetrics::kNoticeKinds> kNoticeKindNames
 // The methods labelled by name; any other (health, reflection, unknown) is "other", so a client
 // cannot grow the number of series.
 constexpr std::array<const char*, ServiceMetrics::kMethods - 1> kMethodNames = {
-    "LoadMesh", "GetMeshInfo", "ListMeshes", "UnloadMesh", "Deform"};
+    "LoadMesh", "GetMeshInfo", "ListMeshes", "UnloadMesh", "Deform", "QueryContact"};
 constexpr std::string_view kServicePrefix = "/deform.v1.DeformService/";
 
 int MethodIndex(std::string_view method) {

@@ -57,7 +57,7 @@ class ServiceMetrics {
   static constexpr int kEncodings = 4;    // index 0 (unspecified) counts as float32
   static constexpr int kNoticeKinds = 5;  // index 0 (unspecified) is never written
   static constexpr int kStatusCodes = kCanonicalStatusCodes;  // grpc::StatusCode 0..16
-  static constexpr int kMethods = 6;  // five DeformService methods and "other"
+  static constexpr int kMethods = 7;  // six DeformService methods and "other"
 
   ServiceMetrics();
   ~ServiceMetrics();

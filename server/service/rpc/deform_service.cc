@@ -2,6 +2,7 @@
 
 #include <string_view>
 
+#include "service/contact/contact_query_reactor.h"
 #include "service/deform/deform_stream_reactor.h"
 #include "service/load/load_mesh_reactor.h"
 #include "service/rpc/unary_calls.h"
@@ -72,6 +73,19 @@ grpc::ServerBidiReactor<v1::DeformRequest, v1::DeformResponse>* DeformServiceImp
   return GrpcStreamAdapter<v1::DeformRequest, v1::DeformResponse>::Create(
       [&](DeformTransport* transport) {
         return NewDeformStream(context_, std::move(*caller), transport);
+      });
+}
+
+grpc::ServerBidiReactor<v1::QueryContactRequest, v1::QueryContactResponse>*
+DeformServiceImpl::QueryContact(grpc::CallbackServerContext* context) {
+  StatusOr<Identity> caller = AuthenticateCall(*context_, AuthorizationOf(context), "contact", "");
+  if (!caller.ok()) {
+    return new RejectedBidiCall<v1::QueryContactRequest, v1::QueryContactResponse>(
+        ToGrpcStatus(caller.status()));
+  }
+  return GrpcStreamAdapter<v1::QueryContactRequest, v1::QueryContactResponse>::Create(
+      [&](ContactQueryTransport* transport) {
+        return NewContactQueryStream(context_, std::move(*caller), transport);
       });
 }
 

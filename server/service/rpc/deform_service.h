@@ -1,6 +1,7 @@
 // The deform.v1.DeformService implementation: a thin layer that converts messages, looks things
 // up in the ServiceContext and maps statuses. Streaming RPCs get their own reactors
-// (load_mesh_reactor.h, deform_stream_reactor.h). Thread-safe; `context` must outlive it.
+// (load_mesh_reactor.h, deform_stream_reactor.h, contact_query_reactor.h). Thread-safe; `context`
+// must outlive it.
 //
 // Every call is authenticated first (context->auth(), from the "authorization" metadata): without a
 // valid token it ends with UNAUTHENTICATED before anything else is looked at. Then the caller's
@@ -29,6 +30,8 @@ class DeformServiceImpl final : public v1::DeformService::CallbackService {
                                        const v1::UnloadMeshRequest* request,
                                        v1::UnloadMeshResponse* response) override;
   grpc::ServerBidiReactor<v1::DeformRequest, v1::DeformResponse>* Deform(
+      grpc::CallbackServerContext* context) override;
+  grpc::ServerBidiReactor<v1::QueryContactRequest, v1::QueryContactResponse>* QueryContact(
       grpc::CallbackServerContext* context) override;
 
  private:

@@ -2,11 +2,16 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
+#include <utility>
 
+#include "core/io/mesh_io.h"
 #include "core/io/phantom.h"
+#include "tests/allocation_counter.h"
+#include "tests/shared_data.h"
 
 namespace deform {
 namespace {
@@ -65,6 +70,129 @@ TEST(TriangleBvh, DistanceToSurfaceMatchesBruteForceOnThePhantom) {
     EXPECT_TRUE(bvh.Contains(joint.rest_position)) << joint.name;
   }
   EXPECT_FALSE(bvh.Contains({20, 4, 0}));
+}
+
+// Brute force, independent of the tree's code: the closest point of triangle abc to p by
+// projection onto its plane when that falls inside, otherwise the nearest of its three edges.
+Eigen::Vector3d BruteClosestOnTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                                       const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  const Eigen::Vector3d n = (b - a).cross(c - a).normalized();
+  const Eigen::Vector3d projected = p - (p - a).dot(n) * n;
+  const auto inside_edge = [&](const Eigen::Vector3d& u, const Eigen::Vector3d& v) {
+    return (v - u).cross(projected - u).dot(n) >= 0;
+  };
+  if (inside_edge(a, b) && inside_edge(b, c) && inside_edge(c, a)) return projected;
+  Eigen::Vector3d best = a;
+  for (const auto& [u, v] : {std::pair{a, b}, std::pair{b, c}, std::pair{c, a}}) {
+    const double t = std::clamp((p - u).dot(v - u) / (v - u).squaredNorm(), 0.0, 1.0);
+    const Eigen::Vector3d on_edge = u + t * (v - u);
+    if ((on_edge - p).squaredNorm() < (best - p).squaredNorm()) best = on_edge;
+  }
+  return best;
+}
+
+double BruteDistance(const TriangleMesh& mesh, const Eigen::Vector3d& p) {
+  double best = std::numeric_limits<double>::infinity();
+  for (int f = 0; f < mesh.num_triangles(); ++f) {
+    const Eigen::Vector3d q = BruteClosestOnTriangle(p, mesh.vertices.row(mesh.triangles(f, 0)),
+                                                     mesh.vertices.row(mesh.triangles(f, 1)),
+                                                     mesh.vertices.row(mesh.triangles(f, 2)));
+    best = std::min(best, (q - p).norm());
+  }
+  return best;
+}
+
+// The segment's distance to the surface, to within its length / samples: the smallest brute
+// distance over points spaced along it.
+double SampledSegmentDistance(const TriangleMesh& mesh, const Eigen::Vector3d& from,
+                              const Eigen::Vector3d& to, int samples) {
+  double best = std::numeric_limits<double>::infinity();
+  for (int s = 0; s <= samples; ++s) {
+    best = std::min(best, BruteDistance(mesh, from + (to - from) * (double(s) / samples)));
+  }
+  return best;
+}
+
+// Random points and segments around the mesh's box: the tree's closest pair matches brute force
+// (a point exactly; a segment within the sampling's spacing, never above the sampled minimum).
+void ExpectClosestPairsMatchBruteForce(const TriangleBvh& bvh, const TriangleMesh& mesh,
+                                       int queries, unsigned seed) {
+  const Eigen::Vector3d lower = mesh.vertices.colwise().minCoeff().transpose();
+  const Eigen::Vector3d upper = mesh.vertices.colwise().maxCoeff().transpose();
+  const Eigen::Vector3d size = upper - lower;
+  std::mt19937 random(seed);
+  std::uniform_real_distribution<double> unit(-0.2, 1.2);
+  const auto random_point = [&] {
+    return Eigen::Vector3d(
+        lower + Eigen::Vector3d(unit(random), unit(random), unit(random)).cwiseProduct(size));
+  };
+  constexpr int kSamples = 64;
+  for (int q = 0; q < queries; ++q) {
+    const Eigen::Vector3d p = random_point();
+    const TriangleBvh::SegmentSurfacePoint at_point = bvh.ClosestPointToSegment(p, p);
+    EXPECT_NEAR(at_point.distance, BruteDistance(mesh, p), 1e-9 * size.norm()) << "query " << q;
+    EXPECT_NEAR((at_point.point - p).norm(), at_point.distance, 1e-9 * size.norm());
+    const Eigen::Vector3d end = p + 0.15 * (random_point() - p);
+    const TriangleBvh::SegmentSurfacePoint at_segment = bvh.ClosestPointToSegment(p, end);
+    const double sampled = SampledSegmentDistance(mesh, p, end, kSamples);
+    const double spacing = (end - p).norm() / kSamples;
+    EXPECT_LE(at_segment.distance, sampled + 1e-9 * size.norm()) << "query " << q;
+    EXPECT_GE(at_segment.distance, sampled - spacing - 1e-9 * size.norm()) << "query " << q;
+    EXPECT_NEAR((at_segment.point - at_segment.segment).norm(), at_segment.distance,
+                1e-9 * size.norm());
+  }
+}
+
+TEST(TriangleBvh, ClosestPointToSegmentMatchesBruteForceOnAGeneratedMesh) {
+  const KneePhantom phantom = *MakeKneePhantom(1500);
+  const TriangleBvh bvh(phantom.mesh);
+  ExpectClosestPairsMatchBruteForce(bvh, phantom.mesh, 60, 7);
+}
+
+TEST(TriangleBvh, ClosestPointToSegmentMatchesBruteForceOnTheSharedLeg) {
+  DEFORM_REQUIRE_SHARED_FILE(path, "leg/leg_1633.obj");
+  const TriangleMesh leg = *ReadMeshFile(path);
+  const TriangleBvh bvh(leg);
+  ExpectClosestPairsMatchBruteForce(bvh, leg, 60, 11);
+}
+
+TEST(TriangleBvh, ASegmentThroughTheSurfaceIsAtDistanceZero) {
+  const TriangleBvh bvh(Octahedron());
+  const TriangleBvh::SegmentSurfacePoint crossing =
+      bvh.ClosestPointToSegment({0.1, 0.1, 0.1}, {2, 0.2, 0.3});
+  EXPECT_NEAR(crossing.distance, 0, 1e-12);
+  EXPECT_NEAR(crossing.point.lpNorm<1>(), 1, 1e-9);  // on the octahedron |x|+|y|+|z| = 1
+}
+
+TEST(TriangleBvh, RefitMatchesATreeBuiltOnTheMovedVerticesWithoutAllocating) {
+  DEFORM_REQUIRE_SHARED_FILE(path, "leg/leg_1633.obj");
+  const TriangleMesh leg = *ReadMeshFile(path);
+  // A twist about the long axis growing along it, and a stretch: every box moves.
+  TriangleMesh moved = leg;
+  const Eigen::Vector3d lower = leg.vertices.colwise().minCoeff().transpose();
+  const Eigen::Vector3d upper = leg.vertices.colwise().maxCoeff().transpose();
+  int axis = 0;
+  (upper - lower).maxCoeff(&axis);
+  const int u = (axis + 1) % 3, w = (axis + 2) % 3;
+  for (int v = 0; v < leg.num_vertices(); ++v) {
+    const double along = (leg.vertices(v, axis) - lower[axis]) / (upper[axis] - lower[axis]);
+    const double angle = 0.8 * along;
+    const double x = leg.vertices(v, u), y = leg.vertices(v, w);
+    moved.vertices(v, u) = std::cos(angle) * x - std::sin(angle) * y;
+    moved.vertices(v, w) = std::sin(angle) * x + std::cos(angle) * y;
+    moved.vertices(v, axis) *= 1.3;
+  }
+  TriangleBvh refitted(leg);
+  const long before = test_support::AllocationCount();
+  refitted.Refit(moved.vertices.data());
+  const TriangleBvh::SegmentSurfacePoint probe =
+      refitted.ClosestPointToSegment(Eigen::Vector3d::Zero(), Eigen::Vector3d::Ones());
+  EXPECT_EQ(test_support::AllocationCount(), before);
+  EXPECT_GE(probe.triangle, 0);
+  const TriangleBvh built(moved);
+  EXPECT_TRUE(refitted.lower().isApprox(built.lower()));
+  EXPECT_TRUE(refitted.upper().isApprox(built.upper()));
+  ExpectClosestPairsMatchBruteForce(refitted, moved, 40, 13);
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include <thread>
 #include <vector>
 
+#include "service/context/latest_frames.h"
 #include "service/context/service_context.h"
 #include "tests/service/support/stream_recorder.h"
 #include "tests/service/support/test_server.h"
@@ -36,11 +37,13 @@ class StreamMemoryTest : public ::testing::Test {
     mesh_bytes_ = probe.server().context().admission().memory_bytes_used();
     auto entry = probe.server().context().registry().Find(id);
     ASSERT_TRUE(entry.ok());
-    // The solve's scratch, the constraints' and each frame's bone surface transforms.
+    // The solve's scratch, the constraints', each frame's bone surface transforms and the latest
+    // frame kept for contact queries (latest_frames.h).
     const SkinConstraints* constraints = (*entry)->constraints.constraints.get();
     ASSERT_NE(constraints, nullptr);
     scratch_bytes_ = (*entry)->model->ScratchBytes() + constraints->ScratchBytes() +
-                     3 * 48 * static_cast<std::size_t>(constraints->bones()->num_surfaces());
+                     3 * 48 * static_cast<std::size_t>(constraints->bones()->num_surfaces()) +
+                     service::LatestFrame::Bytes((*entry)->model->mesh().num_vertices());
     factorization_bytes_ = (*entry)->model->FactorizationBytes();
   }
 

@@ -88,8 +88,58 @@ class Constraints(_message.Message):
     keep_volume: bool
     def __init__(self, contacts: bool = ..., keep_volume: bool = ..., contact_margin: _Optional[float] = ...) -> None: ...
 
+class ContactQuery(_message.Message):
+    __slots__ = ["sequence", "tool"]
+    SEQUENCE_FIELD_NUMBER: _ClassVar[int]
+    TOOL_FIELD_NUMBER: _ClassVar[int]
+    sequence: int
+    tool: ToolState
+    def __init__(self, sequence: _Optional[int] = ..., tool: _Optional[_Union[ToolState, _Mapping]] = ...) -> None: ...
+
+class ContactQueryStart(_message.Message):
+    __slots__ = ["deform_stream_id", "mesh_id", "stiffness"]
+    DEFORM_STREAM_ID_FIELD_NUMBER: _ClassVar[int]
+    MESH_ID_FIELD_NUMBER: _ClassVar[int]
+    STIFFNESS_FIELD_NUMBER: _ClassVar[int]
+    deform_stream_id: int
+    mesh_id: str
+    stiffness: float
+    def __init__(self, mesh_id: _Optional[str] = ..., deform_stream_id: _Optional[int] = ..., stiffness: _Optional[float] = ...) -> None: ...
+
+class ContactQueryStarted(_message.Message):
+    __slots__ = ["bounding_box_diagonal", "stiffness"]
+    BOUNDING_BOX_DIAGONAL_FIELD_NUMBER: _ClassVar[int]
+    STIFFNESS_FIELD_NUMBER: _ClassVar[int]
+    bounding_box_diagonal: float
+    stiffness: float
+    def __init__(self, bounding_box_diagonal: _Optional[float] = ..., stiffness: _Optional[float] = ...) -> None: ...
+
+class ContactResult(_message.Message):
+    __slots__ = ["depth", "force", "frame_number", "frame_sequence", "material_weight", "normal", "point", "sequence", "signed_distance", "tool_point"]
+    DEPTH_FIELD_NUMBER: _ClassVar[int]
+    FORCE_FIELD_NUMBER: _ClassVar[int]
+    FRAME_NUMBER_FIELD_NUMBER: _ClassVar[int]
+    FRAME_SEQUENCE_FIELD_NUMBER: _ClassVar[int]
+    MATERIAL_WEIGHT_FIELD_NUMBER: _ClassVar[int]
+    NORMAL_FIELD_NUMBER: _ClassVar[int]
+    POINT_FIELD_NUMBER: _ClassVar[int]
+    SEQUENCE_FIELD_NUMBER: _ClassVar[int]
+    SIGNED_DISTANCE_FIELD_NUMBER: _ClassVar[int]
+    TOOL_POINT_FIELD_NUMBER: _ClassVar[int]
+    depth: float
+    force: Vector3
+    frame_number: int
+    frame_sequence: int
+    material_weight: float
+    normal: Vector3
+    point: Vector3
+    sequence: int
+    signed_distance: float
+    tool_point: Vector3
+    def __init__(self, sequence: _Optional[int] = ..., point: _Optional[_Union[Vector3, _Mapping]] = ..., normal: _Optional[_Union[Vector3, _Mapping]] = ..., depth: _Optional[float] = ..., force: _Optional[_Union[Vector3, _Mapping]] = ..., signed_distance: _Optional[float] = ..., material_weight: _Optional[float] = ..., frame_number: _Optional[int] = ..., frame_sequence: _Optional[int] = ..., tool_point: _Optional[_Union[Vector3, _Mapping]] = ...) -> None: ...
+
 class DeformFrame(_message.Message):
-    __slots__ = ["bone_transforms", "clamped_angles", "client_timestamp_ns", "constraints", "encoded", "mesh_unloaded", "positions", "sequence", "skipped_poses", "stiffness_version", "timings"]
+    __slots__ = ["bone_transforms", "clamped_angles", "client_timestamp_ns", "constraints", "encoded", "mesh_unloaded", "positions", "sequence", "skipped_poses", "stiffness_version", "stream_id", "timings"]
     BONE_TRANSFORMS_FIELD_NUMBER: _ClassVar[int]
     CLAMPED_ANGLES_FIELD_NUMBER: _ClassVar[int]
     CLIENT_TIMESTAMP_NS_FIELD_NUMBER: _ClassVar[int]
@@ -100,6 +150,7 @@ class DeformFrame(_message.Message):
     SEQUENCE_FIELD_NUMBER: _ClassVar[int]
     SKIPPED_POSES_FIELD_NUMBER: _ClassVar[int]
     STIFFNESS_VERSION_FIELD_NUMBER: _ClassVar[int]
+    STREAM_ID_FIELD_NUMBER: _ClassVar[int]
     TIMINGS_FIELD_NUMBER: _ClassVar[int]
     bone_transforms: bytes
     clamped_angles: int
@@ -111,8 +162,9 @@ class DeformFrame(_message.Message):
     sequence: int
     skipped_poses: int
     stiffness_version: int
+    stream_id: int
     timings: FrameTimings
-    def __init__(self, sequence: _Optional[int] = ..., client_timestamp_ns: _Optional[int] = ..., stiffness_version: _Optional[int] = ..., skipped_poses: _Optional[int] = ..., clamped_angles: _Optional[int] = ..., mesh_unloaded: bool = ..., timings: _Optional[_Union[FrameTimings, _Mapping]] = ..., positions: _Optional[bytes] = ..., encoded: _Optional[_Union[EncodedPositions, _Mapping]] = ..., bone_transforms: _Optional[bytes] = ..., constraints: _Optional[_Union[FrameConstraints, _Mapping]] = ...) -> None: ...
+    def __init__(self, sequence: _Optional[int] = ..., client_timestamp_ns: _Optional[int] = ..., stiffness_version: _Optional[int] = ..., skipped_poses: _Optional[int] = ..., clamped_angles: _Optional[int] = ..., mesh_unloaded: bool = ..., timings: _Optional[_Union[FrameTimings, _Mapping]] = ..., positions: _Optional[bytes] = ..., encoded: _Optional[_Union[EncodedPositions, _Mapping]] = ..., bone_transforms: _Optional[bytes] = ..., constraints: _Optional[_Union[FrameConstraints, _Mapping]] = ..., stream_id: _Optional[int] = ...) -> None: ...
 
 class DeformRequest(_message.Message):
     __slots__ = ["pose", "start", "stiffness"]
@@ -482,6 +534,22 @@ class Quaternion(_message.Message):
     y: float
     z: float
     def __init__(self, w: _Optional[float] = ..., x: _Optional[float] = ..., y: _Optional[float] = ..., z: _Optional[float] = ...) -> None: ...
+
+class QueryContactRequest(_message.Message):
+    __slots__ = ["query", "start"]
+    QUERY_FIELD_NUMBER: _ClassVar[int]
+    START_FIELD_NUMBER: _ClassVar[int]
+    query: ContactQuery
+    start: ContactQueryStart
+    def __init__(self, start: _Optional[_Union[ContactQueryStart, _Mapping]] = ..., query: _Optional[_Union[ContactQuery, _Mapping]] = ...) -> None: ...
+
+class QueryContactResponse(_message.Message):
+    __slots__ = ["result", "started"]
+    RESULT_FIELD_NUMBER: _ClassVar[int]
+    STARTED_FIELD_NUMBER: _ClassVar[int]
+    result: ContactResult
+    started: ContactQueryStarted
+    def __init__(self, started: _Optional[_Union[ContactQueryStarted, _Mapping]] = ..., result: _Optional[_Union[ContactResult, _Mapping]] = ...) -> None: ...
 
 class RegionWeight(_message.Message):
     __slots__ = ["joint", "weight"]

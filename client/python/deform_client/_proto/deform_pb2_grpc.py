@@ -39,6 +39,11 @@ class DeformServiceStub(object):
                 request_serializer=deform_dot_v1_dot_deform__pb2.DeformRequest.SerializeToString,
                 response_deserializer=deform_dot_v1_dot_deform__pb2.DeformResponse.FromString,
                 )
+        self.QueryContact = channel.stream_stream(
+                '/deform.v1.DeformService/QueryContact',
+                request_serializer=deform_dot_v1_dot_deform__pb2.QueryContactRequest.SerializeToString,
+                response_deserializer=deform_dot_v1_dot_deform__pb2.QueryContactResponse.FromString,
+                )
 
 
 class DeformServiceServicer(object):
@@ -93,6 +98,21 @@ class DeformServiceServicer(object):
         context.set_details('Method not implemented!')
         raise NotImplementedError('Method not implemented!')
 
+    def QueryContact(self, request_iterator, context):
+        """The contact of a tool against the skin, at haptic rate (docs/instruments.md), on a stream of
+        its own so that it never waits behind frames. The first request must be `start`: the mesh
+        and, optionally, an open Deform stream of the same tenant (DeformFrame.stream_id) whose
+        latest solved frame is the skin; otherwise the rest pose. The server answers `started`, then
+        one `result` per `query`, in order: it reads the next query only once the previous result is
+        written, so a stream holds at most one query. INVALID_ARGUMENT for a bad start or query
+        (naming it; the stream ends), NOT_FOUND for an unknown mesh or Deform stream (another
+        tenant's are unknown too), RESOURCE_EXHAUSTED beyond the tenant's stream limit (a query
+        stream counts as a stream) or its memory budget; UNAVAILABLE when the server shuts down.
+        """
+        context.set_code(grpc.StatusCode.UNIMPLEMENTED)
+        context.set_details('Method not implemented!')
+        raise NotImplementedError('Method not implemented!')
+
 
 def add_DeformServiceServicer_to_server(servicer, server):
     rpc_method_handlers = {
@@ -120,6 +140,11 @@ def add_DeformServiceServicer_to_server(servicer, server):
                     servicer.Deform,
                     request_deserializer=deform_dot_v1_dot_deform__pb2.DeformRequest.FromString,
                     response_serializer=deform_dot_v1_dot_deform__pb2.DeformResponse.SerializeToString,
+            ),
+            'QueryContact': grpc.stream_stream_rpc_method_handler(
+                    servicer.QueryContact,
+                    request_deserializer=deform_dot_v1_dot_deform__pb2.QueryContactRequest.FromString,
+                    response_serializer=deform_dot_v1_dot_deform__pb2.QueryContactResponse.SerializeToString,
             ),
     }
     generic_handler = grpc.method_handlers_generic_handler(
@@ -213,5 +238,22 @@ class DeformService(object):
         return grpc.experimental.stream_stream(request_iterator, target, '/deform.v1.DeformService/Deform',
             deform_dot_v1_dot_deform__pb2.DeformRequest.SerializeToString,
             deform_dot_v1_dot_deform__pb2.DeformResponse.FromString,
+            options, channel_credentials,
+            insecure, call_credentials, compression, wait_for_ready, timeout, metadata)
+
+    @staticmethod
+    def QueryContact(request_iterator,
+            target,
+            options=(),
+            channel_credentials=None,
+            call_credentials=None,
+            insecure=False,
+            compression=None,
+            wait_for_ready=None,
+            timeout=None,
+            metadata=None):
+        return grpc.experimental.stream_stream(request_iterator, target, '/deform.v1.DeformService/QueryContact',
+            deform_dot_v1_dot_deform__pb2.QueryContactRequest.SerializeToString,
+            deform_dot_v1_dot_deform__pb2.QueryContactResponse.FromString,
             options, channel_credentials,
             insecure, call_credentials, compression, wait_for_ready, timeout, metadata)
