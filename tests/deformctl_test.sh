@@ -154,5 +154,22 @@ run "five --tool are refused" 1 "" --tool sphere:0,6,3,0.1 --tool sphere:0,6,3,0
   --tool sphere:0,6,3,0.1 --tool sphere:0,6,3,0.1 --tool sphere:0,6,3,0.1
 run "--tool with --method lbs is refused" 1 "" --method lbs --tool sphere:0,6,0.86,0.3
 
+# A glTF rig's own animation (the animated chain of the glTF fuzz corpus: its knee turns 90
+# degrees over 1 s): the rest at t = 0, bent by t = 1 (LBS loses a quarter of the volume), the
+# JSON naming the animation and the time; unknown animations and non-glTF meshes are refused.
+ANIMATED="$(dirname "$0")/fuzz/corpus/gltf_fuzz/animated_chain.glb"
+run "--animation at its start is the rest pose" 0 \
+  "d['animation'] == 'bend' and d['time'] == 0 and abs(d['volume_change']) < 1e-9" \
+  --mesh "$ANIMATED" --animation bend --time 0 --method lbs
+run "--animation by index at its end bends the knee" 0 \
+  "d['animation'] == '0' and abs(d['volume_change'] + 0.25) < 1e-3" \
+  --mesh "$ANIMATED" --animation 0 --time 1 --method lbs
+run "--animation after its end clamps to the last key" 0 "abs(d['volume_change'] + 0.25) < 1e-3" \
+  --mesh "$ANIMATED" --animation bend --time 5 --method lbs
+run "--animation that the file does not have is refused" 1 "" \
+  --mesh "$ANIMATED" --animation run --time 0
+grep -q "no animation 'run'" "$WORK/err" || { echo "FAIL: the refusal does not name it" >&2; failed=1; }
+run "--animation on the phantom is refused" 1 "" --animation bend --time 0
+
 [ "$failed" -eq 0 ] || exit 1
 echo "PASS: deformctl deform's flags"

@@ -117,6 +117,7 @@ std::string ReportText(const RunHeader& header, const std::vector<FrameRecord>& 
          "; reference: the same DeformationModel::Build on the same inputs and options, built "
          "locally in " +
          Format("%.0f", header.local_build_ms) + " ms (so the same binding and weights)\n";
+  if (!header.animation.empty()) out += "glTF animation " + header.animation + "\n";
   out += "LBS: linear blend skinning of the same pose with the model's weights\n\n";
   char line[256];
   std::snprintf(line, sizeof(line), "%6s %6s %10s %10s %10s %10s %12s %10s\n", "frame", "line",
@@ -176,6 +177,7 @@ nlohmann::ordered_json ReportJson(const RunHeader& header, const std::vector<Fra
   out["solved_vertices"] = header.solved_vertices;
   out["rigid_vertices"] = header.rigid_vertices;
   out["local_build_ms"] = header.local_build_ms;
+  if (!header.animation.empty()) out["animation"] = header.animation;
   out["frames"] = frames.size();
 
   nlohmann::ordered_json per_frame;
@@ -187,6 +189,11 @@ nlohmann::ordered_json ReportJson(const RunHeader& header, const std::vector<Fra
   }
   per_frame["frame"] = index;
   per_frame["line"] = line;
+  if (!header.animation.empty()) {
+    std::vector<double> time;
+    for (const FrameRecord& r : frames) time.push_back(r.time_s);
+    per_frame["time_s"] = time;
+  }
   for (const Metric& metric : Metrics()) per_frame[metric.key] = Column(frames, metric);
   per_frame["clamped_angles"] = clamped;
   out["per_frame"] = per_frame;

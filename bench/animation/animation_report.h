@@ -13,8 +13,9 @@
 namespace deform::animation {
 
 struct FrameRecord {
-  int frame = 0;  // 0-based index in the animation
-  int line = 0;   // its line in the animation file
+  int frame = 0;      // 0-based index in the animation
+  int line = 0;       // its line in the animation file (0 for a glTF animation)
+  double time_s = 0;  // its time in a glTF animation
   FrameMeasures measures;
   double round_trip_ms = 0;
   double server_solve_ms = 0;  // the frame's timings.rhs_ms + solve_ms
@@ -30,6 +31,7 @@ struct RunHeader {
   int solved_vertices = 0;     // vertices of the solved mesh (after glTF welding)
   int rigid_vertices = 0;      // vertices in a rigid zone (the rigid-zone error's domain)
   double local_build_ms = 0;   // building the local reference model
+  std::string animation;       // the glTF animation played (empty for an animation file)
 };
 
 // Index of the worst element: the largest |value| (volume change), or the smallest / largest value.

@@ -2,20 +2,8 @@
 // pose (deform.v1.PoseUpdate: one local rotation per joint plus the root transform; the meaning is
 // written at PoseUpdate in proto/deform/v1/deform.proto).
 //
-// Bone k's transform B_k maps its rest position to its posed position (rotation, then
-// translation), in the mesh's own frame. The conversion: the root transform is B of the root bone
-// (its head joint's rotation then stays identity; a skeleton with several root bones gets the rigid
-// fit that carries every root head o_k to B_k(o_k)); every joint j that heads a bone k gets
-// R_j = R_parent(k)^T R_k (R_root^T R_k for a root bone). Exact when the transforms are a pose of
-// this skeleton: bones that start at one joint turn together, and each bone's head stays on its
-// parent's tail (a root bone's on the root's image). The result reports how far the input is from
-// that (not an error: an engine's rounding or scale makes it non-zero).
-//
-// Root motion: when a root bone's transform is the identity (a static top joint) but its first
-// child bone's own transform moves that child's head (a common export: the top skin joint static
-// and weightless, the hip carrying the translation), the root bone takes that child's transform
-// first, so the root transform is the hip's and every bone below is exact; only the root bone
-// itself then moves with the hip (exact for linear blend skinning when it carries no weight).
+// The rule itself (bone transforms -> local rotations and root, root motion, the reported
+// disagreement) is core/geometry/bone_transform_pose.h; this is its API form.
 #pragma once
 
 #include <array>

@@ -33,9 +33,11 @@
 #include "core/constraints/tools.h"
 #include "core/eval/method_comparison.h"
 #include "core/io/bone_surface_io.h"
+#include "core/io/gltf_animation.h"
 #include "core/io/mesh_io.h"
 #include "core/io/model_input.h"
 #include "core/io/phantom.h"
+#include "core/io/rig_import.h"
 #include "core/io/skeleton_io.h"
 
 namespace {
@@ -49,6 +51,8 @@ struct DeformArgs {
   std::string weights_path;
   int phantom_vertices = deform::kDefaultPhantomVertices;
   std::string pose = "rest";
+  std::string animation;  // a glTF animation's name or index: the pose at `time` of it
+  double time = 0;
   std::string method = "paper";
   std::string out_path;
   int repeat = 1;
@@ -166,7 +170,12 @@ nlohmann::ordered_json DeformReport(const DeformArgs& args, const deform::ModelI
   out["mesh"] = input.description;
   out["input_warnings"] = input.warnings;
   out["method"] = deform::MethodName(method);
-  out["pose"] = args.pose;
+  if (args.animation.empty()) {
+    out["pose"] = args.pose;
+  } else {
+    out["animation"] = args.animation;
+    out["time"] = args.time;
+  }
   out["vertices"] = input.mesh.num_vertices();
   out["triangles"] = input.mesh.num_triangles();
   out["joint_nodes"] = run.joint_nodes;
@@ -266,11 +275,26 @@ int RunDeform(DeformArgs args) {
   auto input = deform::LoadModelInput(args.mesh_path, args.skeleton_path, args.weights_path,
                                       args.phantom_vertices);
   if (!input.ok()) return Fail(input.status());
-  auto terms = deform::ParsePoseSpec(args.pose, input->skeleton);
-  if (!terms.ok()) return Fail(terms.status());
   deform::Pose pose;
-  auto clamped = deform::PoseFromTerms(input->skeleton, *terms, &pose);
-  if (!clamped.ok()) return Fail(clamped.status());
+  StatusOr<int> clamped = 0;
+  if (args.animation.empty()) {
+    auto terms = deform::ParsePoseSpec(args.pose, input->skeleton);
+    if (!terms.ok()) return Fail(terms.status());
+    clamped = deform::PoseFromTerms(input->skeleton, *terms, &pose);
+    if (!clamped.ok()) return Fail(clamped.status());
+  } else {
+    // The glTF rig's own animation at that time (core/io/gltf_animation.h).
+    if (!deform::IsGltfPath(args.mesh_path)) {
+      return Fail(Status::InvalidArgument("--animation needs a glTF rig: --mesh RIG.glb"));
+    }
+    auto animations = deform::ReadGltfAnimationsFile(args.mesh_path, input->skeleton);
+    if (!animations.ok()) return Fail(animations.status());
+    auto index = deform::FindAnimation(*animations, args.animation);
+    if (!index.ok()) return Fail(index.status().WithContext(args.mesh_path));
+    auto sampled = deform::SamplePose(*animations, *index, args.time);
+    if (!sampled.ok()) return Fail(sampled.status());
+    pose = sampled->pose;
+  }
   auto surfaces = BoneSurfacesFrom(args, *input);
   if (!surfaces.ok()) return Fail(surfaces.status());
   args.bone_surface_count = static_cast<int>(surfaces->size());
@@ -391,8 +415,18 @@ CLI::App* AddDeformCommand(CLI::App* app, DeformArgs* args) {
                       "baselines (lbs, dqs) use them too");
   AddWithDefault(command, "--phantom-vertices", &args->phantom_vertices,
                  "Resolution of the phantom");
-  AddWithDefault(command, "--pose", &args->pose,
-                 "JOINT:AXIS:DEGREES[,...], e.g. knee:flexion:90 or 1:x:90");
+  CLI::Option* pose = AddWithDefault(command, "--pose", &args->pose,
+                                     "JOINT:AXIS:DEGREES[,...], e.g. knee:flexion:90 or 1:x:90");
+  CLI::Option* animation =
+      command
+          ->add_option("--animation", args->animation,
+                       "Pose a glTF rig (--mesh RIG.glb) as its own animation NAME (or index from "
+                       "0) poses it at --time")
+          ->excludes(pose);
+  command->add_option("--time", args->time, "Seconds into --animation (clamped to its keys)")
+      ->capture_default_str()
+      ->check(CLI::Range(-1e9, 1e9))
+      ->needs(animation);
   AddWithDefault(command, "--method", &args->method,
                  "paper | paper-linear (linear rotation blend, no per-frame solve) | laplacian | "
                  "lbs | dqs | cor (optimized centres of rotation) | ddm (direct delta mush)");

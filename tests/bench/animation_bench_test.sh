@@ -7,6 +7,9 @@
 #   gltf       the same through a skinned glTF rig split at seams (WRITER, the 4th argument,
 #              writes it): frames come in the file's vertex order, more vertices than the solve's;
 #              the same checks, and that the frames were mapped (frame vertices > solved).
+#   gltf_animation  the glTF rig's own animation (--animation, ANIMATED the 4th argument: a chain
+#              with a STEP, a LINEAR and a CUBICSPLINE channel): 5 frames at 4 fps, each with its
+#              time, the JSON naming the animation; an unknown animation is exit code 2.
 #   malformed  an animation with a malformed line, and one with an unknown joint: exit code 2 and
 #              a stderr line naming the line number (checked before any server is contacted).
 set -euo pipefail
@@ -36,6 +39,27 @@ if [ "$MODE" = malformed ]; then
   expect_usage_error "$WORK/bad_root.txt" 2
   printf 'knee:flexion:10\nknee:flexion:20\nelbow:x:30\n' >"$WORK/unknown_joint.txt"
   expect_usage_error "$WORK/unknown_joint.txt" 3
+  echo "PASS"
+  exit 0
+fi
+
+if [ "$MODE" = gltf_animation ]; then
+  deformd_start "$WORK/deformd.log" "$DEFORMD" --listen 127.0.0.1:0 --log-level info ||
+    fail "deformd did not start: $(cat "$WORK/deformd.log")"
+  "$BENCH" --target "$DEFORMD_ADDRESS" --mesh "$WRITER" --animation bend --fps 4 --json \
+    >"$WORK/report.json" || fail "the animation did not play"
+  python3 - "$WORK/report.json" <<'PY'
+import json, sys
+report = json.load(open(sys.argv[1]))
+assert report["frames"] == 5, report["frames"]
+assert report["animation"].startswith("bend (index 0"), report["animation"]
+assert report["per_frame"]["time_s"] == [0, 0.25, 0.5, 0.75, 1.0], report["per_frame"]["time_s"]
+assert abs(report["per_frame"]["lbs_volume_change"][4]) > 1e-2, report["per_frame"]
+PY
+  code=0
+  "$BENCH" --target "$DEFORMD_ADDRESS" --mesh "$WRITER" --animation run 2>"$WORK/err.txt" || code=$?
+  [ "$code" -eq 2 ] || fail "exit code $code for an unknown animation, expected 2"
+  grep -q "no animation 'run'" "$WORK/err.txt" || fail "stderr does not name the animation"
   echo "PASS"
   exit 0
 fi

@@ -119,12 +119,7 @@ TEST(PoseFromBoneTransforms, ReportsTransformsThatAreNoPoseOfTheSkeleton) {
   EXPECT_NE(error.find("bone transforms"), std::string::npos) << error;
 }
 
-Eigen::Matrix4d NodeMatrix(const Eigen::Vector3d& translation, const Eigen::Quaterniond& rotation) {
-  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
-  m.block<3, 3>(0, 0) = rotation.toRotationMatrix();
-  m.block<3, 1>(0, 3) = translation;
-  return m;
-}
+using gltf_test::NodeMatrix;
 
 TEST(PoseFromBoneTransforms, TakesRootMotionFromTheHipUnderAStaticWeightlessTopJoint) {
   // glTF nodes root -> hip -> knee -> ankle, one unit apart along +Y; the tube (moved up one unit)
@@ -168,19 +163,7 @@ TEST(PoseFromBoneTransforms, TakesRootMotionFromTheHipUnderAStaticWeightlessTopJ
     joint_matrix[j] = posed_world[j] * rest_world[j].inverse();
   }
   const int n = data.vertex_count();
-  Positions reference(n, 3);
-  for (int v = 0; v < n; ++v) {
-    const Eigen::Vector4d p(data.positions[3 * v], data.positions[3 * v + 1],
-                            data.positions[3 * v + 2], 1);
-    Eigen::Vector4d sum = Eigen::Vector4d::Zero();
-    double total = 0;
-    for (int k = 0; k < 4; ++k) {
-      const double w = data.weights[4 * v + k];
-      sum += w * (joint_matrix[data.joints[4 * v + k]] * p);
-      total += w;
-    }
-    reference.row(v) = (sum / total).head<3>().transpose();
-  }
+  const Positions reference = gltf_test::SkinAsGltf(data, joint_matrix);
 
   // Bone transforms as an engine holds them: each bone's head joint's joint matrix.
   std::vector<client::BoneTransform> given;

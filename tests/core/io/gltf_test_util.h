@@ -6,10 +6,14 @@
 //   GltfBuilder:   a glTF document assembled from raw accessors: every accessor gets its own
 //                  bufferView in one buffer; ToGltf() embeds it as a data URI (the io layer's
 //                  Base64Encode, which base64_test.cc checks on its own), ToGlb() as the BIN chunk.
+//   SkinAsGltf:    a primitive skinned as glTF skins it (joint matrices, weights), written here
+//                  as the reference a pose's linear blend skinning is checked against.
 #pragma once
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -211,6 +215,36 @@ inline GltfBuilder ChainRig(const std::vector<Eigen::Vector3d>& positions,
   builder.AddNode({{"name", "mesh"}, {"mesh", 0}, {"skin", 0}});
   builder.doc()["scenes"] = {{{"nodes", {0, positions.size()}}}};
   return builder;
+}
+
+// The local matrix of a node with `translation` and `rotation` (glTF's T * R).
+inline Eigen::Matrix4d NodeMatrix(const Eigen::Vector3d& translation,
+                                  const Eigen::Quaterniond& rotation) {
+  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+  m.block<3, 3>(0, 0) = rotation.toRotationMatrix();
+  m.block<3, 1>(0, 3) = translation;
+  return m;
+}
+
+// `data`'s vertices skinned as glTF does: sum over influences of weight * joint matrix * position
+// (weights renormalized), `joint_matrix` indexed by the skin's joint.
+inline Positions SkinAsGltf(const PrimitiveData& data,
+                            const std::vector<Eigen::Matrix4d>& joint_matrix) {
+  const int n = data.vertex_count();
+  Positions skinned(n, 3);
+  for (int v = 0; v < n; ++v) {
+    const Eigen::Vector4d p(data.positions[3 * v], data.positions[3 * v + 1],
+                            data.positions[3 * v + 2], 1);
+    Eigen::Vector4d sum = Eigen::Vector4d::Zero();
+    double total = 0;
+    for (int k = 0; k < 4; ++k) {
+      const double w = data.weights[4 * v + k];
+      sum += w * (joint_matrix[data.joints[4 * v + k]] * p);
+      total += w;
+    }
+    skinned.row(v) = (sum / total).head<3>().transpose();
+  }
+  return skinned;
 }
 
 }  // namespace deform::gltf_test
