@@ -278,6 +278,34 @@ public static class Deform {
   [DllImport(Library)]
   public static extern Status deform_stream_frame_tools(IntPtr stream, out FrameTools tools);
 
+  // The server's id of this stream, for deform_contact_open; NoData before its first frame.
+  [DllImport(Library)] public static extern Status deform_stream_id(IntPtr stream, out ulong id);
+
+  // A QueryContact stream: a tool's contact with the skin, one blocking round trip a query.
+  [DllImport(Library)]
+  public static extern Status deform_contact_open(IntPtr client, string meshId,
+                                                  ulong deformStreamId, double stiffness,
+                                                  out IntPtr contact);
+  [StructLayout(LayoutKind.Sequential)]
+  public struct ContactResult {
+    public ulong sequence;
+    [MarshalAs(UnmanagedType.ByValArray, SizeConst = 3)] public double[] point;
+    [MarshalAs(UnmanagedType.ByValArray, SizeConst = 3)] public double[] normal;
+    public double depth;
+    [MarshalAs(UnmanagedType.ByValArray, SizeConst = 3)] public double[] force;
+    public double signedDistance;
+    public double materialWeight;
+    public ulong frameNumber;
+    public ulong frameSequence;
+  }
+  [DllImport(Library)]
+  public static extern Status deform_contact_query(IntPtr contact, ref Tool tool,
+                                                   out ContactResult result);
+  [DllImport(Library)]
+  public static extern Status deform_contact_diagonal(IntPtr contact, out double diagonal);
+  // Ends the query stream, returns its final status and frees the handle.
+  [DllImport(Library)] public static extern Status deform_contact_close(IntPtr contact);
+
   public enum NoticeKind {
     PoseRejected = 1,
     StiffnessRejected = 2,

@@ -78,6 +78,7 @@ static class DeformBindingTest {
       {"deform_frame_info", typeof(Deform.FrameInfo)},
       {"deform_frame_constraints", typeof(Deform.FrameConstraints)},
       {"deform_frame_tools", typeof(Deform.FrameTools)},
+      {"deform_contact_result", typeof(Deform.ContactResult)},
       {"deform_notice_info", typeof(Deform.NoticeInfo)},
     };
     int fields = 0;
@@ -269,6 +270,25 @@ static class DeformBindingTest {
     Check(tools.penetratingBefore > 0 && tools.contacts > 0 && tools.penetratingAfter == 0 &&
               tools.unresolved == 0,
           "the tool's report: skin it entered, moved out");
+    // A larger sphere at the same centre through a contact query against this stream's latest
+    // frame (the dented one: the skin sits on the first sphere, inside the larger).
+    ulong streamId;
+    Ok(Deform.deform_stream_id(stream, out streamId), "deform_stream_id");
+    IntPtr contact;
+    Ok(Deform.deform_contact_open(client, meshId, streamId, 0, out contact),
+       "deform_contact_open");
+    double diagonal;
+    Ok(Deform.deform_contact_diagonal(contact, out diagonal), "deform_contact_diagonal");
+    Deform.Tool larger = sphere[0];
+    larger.radius = 0.5;
+    Deform.ContactResult result;
+    Ok(Deform.deform_contact_query(contact, ref larger, out result), "deform_contact_query");
+    Check(diagonal > 0 && result.sequence == 1 && result.frameNumber > 0 && result.depth > 0 &&
+              result.force.Length == 3 &&
+              result.force[0] * result.normal[0] + result.force[1] * result.normal[1] +
+                      result.force[2] * result.normal[2] > 0,
+          "the contact query: the pressed sphere is in the skin, pushed out along the normal");
+    Ok(Deform.deform_contact_close(contact), "deform_contact_close");
     var bones = new float[12 * (surfaces + 1)];
     Deform.FrameConstraints constraints;
     Ok(Deform.deform_stream_frame_bones(stream, bones, Size(bones.Length), out constraints),

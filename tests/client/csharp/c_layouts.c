@@ -100,6 +100,16 @@ int main(void) {
   FIELD(deform_frame_tools, 2, max_depth_after);
   FIELD(deform_frame_tools, 3, contacts);
   FIELD(deform_frame_tools, 4, unresolved);
+  /* deform_contact_result */
+  FIELD(deform_contact_result, 0, sequence);
+  FIELD(deform_contact_result, 1, point);
+  FIELD(deform_contact_result, 2, normal);
+  FIELD(deform_contact_result, 3, depth);
+  FIELD(deform_contact_result, 4, force);
+  FIELD(deform_contact_result, 5, signed_distance);
+  FIELD(deform_contact_result, 6, material_weight);
+  FIELD(deform_contact_result, 7, frame_number);
+  FIELD(deform_contact_result, 8, frame_sequence);
   /* deform_notice_info */
   FIELD(deform_notice_info, 0, kind);
   FIELD(deform_notice_info, 1, sequence);
