@@ -11,8 +11,8 @@
 #               benchmarks' ctest tests (bench/animation) are not built here (Release suite only).
 #               A skipped test fails the suite as in the Release run (scripts/run-ctest.sh).
 #               Leaks: scripts/sanitizers/lsan.supp lists OpenMesh's one-time registry only.
-#   TSan:       build-tsan ($DEFORM_TSAN_BUILD_DIR), the service's test programs (TSAN_PROGRAMS), run on
-#               the suites in
+#   TSan:       build-tsan ($DEFORM_TSAN_BUILD_DIR), deform_service_concurrency_tests (the files of
+#               the suites below only, so that TSan compiles no other test), run on the suites in
 #               TSAN_SUITES: the frame slots, outbox, pending pose, write pump, self-owning handler,
 #               stiffness switch, worker pool and its parallel runner, registry, token table and the allocation-free
 #               frame paths, where threads meet through our mutexes, condition variables and
@@ -39,9 +39,8 @@ only="${1:-all}"  # all, asan or tsan
 TSAN_SUITES=(AnnotatedMutexTest DeformOutboxTest FrameSlotsTest FrameSolverTest PendingPoseSlotTest
   PoseInputTest SelfOwningHandlerTest StiffnessSwitchTest StreamWritePumpTest WorkerPoolTest
   MeshRegistryTest StatusMappingTest TokenTableTest WorkerPoolParallelRunnerTest)
-# The test programs (one per service layer, tests/service/<layer>) that hold those suites.
-TSAN_PROGRAMS=(deform_service_base_tests deform_service_workers_tests deform_service_registry_tests
-  deform_service_transport_tests deform_service_deform_tests deform_service_access_tests)
+# The one program (tests/CMakeLists.txt, built in this build only) that holds those suites' files.
+TSAN_PROGRAMS=(deform_service_concurrency_tests)
 
 scripts/install-deps.sh scripts/packages/build.txt scripts/packages/checks.txt
 launcher=()
