@@ -261,6 +261,10 @@ int main(int argc, char** argv) {
   app.add_option("--tls-client-ca", args.server.security.client_ca_file,
                  "PEM CA of client certificates: mutual TLS, clients without one are refused")
       ->envname("DEFORMD_TLS_CLIENT_CA");
+  app.add_flag("--tls-allow-expired", args.server.security.allow_expired_certificate,
+               "Serve a certificate that has expired or is not yet valid instead of refusing "
+               "to start")
+      ->envname("DEFORMD_TLS_ALLOW_EXPIRED");
   app.add_flag("--plaintext", args.server.security.allow_plaintext,
                "Without a certificate, serve plaintext on a non-loopback address too")
       ->envname("DEFORMD_PLAINTEXT");

@@ -47,6 +47,9 @@ struct TransportSecurity {
   std::string client_ca_file;
   // Without a certificate, serve plaintext on a non-loopback address too. Default: false.
   bool allow_plaintext = false;
+  // Serve a certificate outside its validity (expired, or not yet valid) instead of refusing to
+  // start. Default: false.
+  bool allow_expired_certificate = false;
 };
 
 // How the server treats connections (gRPC channel arguments; deformd's flags set them).

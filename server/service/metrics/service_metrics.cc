@@ -169,6 +169,17 @@ void ServiceMetrics::RefactorizationFinished(double seconds) {
   refactorization_seconds_->Observe(seconds);
 }
 
+void ServiceMetrics::SetCertificateExpiry(std::int64_t not_after_unix_seconds) {
+  if (certificate_expiry_ == nullptr) {
+    certificate_expiry_ = &prometheus::BuildGauge()
+                               .Name("deformd_tls_certificate_expiry_seconds")
+                               .Help("The served TLS certificate's end of validity, Unix seconds")
+                               .Register(*registry_)
+                               .Add({});
+  }
+  certificate_expiry_->Set(static_cast<double>(not_after_unix_seconds));
+}
+
 void ServiceMetrics::SetGauges(const Gauges& gauges) {
   streams_open_->Set(gauges.streams_open);
   meshes_loaded_->Set(gauges.meshes_loaded);

@@ -24,6 +24,9 @@
 //    deformd_notice_backlog_bytes.
 //  - deformd_build_info{version,commit}: always 1; the build's version and commit as labels
 //    (core/base/build_info.h), as --version prints them.
+//  - deformd_tls_certificate_expiry_seconds: the served certificate's end of validity, Unix
+//    seconds (as the blackbox exporter's probe_ssl_earliest_cert_expiry; alert on it minus
+//    time()); absent without TLS (SetCertificateExpiry).
 //
 // A client's errors as deform-loadtest counts them are the Deform RPCs that ended with a code
 // other than OK plus the notices pose_rejected and stiffness_rejected.
@@ -91,6 +94,8 @@ class ServiceMetrics {
     std::int64_t notice_backlog_bytes = 0;
   };
   void SetGauges(const Gauges& gauges);
+  // The served TLS certificate's end of validity (Unix seconds); called once, when TLS starts.
+  void SetCertificateExpiry(std::int64_t not_after_unix_seconds);
 
   // Everything in Prometheus' text exposition format (version 0.0.4).
   std::string Serialize() const;
@@ -116,6 +121,7 @@ class ServiceMetrics {
   prometheus::Gauge* memory_streams_ = nullptr;
   prometheus::Gauge* memory_budget_ = nullptr;
   prometheus::Gauge* notice_backlog_ = nullptr;
+  prometheus::Gauge* certificate_expiry_ = nullptr;  // added by SetCertificateExpiry
 };
 
 }  // namespace deform::service

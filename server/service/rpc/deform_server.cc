@@ -6,6 +6,7 @@
 #include <spdlog/spdlog.h>
 
 #include <cstdlib>
+#include <ctime>
 #include <vector>
 
 #include "health.pb.h"
@@ -19,6 +20,7 @@
 #include "service/rpc/deform_service.h"
 #include "service/rpc/metrics_endpoint.h"
 #include "service/transport/loopback_port_guard.h"
+#include "service/transport/server_certificate.h"
 #include "service/transport/transport_security.h"
 
 namespace deform::service {
@@ -96,9 +98,11 @@ Status DeformServer::Start() {
   (void)grpc::health::v1::HealthCheckRequest::descriptor();
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();
   std::string transport;
+  ServerCertificate certificate;
   DEFORM_ASSIGN_OR_RETURN(
       std::shared_ptr<grpc::ServerCredentials> credentials,
-      MakeServerCredentials(impl_->options.security, impl_->options.listen_address, &transport));
+      MakeServerCredentials(impl_->options.security, impl_->options.listen_address, &transport,
+                            &certificate));
   // A fixed port: the other loopback family's address first (loopback_port_guard.h).
   const std::string& address = impl_->options.listen_address;
   const std::size_t colon = address.rfind(':');
@@ -150,6 +154,16 @@ Status DeformServer::Start() {
   }
   spdlog::info("listening on {} ({}) with {} workers", listening_address(), transport,
                impl_->context.pool().size());
+  if (!impl_->options.security.cert_file.empty()) {
+    const std::string& path = impl_->options.security.cert_file;
+    impl_->context.metrics().SetCertificateExpiry(certificate.not_after);
+    spdlog::info("TLS certificate '{}' valid until {}", EscapeForLog(path),
+                 FormatUtc(certificate.not_after));
+    for (const std::string& warning : CertificateWarnings(
+             certificate, impl_->options.listen_address, std::time(nullptr), path)) {
+      spdlog::warn("{}", EscapeControlBytes(warning));
+    }
+  }
   if (!impl_->context.auth().uses_tokens()) {
     spdlog::warn(
         "no token file: every caller is the single implicit tenant '{}' and sees every "

@@ -2,8 +2,11 @@
 
 #include <grpcpp/security/server_credentials.h>
 
+#include <ctime>
 #include <fstream>
 #include <sstream>
+
+#include "service/transport/server_certificate.h"
 
 namespace deform::service {
 namespace {
@@ -32,8 +35,8 @@ bool IsLoopbackAddress(const std::string& listen_address) {
 }
 
 StatusOr<std::shared_ptr<grpc::ServerCredentials>> MakeServerCredentials(
-    const TransportSecurity& security, const std::string& listen_address,
-    std::string* description) {
+    const TransportSecurity& security, const std::string& listen_address, std::string* description,
+    ServerCertificate* served_certificate) {
   if (security.cert_file.empty() != security.key_file.empty()) {
     return Status::FailedPrecondition(
         "a TLS certificate needs its key and a key its certificate (--tls-cert and --tls-key)");
@@ -55,6 +58,12 @@ StatusOr<std::shared_ptr<grpc::ServerCredentials>> MakeServerCredentials(
   grpc::SslServerCredentialsOptions options;
   DEFORM_ASSIGN_OR_RETURN(std::string certificate, ReadPemFile(security.cert_file, "certificate"));
   DEFORM_ASSIGN_OR_RETURN(std::string key, ReadPemFile(security.key_file, "private key"));
+  DEFORM_ASSIGN_OR_RETURN(
+      ServerCertificate inspected,
+      InspectServerCertificate(certificate, key, security.cert_file, security.key_file));
+  DEFORM_RETURN_IF_ERROR(CheckCertificateValidity(
+      inspected, std::time(nullptr), security.allow_expired_certificate, security.cert_file));
+  if (served_certificate != nullptr) *served_certificate = std::move(inspected);
   options.pem_key_cert_pairs.push_back({std::move(key), std::move(certificate)});
   if (security.client_ca_file.empty()) {
     options.client_certificate_request = GRPC_SSL_DONT_REQUEST_CLIENT_CERTIFICATE;

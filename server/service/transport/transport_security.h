@@ -15,6 +15,7 @@
 
 #include "core/base/status.h"
 #include "service/base/service_options.h"
+#include "service/transport/server_certificate.h"
 
 namespace deform::service {
 
@@ -23,10 +24,13 @@ bool IsLoopbackAddress(const std::string& listen_address);
 
 // The credentials for `listen_address` under the policy above: FAILED_PRECONDITION (naming the
 // flag to use) for plaintext on a non-loopback address without allow_plaintext, for a key without
-// a certificate (or the reverse) or a client CA without a certificate; NOT_FOUND for an
-// unreadable file. `description` receives what is served, for the log ("TLS", "mutual TLS",
-// "plaintext").
+// a certificate (or the reverse) or a client CA without a certificate, and for a certificate that
+// server_certificate.h refuses (unparsable, not the key's, expired or not yet valid unless
+// allow_expired_certificate); NOT_FOUND for an unreadable file. `description` receives what is
+// served, for the log ("TLS", "mutual TLS", "plaintext"); `served_certificate`, when given and
+// TLS is served, the certificate's names and validity.
 StatusOr<std::shared_ptr<grpc::ServerCredentials>> MakeServerCredentials(
-    const TransportSecurity& security, const std::string& listen_address, std::string* description);
+    const TransportSecurity& security, const std::string& listen_address, std::string* description,
+    ServerCertificate* served_certificate = nullptr);
 
 }  // namespace deform::service

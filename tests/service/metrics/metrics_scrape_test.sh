@@ -12,7 +12,8 @@
 #   auth      a deformd with a token file: a scrape without a token is 401, with a tenant's 403,
 #             with an operator's 200; another path is 404, POST 405; --metrics on a non-loopback
 #             address without a certificate is refused at start-up, exit 1 naming the flag.
-#   tls       a deformd serving gRPC over TLS: its metrics stay plain HTTP on loopback (scraped),
+#   tls       a deformd serving gRPC over TLS: its metrics stay plain HTTP on loopback (scraped,
+#             with the certificate's end of validity as a gauge; an expired one refuses to start),
 #             and --metrics on a non-loopback address is refused unless --plaintext.
 set -euo pipefail
 DEFORMD="$1"
@@ -142,6 +143,17 @@ tls)
   case "$METRICS" in http://127.0.0.1:*) ;; *) fail "metrics not on loopback HTTP: $METRICS" ;; esac
   curl -sf "$METRICS" >"$WORK/page.txt" || fail "loopback scrape failed"
   grep -q '^deformd_meshes_loaded ' "$WORK/page.txt" || fail "the page has no gauge"
+  # The certificate's end of validity as Unix seconds, as openssl reads it.
+  not_after=$(date -d "$(openssl x509 -in "$WORK/certs/server.pem" -noout -enddate | cut -d= -f2)" +%s)
+  expiry=$(sed -n 's/^deformd_tls_certificate_expiry_seconds \(.*\)$/\1/p' "$WORK/page.txt")
+  awk -v a="$expiry" -v b="$not_after" 'BEGIN { exit !(a != "" && a + 0 == b + 0) }' ||
+    fail "deformd_tls_certificate_expiry_seconds is '$expiry', the certificate ends at $not_after"
+  status=0
+  "$DEFORMD" --listen 127.0.0.1:0 --tls-cert "$WORK/certs/expired.pem" \
+    --tls-key "$WORK/certs/expired.key" >"$WORK/expired.log" 2>&1 || status=$?
+  [ "$status" -eq 1 ] || fail "deformd started with an expired certificate (exit $status)"
+  grep -q "expired on 2020-02-01 00:00:00 UTC.*--tls-allow-expired" "$WORK/expired.log" ||
+    fail "the refusal of the expired certificate does not say when and which flag"
   status=0
   "$DEFORMD" --listen 127.0.0.1:0 --tls-cert "$WORK/certs/server.pem" \
     --tls-key "$WORK/certs/server.key" --metrics 0.0.0.0:0 >"$WORK/refused.log" 2>&1 || status=$?

@@ -1,7 +1,8 @@
 // TLS on the gRPC port, through the real client library: a TLS server serves a TLS client that
 // trusts its CA and refuses a plaintext client and a client trusting another CA; with a client CA
 // (mutual TLS) it refuses a client without a certificate or with one from another CA. Without a
-// certificate the server refuses to serve plaintext on a non-loopback address unless asked to.
+// certificate the server refuses to serve plaintext on a non-loopback address unless asked to. An
+// expired certificate, or another certificate's key, refuses to start.
 #include "service/transport/transport_security.h"
 
 #include <gmock/gmock.h>
@@ -123,6 +124,34 @@ TEST(TransportSecurityTest, CertificateSettingsAreChecked) {
   const Status started = server.Start();
   EXPECT_EQ(started.code(), StatusCode::kNotFound);
   EXPECT_THAT(started.message(), HasSubstr("/nonexistent/server.pem"));
+}
+
+TEST(TransportSecurityTest, AnExpiredCertificateOrAnotherCertificatesKeyRefusesToStart) {
+  TestCertificates certificates;
+  ASSERT_TRUE(certificates.ok());
+  service::ServerOptions options = TestServerOptions();
+  options.security.cert_file = certificates.Path("expired.pem");
+  options.security.key_file = certificates.Path("expired.key");
+  {
+    service::DeformServer server(options);
+    const Status started = server.Start();
+    EXPECT_EQ(started.code(), StatusCode::kFailedPrecondition);
+    EXPECT_THAT(started.message(), HasSubstr("expired on 2020-02-01 00:00:00 UTC"));
+    EXPECT_THAT(started.message(), HasSubstr(certificates.Path("expired.pem")));
+  }
+  options.security.allow_expired_certificate = true;  // asked for: it serves
+  {
+    service::DeformServer server(options);
+    const Status started = server.Start();
+    EXPECT_TRUE(started.ok()) << started.ToString();
+  }
+  options.security.allow_expired_certificate = false;
+  options.security.cert_file = certificates.Path("server.pem");
+  options.security.key_file = certificates.Path("client.key");
+  service::DeformServer server(options);
+  const Status started = server.Start();
+  EXPECT_EQ(started.code(), StatusCode::kFailedPrecondition);
+  EXPECT_THAT(started.message(), HasSubstr("is not the key of the certificate"));
 }
 
 TEST(TransportSecurityTest, LoopbackAddresses) {
