@@ -7,6 +7,7 @@
 #include <limits>
 #include <random>
 #include <utility>
+#include <vector>
 
 #include "core/io/mesh_io.h"
 #include "core/io/phantom.h"
@@ -91,27 +92,54 @@ Eigen::Vector3d BruteClosestOnTriangle(const Eigen::Vector3d& p, const Eigen::Ve
   return best;
 }
 
-double BruteDistance(const TriangleMesh& mesh, const Eigen::Vector3d& p) {
-  double best = std::numeric_limits<double>::infinity();
-  for (int f = 0; f < mesh.num_triangles(); ++f) {
-    const Eigen::Vector3d q = BruteClosestOnTriangle(p, mesh.vertices.row(mesh.triangles(f, 0)),
-                                                     mesh.vertices.row(mesh.triangles(f, 1)),
-                                                     mesh.vertices.row(mesh.triangles(f, 2)));
-    best = std::min(best, (q - p).norm());
+// Brute force over every triangle, pruned only by each triangle's bounding sphere against the
+// nearest vertex's distance (an upper bound): exact, and independent of the tree's code.
+class BruteSurface {
+ public:
+  explicit BruteSurface(const TriangleMesh& mesh) : mesh_(mesh) {
+    centres_.resize(mesh.num_triangles());
+    radii_.resize(mesh.num_triangles());
+    for (int f = 0; f < mesh.num_triangles(); ++f) {
+      const Eigen::Vector3d a = mesh.vertices.row(mesh.triangles(f, 0));
+      const Eigen::Vector3d b = mesh.vertices.row(mesh.triangles(f, 1));
+      const Eigen::Vector3d c = mesh.vertices.row(mesh.triangles(f, 2));
+      centres_[f] = (a + b + c) / 3;
+      radii_[f] =
+          std::max({(a - centres_[f]).norm(), (b - centres_[f]).norm(), (c - centres_[f]).norm()});
+    }
   }
-  return best;
-}
 
-// The segment's distance to the surface, to within its length / samples: the smallest brute
-// distance over points spaced along it.
-double SampledSegmentDistance(const TriangleMesh& mesh, const Eigen::Vector3d& from,
-                              const Eigen::Vector3d& to, int samples) {
-  double best = std::numeric_limits<double>::infinity();
-  for (int s = 0; s <= samples; ++s) {
-    best = std::min(best, BruteDistance(mesh, from + (to - from) * (double(s) / samples)));
+  double Distance(const Eigen::Vector3d& p) const {
+    double best = std::numeric_limits<double>::infinity();
+    for (int i = 0; i < mesh_.num_vertices(); ++i) {
+      best = std::min(best, (mesh_.vertices.row(i).transpose() - p).norm());
+    }
+    for (int f = 0; f < mesh_.num_triangles(); ++f) {
+      if ((p - centres_[f]).norm() - radii_[f] > best) continue;  // no point of f is nearer
+      const Eigen::Vector3d q = BruteClosestOnTriangle(p, mesh_.vertices.row(mesh_.triangles(f, 0)),
+                                                       mesh_.vertices.row(mesh_.triangles(f, 1)),
+                                                       mesh_.vertices.row(mesh_.triangles(f, 2)));
+      best = std::min(best, (q - p).norm());
+    }
+    return best;
   }
-  return best;
-}
+
+  // The segment's distance to the surface, to within its length / samples: the smallest
+  // distance over points spaced along it.
+  double SampledSegmentDistance(const Eigen::Vector3d& from, const Eigen::Vector3d& to,
+                                int samples) const {
+    double best = std::numeric_limits<double>::infinity();
+    for (int s = 0; s <= samples; ++s) {
+      best = std::min(best, Distance(from + (to - from) * (double(s) / samples)));
+    }
+    return best;
+  }
+
+ private:
+  const TriangleMesh& mesh_;
+  std::vector<Eigen::Vector3d> centres_;
+  std::vector<double> radii_;
+};
 
 // Random points and segments around the mesh's box: the tree's closest pair matches brute force
 // (a point exactly; a segment within the sampling's spacing, never above the sampled minimum).
@@ -127,14 +155,15 @@ void ExpectClosestPairsMatchBruteForce(const TriangleBvh& bvh, const TriangleMes
         lower + Eigen::Vector3d(unit(random), unit(random), unit(random)).cwiseProduct(size));
   };
   constexpr int kSamples = 64;
+  const BruteSurface brute(mesh);
   for (int q = 0; q < queries; ++q) {
     const Eigen::Vector3d p = random_point();
     const TriangleBvh::SegmentSurfacePoint at_point = bvh.ClosestPointToSegment(p, p);
-    EXPECT_NEAR(at_point.distance, BruteDistance(mesh, p), 1e-9 * size.norm()) << "query " << q;
+    EXPECT_NEAR(at_point.distance, brute.Distance(p), 1e-9 * size.norm()) << "query " << q;
     EXPECT_NEAR((at_point.point - p).norm(), at_point.distance, 1e-9 * size.norm());
     const Eigen::Vector3d end = p + 0.15 * (random_point() - p);
     const TriangleBvh::SegmentSurfacePoint at_segment = bvh.ClosestPointToSegment(p, end);
-    const double sampled = SampledSegmentDistance(mesh, p, end, kSamples);
+    const double sampled = brute.SampledSegmentDistance(p, end, kSamples);
     const double spacing = (end - p).norm() / kSamples;
     EXPECT_LE(at_segment.distance, sampled + 1e-9 * size.norm()) << "query " << q;
     EXPECT_GE(at_segment.distance, sampled - spacing - 1e-9 * size.norm()) << "query " << q;
