@@ -49,4 +49,11 @@ ServiceContext::ServiceContext(const ServerOptions& options)
   InstallEscapingDefaultLogger();  // every line safe, in-process servers included (log_text.h)
 }
 
+bool ServiceContext::CountRefusal(ServiceMetrics::Refusal reason, std::uint64_t* held_back) {
+  metrics_.Refused(reason);
+  const int index = static_cast<int>(reason);
+  if (index < 0 || index >= ServiceMetrics::kRefusals) return false;
+  return refusal_lines_[index].Take(held_back);
+}
+
 }  // namespace deform::service

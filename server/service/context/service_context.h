@@ -8,6 +8,7 @@
 // down its transports and then the worker pool before destroying it).
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cstdint>
@@ -21,6 +22,7 @@
 #include "service/access/identity.h"
 #include "service/access/upload_watchdog.h"
 #include "service/base/annotated_mutex.h"
+#include "service/base/log_budget.h"
 #include "service/base/service_options.h"
 #include "service/base/thread_annotations.h"
 #include "service/context/latest_frames.h"
@@ -103,6 +105,12 @@ class ServiceContext {
   std::atomic<std::int64_t>& notice_backlog_bytes() { return notice_backlog_bytes_; }
   // Counters and histograms of frames, notices, RPCs, builds (service_metrics.h).
   ServiceMetrics& metrics() { return metrics_; }
+  // A refusal any peer can cause at will: counted in deformd_refused_total{reason}, and whether
+  // its log line may be written (a burst of kRefusalLineBurst lines per reason, then
+  // kRefusalLinesPerSecond); *held_back receives that reason's lines not written since the last.
+  static constexpr double kRefusalLinesPerSecond = 1;
+  static constexpr double kRefusalLineBurst = 10;
+  bool CountRefusal(ServiceMetrics::Refusal reason, std::uint64_t* held_back);
 
  private:
   const SolveSettings solve_settings_;
@@ -119,6 +127,11 @@ class ServiceContext {
   std::atomic<std::uint64_t> next_load_id_{1};
   std::atomic<std::int64_t> notice_backlog_bytes_{0};
   ServiceMetrics metrics_;
+  std::array<LogBudget, ServiceMetrics::kRefusals> refusal_lines_{
+      {LogBudget(kRefusalLinesPerSecond, kRefusalLineBurst),
+       LogBudget(kRefusalLinesPerSecond, kRefusalLineBurst),
+       LogBudget(kRefusalLinesPerSecond, kRefusalLineBurst),
+       LogBudget(kRefusalLinesPerSecond, kRefusalLineBurst)}};
 };
 
 }  // namespace deform::service

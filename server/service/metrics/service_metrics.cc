@@ -100,6 +100,13 @@ ServiceMetrics::ServiceMetrics() : registry_(std::make_shared<prometheus::Regist
       rpcs_[m][c] = &rpcs.Add({{"method", method}, {"code", CanonicalStatusCodeName(c)}});
     }
   }
+  auto& refused = BuildCounter()
+                      .Name("deformd_refused_total")
+                      .Help("Refused calls and connections, logged or not, by reason")
+                      .Register(*registry_);
+  for (int r = 0; r < kRefusals; ++r) {
+    refused_[r] = &refused.Add({{"reason", RefusalName(static_cast<Refusal>(r))}});
+  }
   auto& builds = BuildHistogram()
                      .Name("deformd_build_seconds")
                      .Help("Mesh builds (LoadMesh, --preload, --store), by result")
@@ -136,6 +143,25 @@ ServiceMetrics::ServiceMetrics() : registry_(std::make_shared<prometheus::Regist
 }
 
 ServiceMetrics::~ServiceMetrics() = default;
+
+const char* ServiceMetrics::RefusalName(Refusal reason) {
+  switch (reason) {
+    case Refusal::kUnauthenticated:
+      return "unauthenticated";
+    case Refusal::kHttpConnectionLimit:
+      return "http_connection_limit";
+    case Refusal::kHttpHostOrOrigin:
+      return "http_host_or_origin";
+    case Refusal::kHttpTooLarge:
+      return "http_too_large";
+  }
+  return "other";
+}
+
+void ServiceMetrics::Refused(Refusal reason) {
+  const int index = static_cast<int>(reason);
+  if (index >= 0 && index < kRefusals) refused_[index]->Increment();
+}
 
 void ServiceMetrics::FrameWritten(int encoding, std::size_t bytes, double server_seconds,
                                   std::uint64_t skipped_poses) {

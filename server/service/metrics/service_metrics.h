@@ -22,6 +22,10 @@
 //    deformd_memory_budget_reserved_bytes, deformd_memory_budget_streams_bytes,
 //    deformd_memory_budget_bytes,
 //    deformd_notice_backlog_bytes.
+//  - deformd_refused_total{reason}: what any peer can cause at will, counted whether or not it
+//    was logged (ServiceContext::CountRefusal bounds the lines): unauthenticated calls,
+//    HTTP connections over --http-max-connections, HTTP requests for another Host or Origin,
+//    HTTP requests over the header or body limit.
 //  - deformd_build_info{version,commit}: always 1; the build's version and commit as labels
 //    (core/base/build_info.h), as --version prints them.
 //  - deformd_tls_certificate_expiry_seconds: the served certificate's end of validity, Unix
@@ -62,6 +66,11 @@ class ServiceMetrics {
   static constexpr int kStatusCodes = kCanonicalStatusCodes;  // grpc::StatusCode 0..16
   static constexpr int kMethods = 7;  // six DeformService methods and "other"
 
+  // deformd_refused_total's reasons.
+  enum class Refusal { kUnauthenticated, kHttpConnectionLimit, kHttpHostOrOrigin, kHttpTooLarge };
+  static constexpr int kRefusals = 4;
+  static const char* RefusalName(Refusal reason);
+
   ServiceMetrics();
   ~ServiceMetrics();
   ServiceMetrics(const ServiceMetrics&) = delete;
@@ -79,6 +88,7 @@ class ServiceMetrics {
   // An RPC finished: `method` is the full name ("/deform.v1.DeformService/Deform"), `code` the
   // status code (out of range: UNKNOWN).
   void RpcFinished(std::string_view method, int code);
+  void Refused(Refusal reason);
   void BuildFinished(double seconds, bool ok);
   void RefactorizationFinished(double seconds);
 
@@ -110,6 +120,7 @@ class ServiceMetrics {
   prometheus::Counter* frames_unresolved_ = nullptr;
   std::array<prometheus::Counter*, kNoticeKinds> notices_sent_{};
   std::array<std::array<prometheus::Counter*, kStatusCodes>, kMethods> rpcs_{};
+  std::array<prometheus::Counter*, kRefusals> refused_{};
   prometheus::Histogram* build_ok_seconds_ = nullptr;
   prometheus::Histogram* build_error_seconds_ = nullptr;
   prometheus::Histogram* refactorization_seconds_ = nullptr;

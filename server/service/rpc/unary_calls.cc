@@ -3,6 +3,7 @@
 #include <string>
 
 #include "service/access/audit_log.h"
+#include "service/base/log_budget.h"
 #include "service/base/request_limits.h"
 #include "service/messages/frame_encoding.h"
 #include "service/messages/proto_conversion.h"
@@ -19,11 +20,15 @@ std::string_view BoundedForAudit(std::string_view mesh_id) {
 
 }  // namespace
 
-StatusOr<Identity> AuthenticateCall(const ServiceContext& context, std::string_view authorization,
+StatusOr<Identity> AuthenticateCall(ServiceContext& context, std::string_view authorization,
                                     std::string_view action, std::string_view mesh_id) {
   StatusOr<Identity> caller = context.auth().Authenticate(authorization);
   if (!caller.ok()) {
-    Audit("-", action, mesh_id, caller.status().ToString());
+    // Anyone can send a bad token: counted always, audited within the refusal lines' budget.
+    std::uint64_t held_back = 0;
+    if (context.CountRefusal(ServiceMetrics::Refusal::kUnauthenticated, &held_back)) {
+      Audit("-", action, mesh_id, caller.status().ToString() + HeldBackNote(held_back));
+    }
     return caller;
   }
   if (caller->role == Role::kMetrics) {

@@ -18,9 +18,11 @@
 
 namespace deform::service {
 
-// The caller behind `authorization`; a refused caller is audited ("-" as its tenant) for
-// `action` on `mesh_id`.
-StatusOr<Identity> AuthenticateCall(const ServiceContext& context, std::string_view authorization,
+// The caller behind `authorization`. A caller without a valid token is counted
+// (deformd_refused_total{reason="unauthenticated"}) and audited ("-" as its tenant) for `action`
+// on `mesh_id` within ServiceContext::CountRefusal's budget of lines; a metrics-role token is
+// PERMISSION_DENIED and audited under its tenant.
+StatusOr<Identity> AuthenticateCall(ServiceContext& context, std::string_view authorization,
                                     std::string_view action, std::string_view mesh_id);
 
 Status GetMeshInfoCall(ServiceContext& context, std::string_view authorization,

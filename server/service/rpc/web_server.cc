@@ -16,6 +16,7 @@
 #include <thread>
 #include <vector>
 
+#include "service/base/log_budget.h"
 #include "service/base/log_text.h"
 #include "service/deform/deform_stream_reactor.h"
 #include "service/load/load_mesh_reactor.h"
@@ -269,7 +270,12 @@ class HttpSession final : public Abortable, public std::enable_shared_from_this<
     }
     if (error) {
       if (error == http::error::body_limit || error == http::error::header_limit) {
-        spdlog::warn("{} request refused: {}", log_context_, error.message());
+        std::uint64_t held_back = 0;
+        if (shared_->context->CountRefusal(service::ServiceMetrics::Refusal::kHttpTooLarge,
+                                           &held_back)) {
+          spdlog::warn("{} request refused: {}{}", log_context_, error.message(),
+                       service::HeldBackNote(held_back));
+        }
       }
       return;  // the connection closes when the session goes
     }
@@ -284,11 +290,16 @@ class HttpSession final : public Abortable, public std::enable_shared_from_this<
   // 403 with a body for a Host the port is not for or another origin; nullopt when allowed.
   std::optional<Response> RefuseHostOrOrigin(const Request& request) {
     if (HostAndOriginAllowed(*shared_, request)) return std::nullopt;
-    spdlog::warn(
-        "{} request refused: Host '{}' Origin '{}' (not an allowed host, or another "
-        "origin; --http-allowed-host)",
-        log_context_, service::EscapeForLog(HeaderOf(request, http::field::host), 64),
-        service::EscapeForLog(HeaderOf(request, http::field::origin), 64));
+    std::uint64_t held_back = 0;
+    if (shared_->context->CountRefusal(service::ServiceMetrics::Refusal::kHttpHostOrOrigin,
+                                       &held_back)) {
+      spdlog::warn(
+          "{} request refused: Host '{}' Origin '{}' (not an allowed host, or another "
+          "origin; --http-allowed-host){}",
+          log_context_, service::EscapeForLog(HeaderOf(request, http::field::host), 64),
+          service::EscapeForLog(HeaderOf(request, http::field::origin), 64),
+          service::HeldBackNote(held_back));
+    }
     Response response =
         ErrorResponse(request, grpc::StatusCode::PERMISSION_DENIED,
                       shared_->hosts.AllowsHost(HeaderOf(request, http::field::host))
@@ -342,8 +353,7 @@ class HttpSession final : public Abortable, public std::enable_shared_from_this<
                          request[http::field::sec_websocket_protocol].size()));
     StatusOr<service::Identity> caller =
         service::AuthenticateCall(*shared_->context, authorization, deform ? "deform" : "load", "");
-    if (!caller.ok()) {
-      spdlog::warn("{} websocket refused: {}", log_context_, caller.status().message());
+    if (!caller.ok()) {  // audited by AuthenticateCall, within its budget of lines
       Response response =
           ErrorResponse(request, CodeOf(caller.status()), caller.status().message());
       response.keep_alive(false);
@@ -438,8 +448,12 @@ struct WebServer::Impl {
         shared.connections.Track(session);
         session->Run();
       } else {
-        spdlog::warn("http connection refused: {} connections open (the limit)",
-                     shared.options.max_connections);
+        std::uint64_t held_back = 0;
+        if (shared.context->CountRefusal(service::ServiceMetrics::Refusal::kHttpConnectionLimit,
+                                         &held_back)) {
+          spdlog::warn("http connection refused: {} connections open (the limit){}",
+                       shared.options.max_connections, service::HeldBackNote(held_back));
+        }
         beast::error_code ignored;
         socket.close(ignored);
       }

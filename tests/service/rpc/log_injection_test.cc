@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "deform/v1/deform.pb.h"
+#include "tests/service/support/log_capture.h"
 #include "tests/service/support/raw_http.h"
 #include "tests/service/support/stream_recorder.h"
 #include "tests/service/support/test_server.h"
@@ -24,34 +25,6 @@ using ::testing::HasSubstr;
 
 // Each field's value: a forged audit line, a carriage return, an ANSI colour and a bell.
 const std::string kHostile = "x\n[info] [audit] tenant=other forged\r\x1b[31mred\x07y";
-
-// Captures what the default and the audit logger write while it lives (pattern "<%v>").
-class LogCapture {
- public:
-  LogCapture() : sink_(std::make_shared<spdlog::sinks::ostream_sink_mt>(text_)) {
-    sink_->set_pattern("<%v>");
-    loggers_ = {spdlog::default_logger(), spdlog::get("audit")};
-    for (const auto& logger : loggers_) {
-      if (logger != nullptr) logger->sinks().push_back(sink_);
-    }
-  }
-  ~LogCapture() { Stop(); }
-  std::string Stop() {
-    for (const auto& logger : loggers_) {
-      if (logger == nullptr) continue;
-      logger->flush();
-      auto& sinks = logger->sinks();
-      if (!sinks.empty() && sinks.back() == sink_) sinks.pop_back();
-    }
-    loggers_.clear();
-    return text_.str();
-  }
-
- private:
-  std::ostringstream text_;
-  std::shared_ptr<spdlog::sinks::ostream_sink_mt> sink_;
-  std::vector<std::shared_ptr<spdlog::logger>> loggers_;
-};
 
 TEST(LogInjectionTest, ControlBytesInEveryLoggedFieldReachNoLogLineRaw) {
   web::WebOptions web_options;
