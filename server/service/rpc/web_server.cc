@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <array>
 #include <atomic>
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/asio/strand.hpp>
@@ -41,7 +42,16 @@ using Request = http::request<http::string_body>;
 using Response = http::response<http::string_body>;
 
 constexpr std::size_t kMaxHeaderBytes = 8 << 10;
+// A request's line and headers must arrive within kHeaderTimeout of the connection's last
+// request (so that half-open connections give their slot back in seconds), its body within
+// kRequestTimeout of its headers.
+constexpr auto kHeaderTimeout = std::chrono::seconds(5);
 constexpr auto kRequestTimeout = std::chrono::seconds(30);
+// After refusing a request that was too large, its remaining bytes are read and dropped for this
+// long (at most kDrainBytes) before the connection closes, so that the client reads the status
+// instead of a reset.
+constexpr auto kDrainTimeout = std::chrono::seconds(2);
+constexpr std::size_t kDrainBytes = std::size_t{1} << 20;
 
 // The open connections, to count them against max_connections and close them at shutdown.
 class Connections {
@@ -257,6 +267,18 @@ class HttpSession final : public Abortable, public std::enable_shared_from_this<
     parser_.emplace();
     parser_->header_limit(kMaxHeaderBytes);
     parser_->body_limit(shared_->options.max_body_bytes);
+    stream_.expires_after(kHeaderTimeout);
+    http::async_read_header(stream_, buffer_, *parser_,
+                            [self = shared_from_this()](beast::error_code error, std::size_t) {
+                              self->OnHeader(error);
+                            });
+  }
+
+  void OnHeader(beast::error_code error) {
+    if (error || parser_->is_done()) {
+      OnRead(error);
+      return;
+    }
     stream_.expires_after(kRequestTimeout);
     http::async_read(
         stream_, buffer_, *parser_,
@@ -268,17 +290,11 @@ class HttpSession final : public Abortable, public std::enable_shared_from_this<
       stream_.socket().shutdown(tcp::socket::shutdown_send, error);
       return;
     }
-    if (error) {
-      if (error == http::error::body_limit || error == http::error::header_limit) {
-        std::uint64_t held_back = 0;
-        if (shared_->context->CountRefusal(service::ServiceMetrics::Refusal::kHttpTooLarge,
-                                           &held_back)) {
-          spdlog::warn("{} request refused: {}{}", log_context_, error.message(),
-                       service::HeldBackNote(held_back));
-        }
-      }
-      return;  // the connection closes when the session goes
+    if (error == http::error::body_limit || error == http::error::header_limit) {
+      RefuseTooLarge(error == http::error::header_limit);
+      return;
     }
+    if (error) return;  // the connection closes when the session goes
     Request request = parser_->release();
     if (websocket::is_upgrade(request)) {
       Upgrade(std::move(request));
@@ -317,6 +333,47 @@ class HttpSession final : public Abortable, public std::enable_shared_from_this<
       return ApiCall(*shared_, request, target.substr(kApi.size()));
     }
     return StaticFile(*shared_, request);
+  }
+
+  // 431 for a request line and headers over kMaxHeaderBytes, 413 for a body over
+  // max_body_bytes, each with a body saying the limit; then the rest of the request is drained
+  // and the connection closed.
+  void RefuseTooLarge(bool header) {
+    std::uint64_t held_back = 0;
+    const std::string message =
+        header ? "request line and headers over " + std::to_string(kMaxHeaderBytes) + " bytes"
+               : "request body over " + std::to_string(shared_->options.max_body_bytes) + " bytes";
+    if (shared_->context->CountRefusal(service::ServiceMetrics::Refusal::kHttpTooLarge,
+                                       &held_back)) {
+      spdlog::warn("{} request refused: {}{}", log_context_, message,
+                   service::HeldBackNote(held_back));
+    }
+    Request request;  // the refused one's head may be incomplete: HTTP/1.1, closing
+    request.version(11);
+    request.keep_alive(false);
+    Response response = ErrorResponse(request, grpc::StatusCode::RESOURCE_EXHAUSTED, message);
+    response.result(header ? http::status::request_header_fields_too_large
+                           : http::status::payload_too_large);
+    response_ = std::make_shared<Response>(std::move(response));
+    stream_.expires_after(kDrainTimeout);
+    http::async_write(stream_, *response_,
+                      [self = shared_from_this()](beast::error_code error, std::size_t) {
+                        self->response_.reset();
+                        if (error) return;
+                        beast::error_code ignored;
+                        self->stream_.socket().shutdown(tcp::socket::shutdown_send, ignored);
+                        self->Drain(0);
+                      });
+  }
+
+  // Reads and drops what the client still sends, until it closes, kDrainBytes or kDrainTimeout.
+  void Drain(std::size_t drained) {
+    if (drained >= kDrainBytes) return;
+    stream_.async_read_some(
+        asio::buffer(drain_buffer_),
+        [self = shared_from_this(), drained](beast::error_code error, std::size_t bytes) {
+          if (!error) self->Drain(drained + bytes);
+        });
   }
 
   void Respond(Response response) {
@@ -396,6 +453,7 @@ class HttpSession final : public Abortable, public std::enable_shared_from_this<
   beast::flat_buffer buffer_;
   std::optional<http::request_parser<http::string_body>> parser_;
   std::shared_ptr<Response> response_;
+  std::array<char, 4096> drain_buffer_{};
 };
 
 grpc::StatusCode CodeOf(const Status& status) { return service::ToGrpcCode(status.code()); }

@@ -1,0 +1,93 @@
+// The HTTP port's bounds as a client meets them: a request line and headers over 8 KiB are 431
+// and a body over the limit 413, each with a body naming the limit (the client reads the status,
+// not a reset); a connection that sends nothing gives its slot back within the header timeout, so
+// half-open connections deny the viewer for seconds, not for as long as an attacker renews them.
+#include <arpa/inet.h>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "tests/service/support/raw_http.h"
+#include "tests/service/support/test_server.h"
+
+namespace deform::test_support {
+namespace {
+
+using ::testing::HasSubstr;
+
+// A TCP connection to 127.0.0.1:port that sends nothing; -1 when it cannot connect.
+int IdleConnection(int port) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_port = htons(static_cast<unsigned short>(port));
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  if (fd < 0 || ::connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof(address)) != 0) {
+    if (fd >= 0) ::close(fd);
+    return -1;
+  }
+  return fd;
+}
+
+// Seconds until the server closes `fd` (reads return 0), at most `limit`.
+double SecondsUntilClosed(int fd, double limit) {
+  const auto start = std::chrono::steady_clock::now();
+  timeval timeout{static_cast<time_t>(limit) + 1, 0};
+  ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &timeout, sizeof(timeout));
+  char byte;
+  (void)::recv(fd, &byte, 1, 0);
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+const std::string kGet = "GET /index.html HTTP/1.1\r\nHost: localhost\r\nConnection: close\r\n";
+
+TEST(HttpLimitsTest, OversizedHeadersAre431AndAnOversizedBody413WithABody) {
+  TestServer server(TestServerOptions(), "", true);
+  const RawHttpResponse fine = RawHttpExchange(server.web_port(), kGet + "\r\n");
+  EXPECT_EQ(fine.status, 200);
+
+  const RawHttpResponse headers = RawHttpExchange(
+      server.web_port(), kGet + "X-Padding: " + std::string(9000, 'a') + "\r\n\r\n");
+  EXPECT_EQ(headers.status, 431) << headers.head;
+  EXPECT_THAT(headers.body, HasSubstr("request line and headers over 8192 bytes"));
+  EXPECT_THAT(headers.head, HasSubstr("Deform-Status: 8"));  // RESOURCE_EXHAUSTED
+
+  const std::string body(200'000, 'b');
+  const RawHttpResponse posted =
+      RawHttpExchange(server.web_port(),
+                      "POST /deform.v1.DeformService/ListMeshes HTTP/1.1\r\nHost: localhost\r\n"
+                      "Content-Type: application/x-protobuf\r\nContent-Length: " +
+                          std::to_string(body.size()) + "\r\n\r\n" + body);
+  EXPECT_EQ(posted.status, 413) << posted.head;
+  EXPECT_THAT(posted.body, HasSubstr("request body over 65536 bytes"));
+  // The port still serves.
+  EXPECT_EQ(RawHttpExchange(server.web_port(), kGet + "\r\n").status, 200);
+}
+
+TEST(HttpLimitsTest, HalfOpenConnectionsGiveTheirSlotsBackWithinTheHeaderTimeout) {
+  web::WebOptions options;
+  options.max_connections = 2;
+  TestServer server(TestServerOptions(), "", true, options);
+  const int first = IdleConnection(server.web_port());
+  const int second = IdleConnection(server.web_port());
+  ASSERT_GE(first, 0);
+  ASSERT_GE(second, 0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));             // both accepted
+  EXPECT_EQ(RawHttpExchange(server.web_port(), kGet + "\r\n").status, 0);  // every slot taken
+  EXPECT_LT(SecondsUntilClosed(first, 10), 7.0);  // the header timeout is 5 s
+  EXPECT_LT(SecondsUntilClosed(second, 10), 2.0);
+  ::close(first);
+  ::close(second);
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  EXPECT_EQ(RawHttpExchange(server.web_port(), kGet + "\r\n").status, 200);
+}
+
+}  // namespace
+}  // namespace deform::test_support
