@@ -79,7 +79,9 @@ class WebSocketSession final
     timeout.idle_timeout = std::chrono::seconds(60);
     timeout.keep_alive_pings = true;
     ws_.set_option(timeout);
-    ws_.read_message_max(limits_.max_message_bytes);
+    // No limit in Beast, whose own refusal is a bare close 1009: ReadPart refuses a message over
+    // max_message_bytes with the status the stream contract promises.
+    ws_.read_message_max(0);
     ws_.auto_fragment(false);
     const auto offers = upgrade[boost::beast::http::field::sec_websocket_protocol];
     const bool offered = OffersDeformSubprotocol(std::string_view(offers.data(), offers.size()));
@@ -158,16 +160,33 @@ class WebSocketSession final
       return;
     }
     ++window_messages_;
-    ws_.async_read(read_buffer_, [self = this->shared_from_this(), request](
-                                     boost::beast::error_code error, std::size_t) {
-      self->OnRead(error, request);
-    });
+    ReadPart(request);
+  }
+
+  // Reads the next message a part at a time, so that one over max_message_bytes ends the stream
+  // RESOURCE_EXHAUSTED (a status message, then a close frame) after at most max_message_bytes +
+  // kReadPartBytes of it were buffered.
+  static constexpr std::size_t kReadPartBytes = 64 << 10;
+  void ReadPart(Request* request) {
+    ws_.async_read_some(
+        read_buffer_, kReadPartBytes,
+        [self = this->shared_from_this(), request](boost::beast::error_code error, std::size_t) {
+          if (!error && self->read_buffer_.size() > self->limits_.max_message_bytes) {
+            error = boost::beast::websocket::error::message_too_big;
+          }
+          if (!error && !self->ws_.is_message_done()) {
+            self->ReadPart(request);
+            return;
+          }
+          self->OnRead(error, request);
+        });
   }
 
   void OnRead(boost::beast::error_code error, Request* request) {
     read_in_flight_ = false;
     if (error) {
       if (error == boost::beast::websocket::error::message_too_big) {
+        read_buffer_.consume(read_buffer_.size());
         Refuse(grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
                             "a WebSocket message over the limit of " +
                                 std::to_string(limits_.max_message_bytes) + " bytes"));

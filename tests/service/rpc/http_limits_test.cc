@@ -2,6 +2,8 @@
 // and a body over the limit 413, each with a body naming the limit (the client reads the status,
 // not a reset); a connection that sends nothing gives its slot back within the header timeout, so
 // half-open connections deny the viewer for seconds, not for as long as an attacker renews them.
+// A WebSocket message over its limit ends the stream RESOURCE_EXHAUSTED with the stream
+// contract's status message, not with a bare close frame.
 #include <arpa/inet.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -15,7 +17,9 @@
 #include <vector>
 
 #include "tests/service/support/raw_http.h"
+#include "tests/service/support/stream_recorder.h"
 #include "tests/service/support/test_server.h"
+#include "tests/service/support/websocket_deform_stream.h"
 
 namespace deform::test_support {
 namespace {
@@ -87,6 +91,31 @@ TEST(HttpLimitsTest, HalfOpenConnectionsGiveTheirSlotsBackWithinTheHeaderTimeout
   ::close(second);
   std::this_thread::sleep_for(std::chrono::milliseconds(200));
   EXPECT_EQ(RawHttpExchange(server.web_port(), kGet + "\r\n").status, 200);
+}
+
+TEST(HttpLimitsTest, AWebSocketMessageOverTheLimitEndsTheStreamResourceExhausted) {
+  TestServer server(TestServerOptions(), "", true);
+  auto client = server.NewClient();
+  v1::MeshSummary summary;
+  ASSERT_TRUE(client->LoadPhantom(300, {}, &summary).ok());
+  StreamRecorder recorder;
+  WebSocketDeformStream stream(server.web_port(), summary.mesh_id(), recorder.Callbacks());
+  v1::PoseUpdate pose;
+  pose.set_sequence(1);
+  v1::JointAngle* angle = pose.add_angles();
+  angle->set_joint(std::string(5 << 20, 'j'));  // 5 MiB, over the default 4 MiB
+  angle->set_axis("x");
+  ASSERT_TRUE(stream.SendPose(pose));
+  const grpc::Status status = stream.Wait();
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << status.error_message();
+  EXPECT_THAT(status.error_message(), HasSubstr("over the limit of 4194304 bytes"));
+  // The port still serves a stream.
+  StreamRecorder next;
+  WebSocketDeformStream again(server.web_port(), summary.mesh_id(), next.Callbacks());
+  ASSERT_TRUE(again.SendPose(KneePose(1, 30)));
+  EXPECT_TRUE(next.WaitForFrames(1));
+  again.Close();
+  EXPECT_TRUE(again.Wait().ok());
 }
 
 }  // namespace
