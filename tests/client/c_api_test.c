@@ -921,9 +921,9 @@ static void test_tls_server(void) {
       "server name; files and PEM text got in\n");
 
   CHECK(stop_deformd(&server) == 0);
-  const char* names[] = {"ca.pem",           "ca.key",          "server.pem",   "server.key",
-                         "client.pem",       "client.key",      "other-ca.pem", "other-ca.key",
-                         "other-client.pem", "other-client.key"};
+  const char* names[] = {"ca.pem",           "ca.key",           "server.pem",   "server.key",
+                         "client.pem",       "client.key",       "other-ca.pem", "other-ca.key",
+                         "other-client.pem", "other-client.key", "expired.pem",  "expired.key"};
   for (size_t k = 0; k < sizeof names / sizeof names[0]; ++k) {
     char path[160];
     snprintf(path, sizeof path, "%s/%s", dir, names[k]);
