@@ -64,6 +64,8 @@ struct DeformArgs {
   bool volume = true;
   bool bone_reach = true;       // ModelOptions::unanchored_vertices from SkinReachedAcrossJoints
   int unanchored_vertices = 0;  // set once they are found
+  int max_contacts = 0;         // the constraints' bound, set once they are made
+  std::size_t constraint_scratch_bytes = 0;  // a stream's constraint scratch, likewise
   std::string out_bones_dir;
   std::vector<std::string> tools;  // ParseToolSpec's text
   int bone_surface_count = 0;      // set once they are loaded
@@ -211,6 +213,8 @@ nlohmann::ordered_json DeformReport(const DeformArgs& args, const deform::ModelI
                           {"bone_reach", args.bone_reach},
                           {"reached_vertices", args.unanchored_vertices},
                           {"penetration_before", PenetrationJson(c.before)},
+                          {"max_contacts", args.max_contacts},
+                          {"scratch_bytes", args.constraint_scratch_bytes},
                           {"active_contacts", c.contacts},
                           {"rounds", c.rounds},
                           {"solves", c.solves},
@@ -319,6 +323,8 @@ int RunDeform(DeformArgs args) {
   }
   auto constraints = deform::SkinConstraints::Create(**model, bones, constraint_options);
   if (!constraints.ok()) return Fail(constraints.status());
+  args.max_contacts = (*constraints)->options().max_contacts;
+  args.constraint_scratch_bytes = (*constraints)->ScratchBytes();
   deform::ToolSet tools;
   for (const std::string& spec : args.tools) {
     auto tool = deform::ParseToolSpec(spec);

@@ -156,6 +156,17 @@ bool BoneContacts::Deepest(int vertex, const double* xyz, const std::vector<Rigi
   return inside;
 }
 
+bool BoneContacts::Into(int surface, int vertex, const double* xyz,
+                        const std::vector<RigidTransform>& bones, BonePenetration* out) const {
+  const Eigen::Vector3d x(xyz[3 * vertex], xyz[3 * vertex + 1], xyz[3 * vertex + 2]);
+  if (!Penetration(surface, BoneSurfaceTransform(surfaces_[surface].surface, skeleton_, bones), x,
+                   out)) {
+    return false;
+  }
+  out->vertex = vertex;
+  return true;
+}
+
 PenetrationSummary BoneContacts::Measure(const Positions& posed,
                                          const std::vector<RigidTransform>& bones) const {
   PenetrationSummary summary;

@@ -59,6 +59,10 @@ class BoneContacts {
   bool Deepest(int vertex, const double* xyz, const std::vector<RigidTransform>& bones,
                BonePenetration* out) const;
 
+  // Vertex `vertex`'s penetration into surface `surface`, or false when it is outside it.
+  bool Into(int surface, int vertex, const double* xyz, const std::vector<RigidTransform>& bones,
+            BonePenetration* out) const;
+
   // Find's summary alone, for measuring any method's frame.
   PenetrationSummary Measure(const Positions& posed,
                              const std::vector<RigidTransform>& bones) const;

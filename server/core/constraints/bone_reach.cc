@@ -206,7 +206,7 @@ Status UnanchorReachedSkin(const TriangleMesh& skin, const Skeleton& skeleton,
                            const std::vector<BoneSurface>& surfaces,
                            const ConstraintOptions& constraints, ModelOptions* model,
                            const CancelToken* cancel) {
-  if (surfaces.empty() || constraints.max_contacts == 0 || !constraints.bone_reach) {
+  if (surfaces.empty() || !constraints.contacts() || !constraints.bone_reach) {
     return Status::Ok();
   }
   DEFORM_ASSIGN_OR_RETURN(model->unanchored_vertices,

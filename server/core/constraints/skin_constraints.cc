@@ -11,6 +11,21 @@ namespace {
 
 using Vec3 = Eigen::Map<const Eigen::Vector3d>;
 
+// Four partial sums, so that the multiply-adds do not wait on each other and the compiler can pair
+// them in vector registers (a single running sum is bound by the add's latency).
+double Dot(const double* a, const double* b, std::size_t count) {
+  double sum[4] = {0, 0, 0, 0};
+  std::size_t i = 0;
+  for (; i + 4 <= count; i += 4) {
+    sum[0] += a[i] * b[i];
+    sum[1] += a[i + 1] * b[i + 1];
+    sum[2] += a[i + 2] * b[i + 2];
+    sum[3] += a[i + 3] * b[i + 3];
+  }
+  for (; i < count; ++i) sum[0] += a[i] * b[i];
+  return (sum[0] + sum[1]) + (sum[2] + sum[3]);
+}
+
 // Solves the q-square symmetric positive semi-definite system `a` (row-major, stride `stride`,
 // overwritten by its Cholesky factor) for `x` in place. Pivots are regularised by a tiny multiple
 // of the largest diagonal entry, so a degenerate set (two contacts on one vertex's plane) still
@@ -20,14 +35,12 @@ void SolveSymmetric(double* a, int q, int stride, double* x) {
   for (int i = 0; i < q; ++i) largest = std::max(largest, a[i * stride + i]);
   const double floor = 1e-12 * std::max(largest, 1e-300);
   for (int j = 0; j < q; ++j) {
-    double d = a[j * stride + j];
-    for (int p = 0; p < j; ++p) d -= a[j * stride + p] * a[j * stride + p];
-    d = std::sqrt(std::max(d, floor));
+    const double* row_j = a + j * stride;
+    const double d = std::sqrt(std::max(row_j[j] - Dot(row_j, row_j, j), floor));
     a[j * stride + j] = d;
     for (int i = j + 1; i < q; ++i) {
-      double v = a[i * stride + j];
-      for (int p = 0; p < j; ++p) v -= a[i * stride + p] * a[j * stride + p];
-      a[i * stride + j] = v / d;
+      double* row_i = a + i * stride;
+      row_i[j] = (row_i[j] - Dot(row_i, row_j, j)) / d;
     }
   }
   for (int i = 0; i < q; ++i) {
@@ -49,12 +62,6 @@ void Solved(const Status& status) {
   (void)status;
 }
 
-double Dot(const double* a, const double* b, std::size_t count) {
-  double sum = 0;
-  for (std::size_t i = 0; i < count; ++i) sum += a[i] * b[i];
-  return sum;
-}
-
 }  // namespace
 
 StatusOr<std::shared_ptr<const SkinConstraints>> SkinConstraints::Create(
@@ -63,9 +70,11 @@ StatusOr<std::shared_ptr<const SkinConstraints>> SkinConstraints::Create(
   if (!(options.contact_margin >= 0 && options.contact_margin < 1)) {
     return Status::InvalidArgument("contact_margin must be in [0, 1)");
   }
-  if (options.max_contacts < 0 || options.max_contacts > ConstraintOptions::kMaxContacts) {
-    return Status::InvalidArgument("max_contacts must be in [0, " +
-                                   std::to_string(ConstraintOptions::kMaxContacts) + "]");
+  if ((options.max_contacts < 0 && options.max_contacts != ConstraintOptions::kAutomaticContacts) ||
+      options.max_contacts > ConstraintOptions::kMaxContacts) {
+    return Status::InvalidArgument(
+        "max_contacts must be in [0, " + std::to_string(ConstraintOptions::kMaxContacts) +
+        "] or automatic (" + std::to_string(ConstraintOptions::kAutomaticContacts) + ")");
   }
   if (options.max_tool_contacts < 0 ||
       options.max_tool_contacts > ConstraintOptions::kMaxToolContacts) {
@@ -83,6 +92,10 @@ StatusOr<std::shared_ptr<const SkinConstraints>> SkinConstraints::Create(
   constraints->bones_ = std::move(bones);
   constraints->options_ = options;
   const TriangleMesh& mesh = model.mesh();
+  if (options.max_contacts == ConstraintOptions::kAutomaticContacts) {
+    constraints->options_.max_contacts =
+        ConstraintOptions::AutomaticMaxContacts(mesh.num_vertices());
+  }
   constraints->rows_ = mesh.num_vertices() + model.num_joint_nodes();
   constraints->margin_ = options.contact_margin * model.bounding_box_diagonal();
   constraints->closure_ = std::make_unique<VolumeClosure>(mesh.triangles, mesh.num_vertices());
@@ -122,6 +135,11 @@ StatusOr<std::shared_ptr<const SkinConstraints>> SkinConstraints::Create(
     }
   }
   return std::shared_ptr<const SkinConstraints>(std::move(constraints));
+}
+
+int ConstraintOptions::AutomaticMaxContacts(int vertices) {
+  const int scaled = (std::max(vertices, 0) + kVerticesPerContact - 1) / kVerticesPerContact;
+  return std::clamp(scaled, kMinAutomaticContacts, kMaxContacts);
 }
 
 int SkinConstraints::ContactCapacity() const {
@@ -329,8 +347,32 @@ bool SkinConstraints::Apply(const MaterialFactorization& factorization, DeformSc
       found = bones_->Find(x, frame->bone_transforms, s->found.data(), capacity, &summary,
                            s->in_set.empty() ? nullptr : s->in_set.data());
     }
+    // A held vertex the solve pushed into another bone than its contact's (skin caught between
+    // two bones) gets a second contact, on that bone's plane, and keeps the first: holding it
+    // on one plane at a time sends it back and forth between the two.
+    const int bone_capacity = std::max(0, std::min(bone_bound - bone_held, k_max - set));
+    if (bones_ != nullptr) {
+      for (int j = 0; j < set && found < bone_capacity; ++j) {
+        const HeldContact& held = s->contacts[j];
+        BonePenetration other;
+        if (held.kind != ObstacleKind::kBone ||
+            bones_->Into(held.at.surface, held.at.vertex, x, frame->bone_transforms, &other) ||
+            !bones_->Deepest(held.at.vertex, x, frame->bone_transforms, &other)) {
+          continue;
+        }
+        bool held_there = false;
+        for (int l = 0; l < set && !held_there; ++l) {
+          held_there = s->contacts[l].at.vertex == other.vertex &&
+                       s->contacts[l].kind == ObstacleKind::kBone &&
+                       s->contacts[l].at.surface == other.surface;
+        }
+        for (int c = 0; c < found && !held_there; ++c)
+          held_there = s->found[c].vertex == other.vertex;
+        if (!held_there) s->found[found++] = other;
+      }
+    }
     // Bones first: a vertex a bone takes this round is no tool's.
-    for (int c = 0; c < found; ++c) s->in_set[s->found[c].vertex] = 1;
+    for (int c = 0; c < found; ++c) ++s->in_set[s->found[c].vertex];
     PenetrationSummary tool_summary;
     int tool_found = 0;
     if (tools != nullptr) {
@@ -339,7 +381,7 @@ bool SkinConstraints::Apply(const MaterialFactorization& factorization, DeformSc
       tool_found = FindToolPenetrations(*tools, x, n, s->found.data() + found, capacity,
                                         &tool_summary, s->in_set.data());
     }
-    for (int c = 0; c < found; ++c) s->in_set[s->found[c].vertex] = 0;
+    for (int c = 0; c < found; ++c) --s->in_set[s->found[c].vertex];
     const double volume = std::isnan(known_volume) ? closure_->Volume(x) : known_volume;
     known_volume = std::numeric_limits<double>::quiet_NaN();
     if (round == 0) {
@@ -357,10 +399,16 @@ bool SkinConstraints::Apply(const MaterialFactorization& factorization, DeformSc
     // on the tangent plane at its new nearest point.
     // Bones win: a tool contact pushed into a bone takes the bone's plane.
     int refreshed = 0;
+    // A bone contact keeps its bone (a second contact holds it out of another, above).
     for (int j = 0; j < set; ++j) {
       HeldContact& held = s->contacts[j];
       BonePenetration now;
-      if (bones_ != nullptr && bones_->Deepest(held.at.vertex, x, frame->bone_transforms, &now)) {
+      if (held.kind == ObstacleKind::kBone) {
+        if (!bones_->Into(held.at.surface, held.at.vertex, x, frame->bone_transforms, &now)) {
+          continue;
+        }
+      } else if (bones_ != nullptr &&
+                 bones_->Deepest(held.at.vertex, x, frame->bone_transforms, &now)) {
         held.kind = ObstacleKind::kBone;
       } else if (held.kind != ObstacleKind::kTool ||
                  !DeepestToolPenetration(*tools, held.at.vertex, x, &now)) {
@@ -375,7 +423,7 @@ bool SkinConstraints::Apply(const MaterialFactorization& factorization, DeformSc
         round == options_.max_rounds) {
       break;
     }
-    for (int c = 0; c < found + tool_found; ++c) s->in_set[s->found[c].vertex] = 1;
+    for (int c = 0; c < found + tool_found; ++c) ++s->in_set[s->found[c].vertex];
     if (found > 0) AddContacts(factor, found, ObstacleKind::kBone, s, report);
     if (tool_found > 0) {
       std::copy_n(s->found.begin() + found, tool_found, s->found.begin());
@@ -427,7 +475,7 @@ bool SkinConstraints::Apply(const MaterialFactorization& factorization, DeformSc
         if (s->multipliers[j] >= 0) continue;
         dropped = true;
         const int last = set - 1;
-        s->in_set[s->contacts[j].at.vertex] = 0;
+        --s->in_set[s->contacts[j].at.vertex];
         if (j != last) {
           MoveContact(last, j, set, s);
           s->multipliers[j] = s->multipliers[last];

@@ -24,8 +24,9 @@
 // refactorization. Contacts come from an active set: solve, find the vertices inside a bone, hold
 // each on its nearest surface point's tangent plane (plus a margin), solve again; a contact whose
 // multiplier pulls the skin inward leaves the set, and a held vertex still inside gets the tangent
-// plane of its new nearest point. One contact per vertex: skin caught between two bones is held out
-// of the deeper.
+// plane of its new nearest point. A vertex is held out of the deeper bone first; one the solve
+// then pushes into another bone gets a second contact, there, so skin caught between two bones is
+// held out of both.
 //
 // Bones and tools (tools.h) are both obstacles of that one active set, each contact tagged with
 // its kind: a skin vertex inside a tool is held on the tool's tangent plane at its nearest surface
@@ -55,9 +56,20 @@ struct ConstraintOptions {
   // bounding-box diagonal. Default: 1e-3.
   double contact_margin = 1e-3;
   // At most this many contact constraints in a frame (the k of the low-rank terms); a frame that
-  // needs more is flagged unresolved. In [0, kMaxContacts]. Default: 128.
-  int max_contacts = 128;
-  static constexpr int kMaxContacts = 256;
+  // needs more is flagged unresolved. In [0, kMaxContacts], or kAutomaticContacts (the default):
+  // AutomaticMaxContacts of the skin's vertex count.
+  int max_contacts = kAutomaticContacts;
+  static constexpr int kMaxContacts = 2048;
+  static constexpr int kAutomaticContacts = -1;
+  // The automatic bound: one contact per kVerticesPerContact skin vertices, at least
+  // kMinAutomaticContacts, at most kMaxContacts. The skin a bone presses on grows with the
+  // mesh's density (the 133k arm at 120 degrees needs 573 contacts, the 1.6k leg a handful), and
+  // a per-frame bound of the same size for every mesh leaves a dense one inside its bones.
+  static constexpr int kVerticesPerContact = 128;
+  static constexpr int kMinAutomaticContacts = 128;
+  static int AutomaticMaxContacts(int vertices);
+  // Whether skin is held outside the bones (max_contacts 0: penetrations are measured only).
+  bool contacts() const { return max_contacts != 0; }
   // At most this many tool contacts in a frame, besides max_contacts, so that a tool never takes
   // the bones' budget (docs/instruments.md). 0: tools are refused. In [0, kMaxToolContacts].
   // Default: 64.
@@ -129,7 +141,7 @@ struct ConstraintScratch {
   std::vector<double> inverse_block;  // (M^-1)_{i_l i_j}, (max_contacts + max_tool_contacts) square
   std::vector<double> system;         // the (k + 1)-square system, then its Cholesky factor
   std::vector<double> multipliers;    // its right-hand side, then lambda and mu
-  std::vector<char> in_set;           // per vertex: a contact holds it
+  std::vector<char> in_set;           // per vertex: the contacts that hold it (one per bone)
   const void* owner = nullptr;
 };
 

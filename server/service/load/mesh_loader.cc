@@ -130,7 +130,7 @@ StatusOr<std::shared_ptr<const MeshEntry>> Build(ServiceContext* context, Admiss
   }
   const ConstraintOptions& constraint_options = entry->constraints.options;
   spdlog::info("mesh={} constraints: contacts {}, volume {}, margin {:g}; bone surfaces: {}",
-               entry->id, OnOff(constraint_options.max_contacts > 0),
+               entry->id, OnOff(constraint_options.contacts()),
                OnOff(constraint_options.keep_volume), constraint_options.contact_margin,
                bones.empty() ? "none" : bones);
   for (const std::string& warning : entry->model->binding_report().warnings) {

@@ -138,7 +138,7 @@ StatusOr<ConstraintOptions> ConstraintOptionsFromProto(const v1::Constraints& pr
 }
 
 void ConstraintOptionsToProto(const ConstraintOptions& options, v1::Constraints* proto) {
-  proto->set_contacts(options.max_contacts > 0);
+  proto->set_contacts(options.contacts());
   proto->set_keep_volume(options.keep_volume);
   proto->set_contact_margin(options.contact_margin);
 }

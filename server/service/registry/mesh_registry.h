@@ -57,7 +57,8 @@ struct MeshConstraints {
   // released first). Null when there are neither bone surfaces nor a volume to keep: frames are
   // then the model's own and carry no FrameConstraints.
   std::shared_ptr<const SkinConstraints> constraints;
-  // What the load asked for (MethodOptions.constraints): contacts on is max_contacts > 0.
+  // What the load asked for (MethodOptions.constraints): contacts on is
+  // ConstraintOptions::contacts().
   ConstraintOptions options;
   // The estimate of what the bone surfaces, their search trees and the constraints hold.
   std::size_t bytes = 0;

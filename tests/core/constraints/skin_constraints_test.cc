@@ -17,6 +17,10 @@
 namespace deform {
 namespace {
 
+// A phantom dense enough that its skin at 120 degrees presses on about a hundred vertices of its
+// (large) capsule bones.
+constexpr int kDenseVertices = 24000;
+
 struct Limb {
   std::shared_ptr<const DeformationModel> model;
   std::shared_ptr<const BoneContacts> bones;
@@ -123,7 +127,7 @@ TEST(SkinConstraints, ContactsPushTheSkinOutOfBonesItWouldEnter) {
       << frames.report.after.max_depth << " after " << frames.report.rounds << " rounds, "
       << frames.report.contacts << " contacts, " << frames.report.before.vertices << " before";
   EXPECT_GT(frames.report.contacts, 0);
-  EXPECT_LE(frames.report.contacts, options.max_contacts);
+  EXPECT_LE(frames.report.contacts, constraints->options().max_contacts);
   // Local: the vertices far from the contacts barely move.
   const double diagonal = model->bounding_box_diagonal();
   double far_motion = 0;
@@ -177,9 +181,59 @@ TEST(SkinConstraints, RefuseBonesTheRestSkinEntersAndBadOptions) {
   ConstraintOptions options;
   options.max_contacts = ConstraintOptions::kMaxContacts + 1;
   EXPECT_FALSE(SkinConstraints::Create(*model, nullptr, options).ok());
+  options.max_contacts = ConstraintOptions::kAutomaticContacts - 1;
+  EXPECT_FALSE(SkinConstraints::Create(*model, nullptr, options).ok());
   options = {};
   options.volume_tolerance = 0;
   EXPECT_FALSE(SkinConstraints::Create(*model, nullptr, options).ok());
+}
+
+TEST(SkinConstraints, TheAutomaticContactBoundGrowsWithTheSkin) {
+  EXPECT_EQ(ConstraintOptions::AutomaticMaxContacts(0), ConstraintOptions::kMinAutomaticContacts);
+  EXPECT_EQ(ConstraintOptions::AutomaticMaxContacts(1633),
+            ConstraintOptions::kMinAutomaticContacts);
+  EXPECT_EQ(ConstraintOptions::AutomaticMaxContacts(25969), 203);
+  EXPECT_EQ(ConstraintOptions::AutomaticMaxContacts(132946), 1039);
+  EXPECT_EQ(ConstraintOptions::AutomaticMaxContacts(2'000'000), ConstraintOptions::kMaxContacts);
+  KneePhantom phantom = *MakeKneePhantom(800);
+  const auto model =
+      *DeformationModel::Build(phantom.mesh, phantom.skeleton, ModelOptions::Paper());
+  const auto automatic = *SkinConstraints::Create(*model, nullptr);
+  EXPECT_EQ(automatic->options().max_contacts, ConstraintOptions::kMinAutomaticContacts);
+  EXPECT_TRUE(automatic->options().contacts());
+  ConstraintOptions off;
+  off.max_contacts = 0;
+  EXPECT_FALSE(off.contacts());
+}
+
+// A bound below what a dense skin presses on a bone leaves skin inside (the 133k arm at 120
+// degrees against the old fixed 128: docs/constraints.md); the automatic bound, from the vertex
+// count, leaves none.
+TEST(SkinConstraints, ADenseSkinNeedsMoreContactsThanAFixedBound) {
+  KneePhantom phantom = *MakeKneePhantom(kDenseVertices);
+  const auto model =
+      *DeformationModel::Build(phantom.mesh, phantom.skeleton, ModelOptions::Paper());
+  const auto bones =
+      *BoneContacts::Create(MakeCapsuleBoneSurfaces(phantom.mesh, phantom.skeleton, 1.0),
+                            phantom.skeleton, phantom.mesh, model->rigid_bones());
+  const Limb limb{model, bones};
+  const Pose pose = PoseFrom(phantom.skeleton, "knee:flexion:120");
+  ConstraintOptions fixed;
+  fixed.keep_volume = false;
+  fixed.max_contacts = 16;
+  const Frames bounded = Solve(limb, **SkinConstraints::Create(*model, bones, fixed), pose);
+  ASSERT_GT(bounded.report.before.vertices, 4 * fixed.max_contacts);
+  EXPECT_TRUE(bounded.report.unresolved);
+  ConstraintOptions automatic;
+  automatic.keep_volume = false;
+  const auto constraints = *SkinConstraints::Create(*model, bones, automatic);
+  EXPECT_GT(constraints->options().max_contacts, fixed.max_contacts);
+  const Frames frames = Solve(limb, *constraints, pose);
+  EXPECT_EQ(frames.report.after.vertices, 0)
+      << frames.report.after.max_depth << " after " << frames.report.rounds << " rounds, "
+      << frames.report.contacts << " contacts, " << frames.report.before.vertices << " before";
+  EXPECT_FALSE(frames.report.unresolved);
+  EXPECT_GT(frames.report.contacts, fixed.max_contacts);
 }
 
 // The shared legs and arm, with capsule bones by the sizing rule: no skin inside a bone, and the
