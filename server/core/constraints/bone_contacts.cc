@@ -143,13 +143,10 @@ int BoneContacts::Find(const double* xyz, const std::vector<RigidTransform>& bon
 bool BoneContacts::Deepest(int vertex, const double* xyz, const std::vector<RigidTransform>& bones,
                            BonePenetration* out) const {
   bool inside = false;
-  const Eigen::Vector3d x(xyz[3 * vertex], xyz[3 * vertex + 1], xyz[3 * vertex + 2]);
   for (int s = 0; s < num_surfaces(); ++s) {
     BonePenetration found;
-    if (Penetration(s, BoneSurfaceTransform(surfaces_[s].surface, skeleton_, bones), x, &found) &&
-        (!inside || found.depth > out->depth)) {
+    if (Into(s, vertex, xyz, bones, &found) && (!inside || found.depth > out->depth)) {
       *out = found;
-      out->vertex = vertex;
       inside = true;
     }
   }

@@ -342,34 +342,39 @@ bool SkinConstraints::Apply(const MaterialFactorization& factorization, DeformSc
     const int tool_held = set - bone_held;
     PenetrationSummary summary;
     int found = 0;
-    if (bones_ != nullptr) {
-      const int capacity = std::max(0, std::min(bone_bound - bone_held, k_max - set));
-      found = bones_->Find(x, frame->bone_transforms, s->found.data(), capacity, &summary,
-                           s->in_set.empty() ? nullptr : s->in_set.data());
-    }
-    // A held vertex the solve pushed into another bone than its contact's (skin caught between
-    // two bones) gets a second contact, on that bone's plane, and keeps the first: holding it
-    // on one plane at a time sends it back and forth between the two.
     const int bone_capacity = std::max(0, std::min(bone_bound - bone_held, k_max - set));
     if (bones_ != nullptr) {
-      for (int j = 0; j < set && found < bone_capacity; ++j) {
-        const HeldContact& held = s->contacts[j];
-        BonePenetration other;
-        if (held.kind != ObstacleKind::kBone ||
-            bones_->Into(held.at.surface, held.at.vertex, x, frame->bone_transforms, &other) ||
-            !bones_->Deepest(held.at.vertex, x, frame->bone_transforms, &other)) {
-          continue;
-        }
-        bool held_there = false;
-        for (int l = 0; l < set && !held_there; ++l) {
-          held_there = s->contacts[l].at.vertex == other.vertex &&
-                       s->contacts[l].kind == ObstacleKind::kBone &&
-                       s->contacts[l].at.surface == other.surface;
-        }
-        for (int c = 0; c < found && !held_there; ++c)
-          held_there = s->found[c].vertex == other.vertex;
-        if (!held_there) s->found[found++] = other;
+      found = bones_->Find(x, frame->bone_transforms, s->found.data(), bone_capacity, &summary,
+                           s->in_set.empty() ? nullptr : s->in_set.data());
+    }
+    // The held bone contacts, one test of each against its own bone. One still inside (its plane
+    // was tangent where the surface curves away) is held on the tangent plane at its new nearest
+    // point. One the solve pushed into another bone (skin caught between two bones) gets a second
+    // contact, on that bone's plane, and keeps the first: holding it on one plane at a time sends
+    // it back and forth between the two.
+    int refreshed = 0;
+    for (int j = 0; j < set; ++j) {
+      HeldContact& held = s->contacts[j];
+      if (held.kind != ObstacleKind::kBone) continue;
+      BonePenetration now;
+      if (bones_->Into(held.at.surface, held.at.vertex, x, frame->bone_transforms, &now)) {
+        held.at.normal = now.normal;
+        held.at.surface_point = now.surface_point;
+        ++refreshed;
+        continue;
       }
+      if (found >= bone_capacity ||
+          !bones_->Deepest(held.at.vertex, x, frame->bone_transforms, &now)) {
+        continue;
+      }
+      bool held_there = false;
+      for (int l = 0; l < set && !held_there; ++l) {
+        held_there = s->contacts[l].at.vertex == now.vertex &&
+                     s->contacts[l].kind == ObstacleKind::kBone &&
+                     s->contacts[l].at.surface == now.surface;
+      }
+      for (int c = 0; c < found && !held_there; ++c) held_there = s->found[c].vertex == now.vertex;
+      if (!held_there) s->found[found++] = now;
     }
     // Bones first: a vertex a bone takes this round is no tool's.
     for (int c = 0; c < found; ++c) ++s->in_set[s->found[c].vertex];
@@ -395,23 +400,15 @@ bool SkinConstraints::Apply(const MaterialFactorization& factorization, DeformSc
     const bool volume_kept =
         !keeps_volume_ ||
         std::abs(volume - rest_volume_) <= options_.volume_tolerance * std::abs(rest_volume_);
-    // A held vertex still inside (its plane was tangent where the surface curves away): hold it
-    // on the tangent plane at its new nearest point.
-    // Bones win: a tool contact pushed into a bone takes the bone's plane.
-    int refreshed = 0;
-    // A bone contact keeps its bone (a second contact holds it out of another, above).
+    // The held tool contacts. Bones win: one pushed into a bone takes the bone's plane; one still
+    // inside its tool gets the tool's plane at its new nearest point.
     for (int j = 0; j < set; ++j) {
       HeldContact& held = s->contacts[j];
+      if (held.kind != ObstacleKind::kTool) continue;
       BonePenetration now;
-      if (held.kind == ObstacleKind::kBone) {
-        if (!bones_->Into(held.at.surface, held.at.vertex, x, frame->bone_transforms, &now)) {
-          continue;
-        }
-      } else if (bones_ != nullptr &&
-                 bones_->Deepest(held.at.vertex, x, frame->bone_transforms, &now)) {
+      if (bones_ != nullptr && bones_->Deepest(held.at.vertex, x, frame->bone_transforms, &now)) {
         held.kind = ObstacleKind::kBone;
-      } else if (held.kind != ObstacleKind::kTool ||
-                 !DeepestToolPenetration(*tools, held.at.vertex, x, &now)) {
+      } else if (!DeepestToolPenetration(*tools, held.at.vertex, x, &now)) {
         continue;
       }
       held.at.surface = now.surface;

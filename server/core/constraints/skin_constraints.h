@@ -141,7 +141,8 @@ struct ConstraintScratch {
   std::vector<double> inverse_block;  // (M^-1)_{i_l i_j}, (max_contacts + max_tool_contacts) square
   std::vector<double> system;         // the (k + 1)-square system, then its Cholesky factor
   std::vector<double> multipliers;    // its right-hand side, then lambda and mu
-  std::vector<char> in_set;           // per vertex: the contacts that hold it (one per bone)
+  // Per vertex: the contacts that hold it, at most one a bone surface (BoneSurfaceLimits: 64).
+  std::vector<char> in_set;
   const void* owner = nullptr;
 };
 
