@@ -133,14 +133,25 @@ void BM_Frame(benchmark::State& state, BenchMesh mesh) {
 // A whole frame with the constraints (core/constraints): the frame of BM_Frame, then the skin held
 // outside the bones and the volume kept, at `degrees` of flexion (the benchmark pose where 0), on
 // the model built for the bones (BonedModelFor). Compare with Frame/ of the same mesh in the same
-// run.
-void BM_ConstrainedFrame(benchmark::State& state, BenchMesh mesh, int degrees) {
+// run. With `sweep` the frames move, as a stream's do: from degrees - 20 to degrees and back in
+// 2-degree steps, a pose a frame, so a frame's contacts are carried from a different pose.
+void BM_ConstrainedFrame(benchmark::State& state, BenchMesh mesh, int degrees, bool sweep) {
   const BonedModel boned = BonedModelFor(mesh);
   auto frames = SetUpFramesOf(state, mesh, boned.model);
   if (!frames) return;
-  if (degrees > 0) {
-    frames->pose =
-        PoseFromSpecOrRest(*frames->model, mesh.flexion_prefix + std::to_string(degrees));
+  std::vector<Pose> poses;
+  if (sweep) {
+    for (int d = degrees - 20; d < degrees; d += 2) {
+      poses.push_back(PoseFromSpecOrRest(*frames->model, mesh.flexion_prefix + std::to_string(d)));
+    }
+    for (int d = degrees; d > degrees - 20; d -= 2) {
+      poses.push_back(PoseFromSpecOrRest(*frames->model, mesh.flexion_prefix + std::to_string(d)));
+    }
+  } else if (degrees > 0) {
+    poses.push_back(
+        PoseFromSpecOrRest(*frames->model, mesh.flexion_prefix + std::to_string(degrees)));
+  } else {
+    poses.push_back(frames->pose);
   }
   auto bones = BoneContacts::Create(boned.surfaces, frames->model->skeleton(),
                                     frames->model->mesh(), frames->model->rigid_bones());
@@ -155,16 +166,41 @@ void BM_ConstrainedFrame(benchmark::State& state, BenchMesh mesh, int degrees) {
   }
   ConstraintScratch scratch = (*constraints)->MakeScratch();
   ConstraintReport report;
+  std::size_t next = 0;
+  int most_inside_after = 0;
+  double unit_solves = 0, backward_passes = 0, frames_run = 0;
+  std::vector<double> apply_seconds;
   const auto seconds = TimeEach(state, [&] {
-    frames->model->Deform(*frames->factorization, frames->pose, &frames->scratch);
-    (*constraints)->Apply(*frames->factorization, &frames->scratch, &scratch, &report);
+    frames->model->Deform(*frames->factorization, poses[next], &frames->scratch);
+    next = (next + 1) % poses.size();
+    apply_seconds.push_back(SecondsOf([&] {
+      (*constraints)->Apply(*frames->factorization, &frames->scratch, &scratch, &report);
+    }));
+    most_inside_after = std::max(most_inside_after, report.after.vertices);
+    unit_solves += report.unit_solves;
+    backward_passes += report.backward_passes;
+    ++frames_run;
   });
+  // The same poses' frames without the constraints, on this model: the constraints' own cost
+  // is x_unconstrained.
+  std::vector<double> unconstrained;
+  for (std::size_t f = 0; f < seconds.size(); ++f) {
+    unconstrained.push_back(SecondsOf([&] {
+      frames->model->Deform(*frames->factorization, poses[f % poses.size()], &frames->scratch);
+    }));
+  }
   ReportAgainstBound(state, frames->factorization->factor().bytes(), seconds);
+  state.counters["unconstrained_ms"] = Median(unconstrained) * 1e3;
+  state.counters["x_unconstrained"] = Median(seconds) / Median(unconstrained);
+  state.counters["apply_ms"] = Median(apply_seconds) * 1e3;
+  // The last frame's, and over every frame the most left inside and the mean passes.
   state.counters["inside_before"] = report.before.vertices;
-  state.counters["inside_after"] = report.after.vertices;
+  state.counters["inside_after_max"] = most_inside_after;
   state.counters["contacts"] = report.contacts;
+  state.counters["carried"] = report.carried_contacts;
   state.counters["solves"] = report.solves;
-  state.counters["backward_passes"] = report.backward_passes;
+  state.counters["unit_solves_mean"] = unit_solves / std::max(frames_run, 1.0);
+  state.counters["backward_passes_mean"] = backward_passes / std::max(frames_run, 1.0);
 }
 
 // A whole frame with the constraints and `tool_contacts` tool constraints (0: no tool, the same
@@ -729,8 +765,9 @@ void RegisterBenchmarks(const BenchMesh& mesh) {
   RegisterFor(mesh, "Factorize", BM_Factorize)->Iterations(large ? 2 : 5);
   RegisterNumericFactorization(mesh);
   RegisterFor(mesh, "Frame", BM_Frame)->MinTime(1.0);
-  RegisterFor(mesh, "ConstrainedFrame", BM_ConstrainedFrame, 0)->MinTime(1.0);
-  RegisterFor(mesh, "ConstrainedFrame/degrees:120", BM_ConstrainedFrame, 120)->MinTime(1.0);
+  RegisterFor(mesh, "ConstrainedFrame", BM_ConstrainedFrame, 0, false)->MinTime(1.0);
+  RegisterFor(mesh, "ConstrainedFrame/degrees:120", BM_ConstrainedFrame, 120, false)->MinTime(1.0);
+  RegisterFor(mesh, "ConstrainedFrame/sweep:100-120", BM_ConstrainedFrame, 120, true)->MinTime(1.0);
   for (const int tool_contacts : {0, 64}) {
     RegisterFor(mesh, "ToolFrame/tools:" + std::to_string(tool_contacts), BM_ToolFrame,
                 tool_contacts)

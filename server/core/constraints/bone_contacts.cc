@@ -164,6 +164,26 @@ bool BoneContacts::Into(int surface, int vertex, const double* xyz,
   return true;
 }
 
+void BoneContacts::OutsidePlane(int surface, int vertex, const double* xyz,
+                                const std::vector<RigidTransform>& bones,
+                                BonePenetration* out) const {
+  const Surface& entry = surfaces_[surface];
+  const RigidTransform pose = BoneSurfaceTransform(entry.surface, skeleton_, bones);
+  const Eigen::Vector3d x(xyz[3 * vertex], xyz[3 * vertex + 1], xyz[3 * vertex + 2]);
+  const Eigen::Vector3d local = pose.rotation.conjugate() * (x - pose.translation);
+  const TriangleBvh::SurfacePoint nearest = entry.bvh->ClosestPoint(local);
+  // Outward: from the surface point to the outside point; on the surface, the face's.
+  const double scale = (entry.bvh->upper() - entry.bvh->lower()).norm();
+  const Eigen::Vector3d normal = nearest.distance > 1e-9 * scale
+                                     ? Eigen::Vector3d((local - nearest.point) / nearest.distance)
+                                     : entry.bvh->TriangleNormal(nearest.triangle);
+  out->vertex = vertex;
+  out->surface = surface;
+  out->depth = -nearest.distance;
+  out->normal = pose.rotation * normal;
+  out->surface_point = pose.Apply(nearest.point);
+}
+
 PenetrationSummary BoneContacts::Measure(const Positions& posed,
                                          const std::vector<RigidTransform>& bones) const {
   PenetrationSummary summary;

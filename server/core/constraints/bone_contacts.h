@@ -63,6 +63,12 @@ class BoneContacts {
   bool Into(int surface, int vertex, const double* xyz, const std::vector<RigidTransform>& bones,
             BonePenetration* out) const;
 
+  // For a vertex outside surface `surface` (Into false): the nearest surface point, the outward
+  // normal there, and `depth` minus the distance. For a contact a frame carries over from the
+  // last one (SkinConstraints).
+  void OutsidePlane(int surface, int vertex, const double* xyz,
+                    const std::vector<RigidTransform>& bones, BonePenetration* out) const;
+
   // Find's summary alone, for measuring any method's frame.
   PenetrationSummary Measure(const Positions& posed,
                              const std::vector<RigidTransform>& bones) const;

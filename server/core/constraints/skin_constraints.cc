@@ -26,11 +26,11 @@ double Dot(const double* a, const double* b, std::size_t count) {
   return (sum[0] + sum[1]) + (sum[2] + sum[3]);
 }
 
-// Solves the q-square symmetric positive semi-definite system `a` (row-major, stride `stride`,
-// overwritten by its Cholesky factor) for `x` in place. Pivots are regularised by a tiny multiple
-// of the largest diagonal entry, so a degenerate set (two contacts on one vertex's plane) still
-// gives a solution. No allocation.
-void SolveSymmetric(double* a, int q, int stride, double* x) {
+// Overwrites the q-square symmetric positive semi-definite system `a` (row-major, stride
+// `stride`) by its Cholesky factor. Pivots are regularised by a tiny multiple of the largest
+// diagonal entry, so a degenerate set (two contacts on one vertex's plane) still gives a
+// solution. The factor's leading p-square block is the leading block's factor, for any p <= q.
+void FactorSymmetric(double* a, int q, int stride) {
   double largest = 0;
   for (int i = 0; i < q; ++i) largest = std::max(largest, a[i * stride + i]);
   const double floor = 1e-12 * std::max(largest, 1e-300);
@@ -43,6 +43,10 @@ void SolveSymmetric(double* a, int q, int stride, double* x) {
       row_i[j] = (row_i[j] - Dot(row_i, row_j, j)) / d;
     }
   }
+}
+
+// Solves with the leading q-square block of a FactorSymmetric factor, for `x` in place.
+void SubstituteSymmetric(const double* a, int q, int stride, double* x) {
   for (int i = 0; i < q; ++i) {
     double v = x[i];
     for (int p = 0; p < i; ++p) v -= a[i * stride + p] * x[p];
@@ -53,6 +57,27 @@ void SolveSymmetric(double* a, int q, int stride, double* x) {
     for (int p = i + 1; p < q; ++p) v -= a[p * stride + i] * x[p];
     x[i] = v / a[i * stride + i];
   }
+}
+
+double CubicAt(const double cubic[4], double t) {
+  return cubic[0] + t * (cubic[1] + t * (cubic[2] + t * cubic[3]));
+}
+
+// The root of cubic(t) = target next to `start` (Newton from there), or `start` where the slope
+// vanishes.
+double CubicRoot(const double cubic[4], double target, double start) {
+  double t = start;
+  for (int step = 0; step < 8; ++step) {
+    const double value = CubicAt(cubic, t) - target;
+    const double slope = cubic[1] + t * (2 * cubic[2] + t * 3 * cubic[3]);
+    if (!(std::abs(slope) > 0)) break;
+    const double next = t - value / slope;
+    if (!std::isfinite(next)) break;
+    const bool settled = std::abs(next - t) <= 1e-14 * std::max(1.0, std::abs(t));
+    t = next;
+    if (settled) break;
+  }
+  return t;
 }
 
 // A model's factorization always has a factor, and the column counts are in range: its solves
@@ -152,7 +177,13 @@ ConstraintScratch SkinConstraints::MakeScratch() const {
   const std::size_t rows = rows_;
   const std::size_t k = ContactCapacity();
   s.base.resize(3 * rows);
-  s.correction.resize(3 * rows);
+  // Two combinations of the contacts' forward passes (SkinConstraints::Apply) with the volume.
+  const bool six_columns = keeps_volume_ && k > 0;
+  s.correction.resize((six_columns ? 6 : 3) * rows);
+  if (six_columns) {
+    s.direction.resize(3 * rows);
+    s.shares.resize(k);
+  }
   if (keeps_volume_) {
     s.gradient.resize(3 * rows);
     s.h.resize(3 * rows);
@@ -170,7 +201,8 @@ ConstraintScratch SkinConstraints::MakeScratch() const {
     s.inverse_block.resize(k * k);
     s.in_set.assign(model_->mesh().num_vertices(), 0);
   }
-  s.solve_work.resize(model_->default_factorization()->factor().WorkSize());
+  const CholeskyFactor& factor = model_->default_factorization()->factor();
+  s.solve_work.resize(std::max(factor.WorkSize(), six_columns ? factor.WorkSizeMany(6) : 0));
   s.system.resize((k + 1) * (k + 1));
   s.multipliers.resize(k + 1);
   return s;
@@ -179,16 +211,18 @@ ConstraintScratch SkinConstraints::MakeScratch() const {
 std::size_t SkinConstraints::ScratchBytes() const {
   const std::size_t rows = rows_;
   const std::size_t k = ContactCapacity();
-  std::size_t doubles =
-      6 * rows + (k + 1) * (k + 2) + model_->default_factorization()->factor().WorkSize();
+  const bool six_columns = keeps_volume_ && k > 0;
+  const CholeskyFactor& factor = model_->default_factorization()->factor();
+  std::size_t doubles = 6 * rows + (k + 1) * (k + 2) +
+                        std::max(factor.WorkSize(), six_columns ? factor.WorkSizeMany(6) : 0);
   std::size_t bytes = 0;
   if (keeps_volume_) {
     doubles += 6 * rows + direction_bones_.size() * 3 * rows;
     bytes += model_->skeleton().num_bones() * sizeof(Eigen::Matrix3d);
   }
+  if (six_columns) doubles += 6 * rows + k;
   if (k > 0) {
-    doubles +=
-        model_->default_factorization()->factor().UnitSolvesWorkSize() + k * path_columns_ + k * k;
+    doubles += factor.UnitSolvesWorkSize() + k * path_columns_ + k * k;
     bytes += (k * path_supernodes_ + 2 * k) * sizeof(int) + k * sizeof(BonePenetration) +
              k * sizeof(HeldContact) + model_->mesh().num_vertices();
   }
@@ -326,15 +360,29 @@ bool SkinConstraints::Apply(const MaterialFactorization& factorization, DeformSc
     return rest_volume_ != 0 ? volume / rest_volume_ - 1 : 0.0;
   };
   int& set = report->contacts;
+  // The last frame's bone contacts, when it had this factorization.
+  int carried = 0;
+  if (s->kept > 0) {
+    if (s->kept_serial == factorization.serial()) {
+      carried = s->kept;
+    } else {
+      for (int j = 0; j < s->kept; ++j) --s->in_set[s->contacts[j].at.vertex];
+    }
+    s->kept = 0;
+  }
+  set = carried;
   // The volume of x when a round already knows it (the cubic's value at its mu); NaN otherwise.
   double known_volume = std::numeric_limits<double>::quiet_NaN();
   double cubic[4] = {0, 0, 0, 0};
-  if (keeps_volume_) {
-    PoseVolumeDirections(factorization, frame->bone_transforms, s, report);
-    // Along x* + mu M^-1 g: its value at mu = 0 is the volume of x*.
+  // The volume along x* + mu M^-1 g (its value at mu = 0 the volume of x*), once a round needs
+  // it: a frame without contacts, in its first round.
+  bool cubic_known = false;
+  auto need_cubic = [&] {
+    if (cubic_known) return;
     closure_->VolumeAlong(s->base.data(), s->h.data(), cubic);
-    known_volume = cubic[0];
-  }
+    cubic_known = true;
+  };
+  if (keeps_volume_) PoseVolumeDirections(factorization, frame->bone_transforms, s, report);
   for (int round = 0;; ++round) {
     // The contacts each kind holds now (a tool contact may have taken a bone's plane).
     int bone_held = 0;
@@ -342,17 +390,38 @@ bool SkinConstraints::Apply(const MaterialFactorization& factorization, DeformSc
     const int tool_held = set - bone_held;
     PenetrationSummary summary;
     int found = 0;
-    const int bone_capacity = std::max(0, std::min(bone_bound - bone_held, k_max - set));
     if (bones_ != nullptr) {
-      found = bones_->Find(x, frame->bone_transforms, s->found.data(), bone_capacity, &summary,
+      const int capacity = std::max(0, std::min(bone_bound - bone_held, k_max - set));
+      found = bones_->Find(x, frame->bone_transforms, s->found.data(), capacity, &summary,
                            s->in_set.empty() ? nullptr : s->in_set.data());
+      if (round == 0 && carried > 0 && found == capacity && summary.vertices > found) {
+        // More skin inside than the bound leaves room for: the carried contacts whose vertex is
+        // outside its bone give their slots back, and the search runs again.
+        for (int j = carried - 1; j >= 0; --j) {
+          BonePenetration inside;
+          const HeldContact& held = s->contacts[j];
+          if (bones_->Into(held.at.surface, held.at.vertex, x, frame->bone_transforms, &inside)) {
+            continue;
+          }
+          --s->in_set[held.at.vertex];
+          if (j != set - 1) MoveContact(set - 1, j, set, s);
+          --set;
+          --carried;
+        }
+        bone_held = set;
+        const int room = std::max(0, std::min(bone_bound - bone_held, k_max - set));
+        found = bones_->Find(x, frame->bone_transforms, s->found.data(), room, &summary,
+                             s->in_set.data());
+      }
     }
-    // The held bone contacts, one test of each against its own bone. One still inside (its plane
-    // was tangent where the surface curves away) is held on the tangent plane at its new nearest
-    // point. One the solve pushed into another bone (skin caught between two bones) gets a second
-    // contact, on that bone's plane, and keeps the first: holding it on one plane at a time sends
-    // it back and forth between the two.
+    // The held bone contacts. One still inside its bone (its plane was tangent where the
+    // surface curves away) is held on the tangent plane at its new nearest point. One outside it:
+    // carried from the last frame, its plane at its nearest point now (its multiplier says
+    // whether the frame needs it); pushed into another bone (skin caught between two bones), a
+    // second contact there, keeping the first, since holding it on one plane at a time sends it
+    // back and forth between the two.
     int refreshed = 0;
+    const int bone_capacity = std::max(0, std::min(bone_bound - bone_held, k_max - set));
     for (int j = 0; j < set; ++j) {
       HeldContact& held = s->contacts[j];
       if (held.kind != ObstacleKind::kBone) continue;
@@ -362,6 +431,11 @@ bool SkinConstraints::Apply(const MaterialFactorization& factorization, DeformSc
         held.at.surface_point = now.surface_point;
         ++refreshed;
         continue;
+      }
+      if (round == 0 && j < carried) {
+        bones_->OutsidePlane(held.at.surface, held.at.vertex, x, frame->bone_transforms, &now);
+        held.at.normal = now.normal;
+        held.at.surface_point = now.surface_point;
       }
       if (found >= bone_capacity ||
           !bones_->Deepest(held.at.vertex, x, frame->bone_transforms, &now)) {
@@ -387,6 +461,10 @@ bool SkinConstraints::Apply(const MaterialFactorization& factorization, DeformSc
                                         &tool_summary, s->in_set.data());
     }
     for (int c = 0; c < found; ++c) --s->in_set[s->found[c].vertex];
+    if (keeps_volume_ && round == 0 && set == 0 && found == 0 && tool_found == 0) {
+      need_cubic();
+      known_volume = cubic[0];
+    }
     const double volume = std::isnan(known_volume) ? closure_->Volume(x) : known_volume;
     known_volume = std::numeric_limits<double>::quiet_NaN();
     if (round == 0) {
@@ -420,8 +498,13 @@ bool SkinConstraints::Apply(const MaterialFactorization& factorization, DeformSc
         round == options_.max_rounds) {
       break;
     }
-    for (int c = 0; c < found + tool_found; ++c) ++s->in_set[s->found[c].vertex];
-    if (found > 0) AddContacts(factor, found, ObstacleKind::kBone, s, report);
+    // With carried contacts, the first solve holds those alone: the skin they push out takes
+    // its neighbours along, and the next round adds only what is still inside (adding every
+    // vertex found at x* makes forward passes for contacts that then leave, every frame).
+    const int bone_added = round == 0 && set > 0 && carried > 0 ? 0 : found;
+    for (int c = 0; c < bone_added; ++c) ++s->in_set[s->found[c].vertex];
+    for (int c = found; c < found + tool_found; ++c) ++s->in_set[s->found[c].vertex];
+    if (bone_added > 0) AddContacts(factor, bone_added, ObstacleKind::kBone, s, report);
     if (tool_found > 0) {
       std::copy_n(s->found.begin() + found, tool_found, s->found.begin());
       AddContacts(factor, tool_found, ObstacleKind::kTool, s, report);
@@ -464,7 +547,8 @@ bool SkinConstraints::Apply(const MaterialFactorization& factorization, DeformSc
         s->multipliers[set] = volume_target;
       }
       if (q == 0) break;
-      SolveSymmetric(s->system.data(), q, stride, s->multipliers.data());
+      FactorSymmetric(s->system.data(), q, stride);
+      SubstituteSymmetric(s->system.data(), q, stride, s->multipliers.data());
       mu = volume_row ? s->multipliers[set] : 0;
       // Drop every contact with a negative multiplier (from the end, swapping in the last).
       bool dropped = false;
@@ -484,60 +568,105 @@ bool SkinConstraints::Apply(const MaterialFactorization& factorization, DeformSc
 
     // x = x* + M^-1 sum_j lambda_j e_{i_j} n_j^T + mu M^-1 g.
     std::copy(s->base.begin(), s->base.end(), x);
+    // With contacts and the volume row, the linearised mu leaves a fifth of a large volume
+    // change, and a step along h alone would move the contacts off their planes. Along
+    // d = h - M^-1 N nu, with A nu = N^T h (A the contact block, N the contacts' normals at their
+    // vertices), the contacts stay on their planes (N^T d = 0), and x0 = x* + M^-1 N lambda0 with
+    // lambda0 = lambda + mu nu holds them with the volume row's share taken out: the volume along
+    // x0 + t d is a cubic in t, whose root next to mu keeps the rest volume exactly. Both
+    // combinations are one six-column backward pass. The active set is the linearised row's: a
+    // multiplier lambda0 - t nu that the exact t turns slightly negative holds its contact for
+    // this frame, and the next frame, starting from it, drops it.
+    const bool along_contacts = volume_row && set > 0;
+    if (along_contacts) {
+      for (int l = 0; l < set; ++l) {
+        const BonePenetration& cl = s->contacts[l].at;
+        s->shares[l] = cl.normal.dot(Vec3(s->h.data() + 3 * cl.vertex));
+      }
+      SubstituteSymmetric(s->system.data(), set, stride, s->shares.data());
+      for (int l = 0; l < set; ++l) s->multipliers[l] += mu * s->shares[l];
+    }
     if (set > 0) {
       // M^-1 e_i = P^T L^-T y_i: the contacts' forward passes are known, so the correction is
       // the backward pass of sum_j lambda_j y_j n_j^T (on their paths), half a solve.
-      std::fill(s->correction.begin(), s->correction.end(), 0.0);
+      const int width = along_contacts ? 6 : 3;
+      std::fill_n(s->correction.begin(), width * rows_, 0.0);
       for (int j = 0; j < set; ++j) {
         const BonePenetration& c = s->contacts[j].at;
         const Eigen::Vector3d weight = s->multipliers[j] * c.normal;
+        const Eigen::Vector3d share =
+            along_contacts ? Eigen::Vector3d(s->shares[j] * c.normal) : Eigen::Vector3d::Zero();
         const int* path = s->paths.data() + static_cast<std::size_t>(j) * path_supernodes_;
         const double* y = s->path_values.data() + static_cast<std::size_t>(j) * path_columns_;
         for (int p = 0; p < s->path_lengths[j]; ++p) {
-          const int width = factor.SupernodeWidth(path[p]);
-          double* z = s->correction.data() + 3 * factor.SupernodeFirstColumn(path[p]);
-          for (int q = 0; q < width; ++q) {
-            z[3 * q] += weight.x() * y[q];
-            z[3 * q + 1] += weight.y() * y[q];
-            z[3 * q + 2] += weight.z() * y[q];
+          const int columns = factor.SupernodeWidth(path[p]);
+          double* z = s->correction.data() +
+                      static_cast<std::size_t>(width) * factor.SupernodeFirstColumn(path[p]);
+          for (int q = 0; q < columns; ++q) {
+            double* zq = z + width * q;
+            zq[0] += weight.x() * y[q];
+            zq[1] += weight.y() * y[q];
+            zq[2] += weight.z() * y[q];
+            if (along_contacts) {
+              zq[3] += share.x() * y[q];
+              zq[4] += share.y() * y[q];
+              zq[5] += share.z() * y[q];
+            }
           }
-          y += width;
+          y += columns;
         }
       }
-      Solved(
-          factor.SolveBackward3(s->correction.data(), s->correction.data(), s->solve_work.data()));
       ++report->backward_passes;
-      for (std::size_t v = 0; v < values; ++v) x[v] += s->correction[v];
-    }
-    if (volume_row && set == 0) {
-      // The volume alone: along x* + mu h it is a cubic in mu, so take its root next to the
-      // linearised mu (Newton on the cubic) and the volume is kept in this round, not the next.
-      auto cubic_at = [&](double t) {
-        return cubic[0] + t * (cubic[1] + t * (cubic[2] + t * cubic[3]));
-      };
-      for (int step = 0; step < 8; ++step) {
-        const double value = cubic_at(mu) - rest_volume_;
-        const double slope = cubic[1] + mu * (2 * cubic[2] + mu * 3 * cubic[3]);
-        if (!(std::abs(slope) > 0)) break;
-        const double next = mu - value / slope;
-        if (!std::isfinite(next)) break;
-        const bool settled = std::abs(next - mu) <= 1e-14 * std::max(1.0, std::abs(mu));
-        mu = next;
-        if (settled) break;
+      if (along_contacts) {
+        Solved(factor.SolveBackwardMany(s->correction.data(), s->correction.data(), 6,
+                                        s->solve_work.data()));
+        const double* c = s->correction.data();
+        for (int r = 0; r < rows_; ++r) {
+          for (int k = 0; k < 3; ++k) {
+            x[3 * r + k] += c[6 * r + k];
+            s->direction[3 * r + k] = s->h[3 * r + k] - c[6 * r + 3 + k];
+          }
+        }
+      } else {
+        Solved(factor.SolveBackward3(s->correction.data(), s->correction.data(),
+                                     s->solve_work.data()));
+        for (std::size_t v = 0; v < values; ++v) x[v] += s->correction[v];
       }
-      known_volume = cubic_at(mu);
     }
-    if (volume_row) {
+    if (along_contacts) {
+      double along[4];
+      closure_->VolumeAlong(x, s->direction.data(), along);
+      const double t = CubicRoot(along, rest_volume_, mu);
+      for (std::size_t v = 0; v < values; ++v) x[v] += t * s->direction[v];
+      known_volume = CubicAt(along, t);
+    } else if (volume_row) {
+      // The volume alone: along x* + mu h it is a cubic in mu, so take its root next to the
+      // linearised mu and the volume is kept in this round, not the next.
+      need_cubic();
+      mu = CubicRoot(cubic, rest_volume_, mu);
+      known_volume = CubicAt(cubic, mu);
       for (std::size_t v = 0; v < values; ++v) x[v] += mu * s->h[v];
     }
     ++report->rounds;
   }
   report->unresolved = report->after.vertices > 0;
   report->tools_unresolved = report->tool_after.vertices > 0;
-  for (int j = 0; j < set; ++j) {
-    report->tool_contacts += s->contacts[j].kind == ObstacleKind::kTool;
-    s->in_set[s->contacts[j].at.vertex] = 0;
+  report->carried_contacts = carried;
+  // The bone contacts stay for the next frame; the tool contacts leave (a tool moves on its own).
+  for (int j = set - 1; j >= 0; --j) {
+    if (s->contacts[j].kind != ObstacleKind::kTool) continue;
+    ++report->tool_contacts;
+    --s->in_set[s->contacts[j].at.vertex];
+    if (j != set - 1) MoveContact(set - 1, j, set, s);
+    --set;
   }
+  s->kept = set;
+  s->kept_serial = factorization.serial();
+  // Contacts of the last solve; none when the frame needed no solve.
+  if (report->rounds == 0)
+    report->contacts = 0;
+  else
+    report->contacts += report->tool_contacts;
   return true;
 }
 

@@ -13,7 +13,11 @@
 // rigid zones, zero on them), so that its direction in the solve's metric is
 // M^-1 g = sum_k D_k R_k^T with D_k = M^-1 (h_k g_rest) solved once per stream and factorization:
 // no solve per frame. Without contacts the volume along x* + mu M^-1 g is a cubic in mu, solved
-// exactly, so the volume is kept in one round.
+// exactly, so the volume is kept in one round. With contacts the linearised row decides which
+// contacts stay, and the step is exact along d = M^-1 g - M^-1 N nu (A nu = N^T M^-1 g, A the
+// contacts' block, N their normals), which leaves every contact on its plane (N^T d = 0): the
+// volume along it is a cubic again. The contacts' correction and d's are one six-column backward
+// pass (CholeskyFactor::SolveBackwardMany), so a frame whose contacts hold needs one round.
 //
 // With M = A^T A = P^T L L^T P, the one factorization: x = x* + sum_j lambda_j M^-1 e_{i_j} n_j^T +
 // mu M^-1 g. The contacts need (M^-1)_{i_l i_j} = y_l . y_j with y_j = L^-1 P e_{i_j}, each a
@@ -27,6 +31,13 @@
 // plane of its new nearest point. A vertex is held out of the deeper bone first; one the solve
 // then pushes into another bone gets a second contact, there, so skin caught between two bones is
 // held out of both.
+//
+// A scratch carries a frame's bone contacts into the next frame (a stream's frames follow each
+// other): y_j and the inverse block depend only on the vertex and the factorization, so a contact
+// that persists costs no forward pass again. Each carried contact starts with its plane at the
+// new frame's nearest bone point, inside or not; one the frame does not need gets a negative
+// multiplier and leaves. The solution is the same optimum as a fresh active set's up to where a
+// plane was taken; a new factorization (a stiffness change) drops them.
 //
 // Bones and tools (tools.h) are both obstacles of that one active set, each contact tagged with
 // its kind: a skin vertex inside a tool is held on the tool's tangent plane at its nearest surface
@@ -95,7 +106,10 @@ struct ConstraintReport {
   int rounds = 0;             // constrained solves
   int solves = 0;             // three-column solves with the factor (a frame's is one)
   int backward_passes = 0;    // backward halves of a solve (SolveBackward3), one a round
-  int unit_solves = 0;        // unit right-hand sides (ForwardUnitSolves), one a contact
+  int unit_solves = 0;        // unit right-hand sides (ForwardUnitSolves), one a new contact
+  // Bone contacts carried over from the scratch's last frame (their forward passes and products
+  // kept, not redone).
+  int carried_contacts = 0;
   // Vertices left inside a bone (more contacts than max_contacts, or rounds exhausted).
   bool unresolved = false;
   double volume_change_before = 0;  // (V - V_rest) / V_rest
@@ -129,10 +143,14 @@ struct ConstraintScratch {
   std::vector<double> bone_directions;
   std::uint64_t directions_serial = 0;
   std::vector<Eigen::Matrix3d> rotations;  // the frame's bone rotations, K
-  std::vector<double> correction;          // right-hand side, then M^-1 sum lambda_j e_{i_j} n_j^T
-  std::vector<double> unit_work;           // ForwardUnitSolves', zeros
-  std::vector<int> unit_columns;           // a round's new contacts' vertices
-  std::vector<int> paths;  // per contact, its path's supernodes (path_supernodes each)
+  // Right-hand side, then M^-1 sum lambda_j e_{i_j} n_j^T; with the volume, beside it (six
+  // columns a row) M^-1 sum nu_j e_{i_j} n_j^T.
+  std::vector<double> correction;
+  std::vector<double> direction;  // d = h - M^-1 N nu, the volume's step that keeps the contacts
+  std::vector<double> shares;     // nu: A nu = N^T h, the contacts' share of the volume's step
+  std::vector<double> unit_work;  // ForwardUnitSolves', zeros
+  std::vector<int> unit_columns;  // a round's new contacts' vertices
+  std::vector<int> paths;         // per contact, its path's supernodes (path_supernodes each)
   std::vector<int> path_lengths;
   std::vector<double> path_values;  // per contact, y on its path (path_columns each)
   std::vector<double> solve_work;
@@ -143,6 +161,9 @@ struct ConstraintScratch {
   std::vector<double> multipliers;    // its right-hand side, then lambda and mu
   // Per vertex: the contacts that hold it, at most one a bone surface (BoneSurfaceLimits: 64).
   std::vector<char> in_set;
+  // The last frame's bone contacts, contacts[0, kept), for its factorization's serial.
+  int kept = 0;
+  std::uint64_t kept_serial = 0;
   const void* owner = nullptr;
 };
 

@@ -184,6 +184,18 @@ Status CholeskyFactor::SolveBackward3(const double* z, double* x, double* work) 
   return Status::Ok();
 }
 
+Status CholeskyFactor::SolveBackwardMany(const double* z, double* x, int columns,
+                                         double* work) const {
+  if (!symbolic_) return Status::FailedPrecondition("the Cholesky factor is empty");
+  if (columns < 1 || columns > kMaxSolveColumns) {
+    return Status::InvalidArgument("a backward pass takes 1 to " +
+                                   std::to_string(kMaxSolveColumns) + " columns, not " +
+                                   std::to_string(columns));
+  }
+  SolveKernelFunctionsFor(BestSolveKernel()).solve_backward_many(View(), z, x, columns, work);
+  return Status::Ok();
+}
+
 std::size_t CholeskyFactor::WorkSizeMany(int columns) const {
   return symbolic_ ? static_cast<std::size_t>(SolveManyWorkSize(symbolic_->n_, columns)) : 0;
 }

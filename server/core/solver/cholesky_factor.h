@@ -126,6 +126,11 @@ class CholeskyFactor {
   // costs one pass once the forward passes y_j are known (ForwardUnitSolve). `x` may equal `z`;
   // `work` holds WorkSize() doubles.
   Status SolveBackward3(const double* z, double* x, double* work) const;
+  // SolveBackward3 for `columns` columns (1 to kMaxSolveColumns, z[columns * c + k]), all in one
+  // pass over the factor: two combinations of the same forward passes cost one read of it. `x`
+  // may equal `z`; `work` holds WorkSizeMany(columns) doubles. INVALID_ARGUMENT for a column
+  // count out of range.
+  Status SolveBackwardMany(const double* z, double* x, int columns, double* work) const;
   // Supernode s's first column (in the factor's order).
   int SupernodeFirstColumn(int s) const;
   // The most columns and the most supernodes on one path (what ForwardUnitSolve may write).

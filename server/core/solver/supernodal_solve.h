@@ -75,6 +75,11 @@ using SolveManyFunction = void (*)(const SupernodalFactorView& factor, const dou
 // arrays of their own, interleaved (b[f][3 i + c]): gathered into the batch and scattered back
 // in the same passes that apply the permutation, with no packed copy. x[f] may equal b[f]; `work`
 // holds SolveManyWorkSize(size, 3 * frames) doubles.
+// The backward pass alone for `columns` (1 to kMaxSolveColumns) columns z given in the factor's
+// order (z[columns * c + k], c a column of L): x = P^T L^-T z, stored by rows as SolveMany's. `x`
+// may equal `z`; `work` holds SolveManyWorkSize() doubles. Allocates nothing.
+using SolveBackwardManyFunction = void (*)(const SupernodalFactorView& factor, const double* z,
+                                           double* x, int columns, double* work);
 using SolveFramesFunction = void (*)(const SupernodalFactorView& factor, const double* const* b,
                                      double* const* x, int frames, double* work);
 
@@ -152,6 +157,7 @@ struct SolveKernelFunctions {
   SupernodeListManyPass forward_list_many;
   SupernodeListManyPass backward_list_many;
   Solve3Function solve_backward3;  // x = P^T L^-T z, z in the factor's order
+  SolveBackwardManyFunction solve_backward_many;
 };
 // The kernel's passes; it must be available.
 const SolveKernelFunctions& SolveKernelFunctionsFor(SolveKernel kernel);

@@ -227,6 +227,30 @@ TEST_P(SparseCholeskyTest, TheBackwardHalfOfForwardUnitSolvesIsTheSolve) {
   }
   EXPECT_GT(largest, 0);
   EXPECT_LT(difference, 1e-12 * largest);
+  // Two combinations in one pass (SolveBackwardMany, six columns): each half as its own
+  // SolveBackward3.
+  std::vector<double> doubled(3 * n), twice(6 * n), many_work(factor->WorkSizeMany(6));
+  for (int v = 0; v < 3 * n; ++v) doubled[v] = -2 * z[v] + 1e-3 * v;
+  for (int r = 0; r < n; ++r) {
+    for (int c = 0; c < 3; ++c) {
+      twice[6 * r + c] = z[3 * r + c];
+      twice[6 * r + 3 + c] = doubled[3 * r + c];
+    }
+  }
+  std::vector<double> second(3 * n);
+  ASSERT_TRUE(factor->SolveBackward3(doubled.data(), second.data(), work.data()).ok());
+  ASSERT_TRUE(factor->SolveBackwardMany(twice.data(), twice.data(), 6, many_work.data()).ok());
+  double many_difference = 0;
+  for (int r = 0; r < n; ++r) {
+    for (int c = 0; c < 3; ++c) {
+      many_difference = std::max(many_difference, std::abs(twice[6 * r + c] - halved[3 * r + c]));
+      many_difference =
+          std::max(many_difference, std::abs(twice[6 * r + 3 + c] - second[3 * r + c]));
+    }
+  }
+  EXPECT_LT(many_difference, 1e-12 * largest);
+  EXPECT_EQ(factor->SolveBackwardMany(twice.data(), twice.data(), 0, many_work.data()).code(),
+            StatusCode::kInvalidArgument);
 }
 
 TEST_P(SparseCholeskyTest, TwoThreadsFactorizeExactlyAsOne) {

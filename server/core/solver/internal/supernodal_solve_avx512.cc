@@ -8,7 +8,8 @@ namespace deform {
 // Declared (and picked) in supernodal_solve.cc.
 extern const SolveKernelFunctions kAvx512SolveKernel;
 const SolveKernelFunctions kAvx512SolveKernel = {
-    &Solve3Impl, &SolveManyImpl,       &SolveFramesImpl,      &ForwardListImpl,   &BackwardListImpl,
-    kBatchLanes, &ForwardListManyImpl, &BackwardListManyImpl, &SolveBackward3Impl};
+    &Solve3Impl,         &SolveManyImpl,        &SolveFramesImpl,     &ForwardListImpl,
+    &BackwardListImpl,   kBatchLanes,           &ForwardListManyImpl, &BackwardListManyImpl,
+    &SolveBackward3Impl, &SolveBackwardManyImpl};
 
 }  // namespace deform

@@ -6,7 +6,8 @@ namespace deform {
 // Declared (and picked) in supernodal_solve.cc.
 extern const SolveKernelFunctions kBaselineSolveKernel;
 const SolveKernelFunctions kBaselineSolveKernel = {
-    &Solve3Impl, &SolveManyImpl,       &SolveFramesImpl,      &ForwardListImpl,   &BackwardListImpl,
-    kBatchLanes, &ForwardListManyImpl, &BackwardListManyImpl, &SolveBackward3Impl};
+    &Solve3Impl,         &SolveManyImpl,        &SolveFramesImpl,     &ForwardListImpl,
+    &BackwardListImpl,   kBatchLanes,           &ForwardListManyImpl, &BackwardListManyImpl,
+    &SolveBackward3Impl, &SolveBackwardManyImpl};
 
 }  // namespace deform

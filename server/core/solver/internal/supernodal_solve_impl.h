@@ -1252,6 +1252,37 @@ void BackwardListManyImpl(const SupernodalFactorView& f, const int* supernodes, 
   });
 }
 
+// The backward pass alone on `columns` columns given in the factor's order (SolveBackwardMany):
+// one pass over the factor for all of them, as SolveManyImpl's second half.
+void SolveBackwardManyImpl(const SupernodalFactorView& f, const double* z, double* x, int columns,
+                           double* work) {
+  WithBatchShape(f, columns, [&](auto vecs, auto value) {
+    using Value = decltype(value);
+    constexpr int kStride = kBatchLanes * decltype(vecs)::value;
+    const int n = f.size;
+    double* __restrict y = AlignedTo(work, kBatchLanes);
+    for (int column = 0; column < n; ++column) {
+      const double* source = z + static_cast<std::ptrdiff_t>(columns) * column;
+      double* t = y + kStride * static_cast<std::ptrdiff_t>(column);
+      for (int c = 0; c < columns; ++c) t[c] = source[c];
+      for (int c = columns; c < kStride; ++c) t[c] = 0;
+    }
+    for (int sn = f.num_supernodes - 1; sn >= 0; --sn) {
+      BackwardSupernodeMany<Value, decltype(vecs)::value>(BlockOf<Value>(f, sn), y);
+    }
+    for (int unknown = 0; unknown < n; ++unknown) {
+      const double* t = y + kStride * static_cast<std::ptrdiff_t>(f.inverse_permutation[unknown]);
+      if (unknown + kBatchRowsAhead < n) {
+        PrefetchBatchRow(y + kStride * static_cast<std::ptrdiff_t>(
+                                           f.inverse_permutation[unknown + kBatchRowsAhead]),
+                         kStride);
+      }
+      double* target = x + static_cast<std::ptrdiff_t>(columns) * unknown;
+      for (int c = 0; c < columns; ++c) target[c] = t[c];
+    }
+  });
+}
+
 }  // namespace
 }  // namespace deform
 
