@@ -301,11 +301,13 @@ void SkinConstraints::PoseVolumeDirections(const MaterialFactorization& factoriz
   const std::size_t rows = rows_;
   const int n = model_->mesh().num_vertices();
   const int directions = static_cast<int>(direction_bones_.size());
+  const BoneWeights& weights = model_->bone_weights();
   if (s->directions_serial != factorization.serial()) {
-    // D_k = M^-1 (h_k g_rest) for this factorization: once per stream and stiffness.
-    const BoneWeights& weights = model_->bone_weights();
+    // D_k = M^-1 (h_k g_rest) for this factorization: once per stream and stiffness. Each is
+    // solved in s->h, then laid out by rows (row r's D_k side by side), so that posing them is
+    // one pass over the rows.
     for (int d = 0; d < directions; ++d) {
-      double* column = s->bone_directions.data() + d * 3 * rows;
+      double* column = s->h.data();
       std::fill(column, column + 3 * rows, 0.0);
       for (int i = 0; i < n; ++i) {
         for (int e = weights.offsets[i]; e < weights.offsets[i + 1]; ++e) {
@@ -316,29 +318,32 @@ void SkinConstraints::PoseVolumeDirections(const MaterialFactorization& factoriz
       }
       Solved(factorization.factor().Solve3(column, column, s->solve_work.data()));
       ++report->solves;
+      for (std::size_t r = 0; r < rows; ++r) {
+        std::copy_n(column + 3 * r, 3, s->bone_directions.data() + 3 * (r * directions + d));
+      }
     }
     s->directions_serial = factorization.serial();
   }
-  // g = sum_k h_ik R_k g_rest_i and its direction M^-1 g = sum_k D_k R_k^T, by rows.
-  const BoneWeights& weights = model_->bone_weights();
+  // g = sum_k h_ik R_k g_rest_i and its direction M^-1 g = sum_k D_k R_k^T, by rows. The rows of
+  // g outside the free vertices stay zero (MakeScratch).
   for (std::size_t k = 0; k < bones.size(); ++k) {
     s->rotations[k] = bones[k].rotation.toRotationMatrix();
   }
-  std::fill(s->gradient.begin(), s->gradient.end(), 0.0);
   for (int i : free_vertices_) {
     const Vec3 g(rest_gradient_.data() + 3 * i);
-    Eigen::Map<Eigen::Vector3d> posed(s->gradient.data() + 3 * i);
+    Eigen::Vector3d posed = Eigen::Vector3d::Zero();
     for (int e = weights.offsets[i]; e < weights.offsets[i + 1]; ++e) {
       posed += weights.weights[e] * (s->rotations[weights.bones[e]] * g);
     }
+    Eigen::Map<Eigen::Vector3d>(s->gradient.data() + 3 * i) = posed;
   }
-  std::fill(s->h.begin(), s->h.end(), 0.0);
-  for (int d = 0; d < directions; ++d) {
-    const Eigen::Matrix3d& rotation = s->rotations[direction_bones_[d]];
-    const double* column = s->bone_directions.data() + d * 3 * rows;
-    for (std::size_t r = 0; r < rows; ++r) {
-      Eigen::Map<Eigen::Vector3d>(s->h.data() + 3 * r) += rotation * Vec3(column + 3 * r);
+  const double* column = s->bone_directions.data();
+  for (std::size_t r = 0; r < rows; ++r) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (int d = 0; d < directions; ++d, column += 3) {
+      sum += s->rotations[direction_bones_[d]] * Vec3(column);
     }
+    Eigen::Map<Eigen::Vector3d>(s->h.data() + 3 * r) = sum;
   }
 }
 

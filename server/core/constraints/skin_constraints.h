@@ -138,8 +138,9 @@ struct ConstraintScratch {
   std::vector<double> base;      // x*, (n + m) by 3
   std::vector<double> gradient;  // g, (n + m) by 3 (zero on the joint nodes' and rigid rows)
   std::vector<double> h;         // M^-1 g
-  // D_k = M^-1 (h_k g_rest) per bone that weighs a free vertex, (n + m) by 3 each, for the
-  // factorization with this serial (MaterialFactorization::serial; 0: none yet).
+  // D_k = M^-1 (h_k g_rest) per bone that weighs a free vertex, (n + m) by 3 each, by rows (row
+  // r of every D_k side by side), for the factorization with this serial
+  // (MaterialFactorization::serial; 0: none yet).
   std::vector<double> bone_directions;
   std::uint64_t directions_serial = 0;
   std::vector<Eigen::Matrix3d> rotations;  // the frame's bone rotations, K
