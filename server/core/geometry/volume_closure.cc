@@ -123,13 +123,13 @@ void AddTripleCubic(const Eigen::Vector3d& a0, const Eigen::Vector3d& a1, const 
 
 }  // namespace
 
-void VolumeClosure::VolumeAlong(const double* xyz, const double* direction, double c[4]) const {
-  c[0] = c[1] = c[2] = c[3] = 0;
-  // Plain arithmetic: this pass runs every frame that keeps the volume (about the cost of a small
-  // mesh's solve), so it is written for the compiler to keep in registers.
+namespace {
+
+// The mesh triangles' share of VolumeAlong (times 6): plain arithmetic, written for the compiler
+// to keep in registers, since this pass runs every frame that keeps the volume.
+inline void TriangleCubic(const int* t, int faces, const double* xyz, const double* direction,
+                          double c[4]) {
   double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
-  const int* t = triangles_.data();
-  const int faces = static_cast<int>(triangles_.rows());
   for (int f = 0; f < faces; ++f) {
     const double* a0 = xyz + 3 * t[3 * f];
     const double* b0 = xyz + 3 * t[3 * f + 1];
@@ -159,6 +159,37 @@ void VolumeClosure::VolumeAlong(const double* xyz, const double* direction, doub
   c[1] = s1;
   c[2] = s2;
   c[3] = s3;
+}
+
+#if defined(__x86_64__) && defined(__GNUC__)
+// The same with fused multiply-adds where the CPU has them: each cross product and dot is about
+// half the instructions.
+__attribute__((target("avx2,fma"))) void TriangleCubicFma(const int* t, int faces,
+                                                          const double* xyz,
+                                                          const double* direction, double c[4]) {
+  TriangleCubic(t, faces, xyz, direction, c);
+}
+
+bool HasAvx2Fma() {
+  static const bool has = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  return has;
+}
+#endif
+
+}  // namespace
+
+void VolumeClosure::VolumeAlong(const double* xyz, const double* direction, double c[4]) const {
+  const int* t = triangles_.data();
+  const int faces = static_cast<int>(triangles_.rows());
+#if defined(__x86_64__) && defined(__GNUC__)
+  if (HasAvx2Fma()) {
+    TriangleCubicFma(t, faces, xyz, direction, c);
+  } else {
+    TriangleCubic(t, faces, xyz, direction, c);
+  }
+#else
+  TriangleCubic(t, faces, xyz, direction, c);
+#endif
   for (const Loop& loop : loops_) {
     double centroid[3], moved[3];
     Centroid(xyz, loop, centroid);
