@@ -131,6 +131,7 @@ class ServiceContext {
       {LogBudget(kRefusalLinesPerSecond, kRefusalLineBurst),
        LogBudget(kRefusalLinesPerSecond, kRefusalLineBurst),
        LogBudget(kRefusalLinesPerSecond, kRefusalLineBurst),
+       LogBudget(kRefusalLinesPerSecond, kRefusalLineBurst),
        LogBudget(kRefusalLinesPerSecond, kRefusalLineBurst)}};
 };
 

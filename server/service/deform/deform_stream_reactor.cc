@@ -199,6 +199,9 @@ class DeformStreamReactor final : public StreamHandler,
   std::uint64_t poses_rejected_ DEFORM_GUARDED_BY(mutex_) = 0;
   bool reading_paused_ DEFORM_GUARDED_BY(mutex_) = false;
   bool revoked_ DEFORM_GUARDED_BY(mutex_) = false;  // its token was revoked or changed
+  // The call was cancelled: by the client, or by its connection ending (a keepalive ping left
+  // unanswered), which may come after the failed read has finished the stream OK.
+  bool cancelled_ DEFORM_GUARDED_BY(mutex_) = false;
 };
 
 void DeformStreamReactor::OnReadDone(bool ok) {
@@ -621,6 +624,7 @@ void DeformStreamReactor::OnWriteDone(bool ok) {
 
 void DeformStreamReactor::OnCancel() {
   MutexLock lock(&mutex_);
+  cancelled_ = true;
   pump_.RequestFinish(grpc::Status(grpc::StatusCode::CANCELLED, "cancelled by the client"));
   pump_.Pump();
 }
@@ -659,10 +663,16 @@ void DeformStreamReactor::OnDone() {
   {
     MutexLock lock(&mutex_);
     const grpc::Status& status = pump_.finish_status();
+    // A read that fails because the connection died finishes OK; the cancel that follows says
+    // what happened.
+    const std::string outcome =
+        !status.ok() ? EscapeControlBytes(status.error_message())
+        : cancelled_ ? std::string("cancelled: the client or its connection went away")
+                     : std::string("OK");
     spdlog::info(
         "{} closed ({}): {} frames written ({} unresolved), {} poses rejected, {} notices dropped",
-        log_context_, status.ok() ? std::string("OK") : EscapeControlBytes(status.error_message()),
-        frames_written_, frames_unresolved_, poses_rejected_, outbox_.notices_dropped());
+        log_context_, outcome, frames_written_, frames_unresolved_, poses_rejected_,
+        outbox_.notices_dropped());
   }
   ReleaseTransportReference();  // last: may free the reactor
 }

@@ -154,6 +154,8 @@ const char* ServiceMetrics::RefusalName(Refusal reason) {
       return "http_host_or_origin";
     case Refusal::kHttpTooLarge:
       return "http_too_large";
+    case Refusal::kMetricsScrape:
+      return "metrics_scrape";
   }
   return "other";
 }

@@ -67,8 +67,14 @@ class ServiceMetrics {
   static constexpr int kMethods = 7;  // six DeformService methods and "other"
 
   // deformd_refused_total's reasons.
-  enum class Refusal { kUnauthenticated, kHttpConnectionLimit, kHttpHostOrOrigin, kHttpTooLarge };
-  static constexpr int kRefusals = 4;
+  enum class Refusal {
+    kUnauthenticated,
+    kHttpConnectionLimit,
+    kHttpHostOrOrigin,
+    kHttpTooLarge,
+    kMetricsScrape,  // a scrape without a valid metrics or operator token
+  };
+  static constexpr int kRefusals = 5;
   static const char* RefusalName(Refusal reason);
 
   ServiceMetrics();

@@ -130,7 +130,11 @@ Status DeformServer::Start() {
     DEFORM_ASSIGN_OR_RETURN(
         impl_->metrics, MetricsEndpoint::Start(
                             impl_->options.metrics_address, impl_->options.security.allow_plaintext,
-                            &context->auth(), [context] { return RenderMetrics(context); }));
+                            &context->auth(), [context] { return RenderMetrics(context); },
+                            [context](std::uint64_t* held_back) {
+                              return context->CountRefusal(ServiceMetrics::Refusal::kMetricsScrape,
+                                                           held_back);
+                            }));
   }
   impl_->server = builder.BuildAndStart();
   if (impl_->server == nullptr || impl_->port == 0) {

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "service/base/annotated_mutex.h"
+#include "service/base/log_budget.h"
 #include "service/base/log_text.h"
 #include "service/transport/transport_security.h"
 
@@ -16,6 +17,15 @@ namespace deform::service {
 struct MetricsEndpoint::State {
   const Authenticator* authenticator = nullptr;
   std::function<std::string()> render;
+  MetricsEndpoint::RefusalCounter count_refusal;
+  // Whether a refusal's line may be written, and the note on the lines held back before it.
+  bool LogRefusal(std::string* note) const {
+    if (!count_refusal) return true;
+    std::uint64_t held_back = 0;
+    if (!count_refusal(&held_back)) return false;
+    *note = HeldBackNote(held_back);
+    return true;
+  }
   Mutex mutex;
   std::string start_error DEFORM_GUARDED_BY(mutex);  // civetweb's messages while starting
 };
@@ -44,15 +54,21 @@ int HandleMetrics(mg_connection* connection, void* data) {
     const char* header = mg_get_header(connection, "Authorization");
     StatusOr<Identity> caller = state->authenticator->Authenticate(header != nullptr ? header : "");
     if (!caller.ok()) {
-      spdlog::warn("metrics: scrape from {} refused: {}", request->remote_addr,
-                   caller.status().message());
+      std::string note;
+      if (state->LogRefusal(&note)) {
+        spdlog::warn("metrics: scrape from {} refused: {}{}", request->remote_addr,
+                     caller.status().message(), note);
+      }
       Reply(connection, 401, "Unauthorized", caller.status().message() + "\n",
             "WWW-Authenticate: Bearer realm=\"deformd metrics\"\r\n");
       return 401;
     }
     if (caller->role != Role::kOperator && caller->role != Role::kMetrics) {
-      spdlog::warn("metrics: scrape by tenant={} refused: not an operator or metrics token",
-                   EscapeForLog(caller->tenant));
+      std::string note;
+      if (state->LogRefusal(&note)) {
+        spdlog::warn("metrics: scrape by tenant={} refused: not an operator or metrics token{}",
+                     EscapeForLog(caller->tenant), note);
+      }
       Reply(connection, 403, "Forbidden", "the metrics need a metrics or operator token\n");
       return 403;
     }
@@ -102,7 +118,7 @@ StatusOr<std::string> CivetPort(const std::string& address, std::string* host) {
 
 StatusOr<std::unique_ptr<MetricsEndpoint>> MetricsEndpoint::Start(
     const std::string& address, bool allow_plaintext, const Authenticator* authenticator,
-    std::function<std::string()> render) {
+    std::function<std::string()> render, RefusalCounter count_refusal) {
   if (!IsLoopbackAddress(address) && !allow_plaintext) {
     return Status::FailedPrecondition(
         "--metrics '" + EscapeForLog(address) +
@@ -115,6 +131,7 @@ StatusOr<std::unique_ptr<MetricsEndpoint>> MetricsEndpoint::Start(
   endpoint->state_ = std::make_unique<State>();
   endpoint->state_->authenticator = authenticator;
   endpoint->state_->render = std::move(render);
+  endpoint->state_->count_refusal = std::move(count_refusal);
 
   static std::once_flag library_once;
   std::call_once(library_once, [] { mg_init_library(0); });

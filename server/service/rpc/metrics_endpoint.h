@@ -16,6 +16,7 @@
 // on civetweb's threads, concurrently, until the destructor returns.
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
@@ -27,17 +28,22 @@ namespace deform::service {
 
 class MetricsEndpoint {
  public:
+  using RefusalCounter = std::function<bool(std::uint64_t* held_back)>;
   // Threads serving scrapes.
   static constexpr int kThreads = 2;
 
   // Serves on `address` ("host:port"; port 0 picks a free one: port() tells which). `render`
-  // produces the page; `authenticator` checks tokens. Both must outlive the endpoint.
+  // produces the page; `authenticator` checks tokens. Both must outlive the endpoint. A refused
+  // scrape (401, 403) calls `count_refusal`, which counts it and says whether its log line may be
+  // written, with the lines held back before it (ServiceContext::CountRefusal); empty: every
+  // refusal is logged.
   // FAILED_PRECONDITION naming the flag for a non-loopback address without `allow_plaintext`, or
   // an address that cannot be bound; INVALID_ARGUMENT for an address that is not HOST:PORT.
   static StatusOr<std::unique_ptr<MetricsEndpoint>> Start(const std::string& address,
                                                           bool allow_plaintext,
                                                           const Authenticator* authenticator,
-                                                          std::function<std::string()> render);
+                                                          std::function<std::string()> render,
+                                                          RefusalCounter count_refusal = {});
   ~MetricsEndpoint();
   MetricsEndpoint(const MetricsEndpoint&) = delete;
   MetricsEndpoint& operator=(const MetricsEndpoint&) = delete;

@@ -102,5 +102,35 @@ TEST(RefusalLogTest, RequestsForAnotherHostAreAllCountedAndLoggedWithinTheBudget
             "deformd_refused_total{reason=\"http_host_or_origin\"} " + std::to_string(kRequests));
 }
 
+TEST(RefusalLogTest, RefusedScrapesAreAllCountedAndLoggedWithinTheBudget) {
+  TempDir dir;
+  service::ServerOptions options = TestServerOptions();
+  options.metrics_address = "127.0.0.1:0";
+  TestServer server(options, dir.Write("tokens", TokenLine("good", "ward", "tenant") +
+                                                     TokenLine("scrape", "prometheus", "metrics")));
+  const int port = server.server().metrics_port();
+  const std::string host = "Host: 127.0.0.1:" + std::to_string(port) + "\r\n";
+  LogCapture capture;
+  constexpr int kScrapes = 30;
+  for (int i = 0; i < kScrapes; ++i) {
+    // A bad token (401) and a tenant's (403) alternately: both are any peer's to repeat.
+    const std::string token = i % 2 == 0 ? "bad" : "good";
+    const RawHttpResponse response =
+        RawHttpExchange(port, "GET /metrics HTTP/1.1\r\n" + host + "Authorization: Bearer " +
+                                  token + "\r\nConnection: close\r\n\r\n");
+    ASSERT_EQ(response.status, i % 2 == 0 ? 401 : 403) << i;
+  }
+  const RawHttpResponse scrape =
+      RawHttpExchange(port, "GET /metrics HTTP/1.1\r\n" + host +
+                                "Authorization: Bearer scrape\r\nConnection: close\r\n\r\n");
+  ASSERT_EQ(scrape.status, 200) << scrape.head;
+  const std::string log = capture.Stop();
+  const Lines lines = LinesWith(log, "metrics: scrape");
+  EXPECT_GE(lines.count, kBurst);
+  EXPECT_LT(lines.count, kScrapes) << log;
+  EXPECT_THAT(scrape.body, HasSubstr("deformd_refused_total{reason=\"metrics_scrape\"} " +
+                                     std::to_string(kScrapes)));
+}
+
 }  // namespace
 }  // namespace deform::test_support

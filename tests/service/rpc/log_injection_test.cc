@@ -7,6 +7,7 @@
 #include <spdlog/sinks/ostream_sink.h>
 #include <spdlog/spdlog.h>
 
+#include <chrono>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -66,6 +67,9 @@ TEST(LogInjectionTest, ControlBytesInEveryLoggedFieldReachNoLogLineRaw) {
     auto stream = client->OpenStream(kHostile, recorder.Callbacks());
     EXPECT_EQ(stream->Wait().error_code(), grpc::StatusCode::NOT_FOUND);
   }
+  // The server writes the stream's closing line once the call is done, after the client has its
+  // status.
+  EXPECT_TRUE(capture.WaitFor("closed (no mesh with id", std::chrono::seconds(30)));
   // A stream's poses and stiffness updates.
   ASSERT_TRUE(client->ListMeshes(&meshes).ok());
   ASSERT_EQ(meshes.size(), 1u);

@@ -2,11 +2,13 @@
 // each "<message>" (the pattern "<%v>"), for tests of what reaches the log.
 #pragma once
 
-#include <spdlog/sinks/ostream_sink.h>
+#include <spdlog/sinks/base_sink.h>
 #include <spdlog/spdlog.h>
 
+#include <chrono>
+#include <condition_variable>
 #include <memory>
-#include <sstream>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -14,7 +16,7 @@ namespace deform::test_support {
 
 class LogCapture {
  public:
-  LogCapture() : sink_(std::make_shared<spdlog::sinks::ostream_sink_mt>(text_)) {
+  LogCapture() : sink_(std::make_shared<Sink>()) {
     sink_->set_pattern("<%v>");
     loggers_ = {spdlog::default_logger(), spdlog::get("audit")};
     for (const auto& logger : loggers_) {
@@ -22,6 +24,11 @@ class LogCapture {
     }
   }
   ~LogCapture() { Stop(); }
+  // Whether a line holding `needle` was written within `timeout`: for a line the server writes
+  // after the client has its answer (a stream's "closed" line is written once its call is done).
+  bool WaitFor(const std::string& needle, std::chrono::milliseconds timeout) {
+    return sink_->WaitFor(needle, timeout);
+  }
   std::string Stop() {
     for (const auto& logger : loggers_) {
       if (logger == nullptr) continue;
@@ -30,12 +37,38 @@ class LogCapture {
       if (!sinks.empty() && sinks.back() == sink_) sinks.pop_back();
     }
     loggers_.clear();
-    return text_.str();
+    return sink_->Text();
   }
 
  private:
-  std::ostringstream text_;
-  std::shared_ptr<spdlog::sinks::ostream_sink_mt> sink_;
+  // The lines in a string, under the sink's own mutex, and a wait for one of them.
+  class Sink : public spdlog::sinks::base_sink<std::mutex> {
+   public:
+    std::string Text() {
+      std::lock_guard<std::mutex> lock(mutex_);
+      return text_;
+    }
+    bool WaitFor(const std::string& needle, std::chrono::milliseconds timeout) {
+      std::unique_lock<std::mutex> lock(mutex_);
+      return written_.wait_for(lock, timeout,
+                               [&] { return text_.find(needle) != std::string::npos; });
+    }
+
+   protected:
+    void sink_it_(const spdlog::details::log_msg& message) override {
+      spdlog::memory_buf_t formatted;
+      formatter_->format(message, formatted);
+      text_.append(formatted.data(), formatted.size());
+      written_.notify_all();
+    }
+    void flush_() override {}
+
+   private:
+    std::string text_;
+    std::condition_variable written_;
+  };
+
+  std::shared_ptr<Sink> sink_;
   std::vector<std::shared_ptr<spdlog::logger>> loggers_;
 };
 
