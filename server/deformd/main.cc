@@ -10,6 +10,7 @@
 //           [--tenant-max-memory-mb N] [--preload-tenant NAME] [--store DIR [--store-key FILE]]
 //           [--metrics ADDR]
 //           [--http ADDR [--http-root DIR] [--http-max-connections N]
+//            [--http-max-connections-per-address N]
 //            [--http-allowed-host NAME]...]
 //   deformd --version   prints "deformd VERSION (commit COMMIT)" (core/base/build_info.h)
 //
@@ -55,6 +56,7 @@
 #include "core/io/model_input.h"
 #include "service/access/identity.h"
 #include "service/base/log_text.h"
+#include "service/base/open_files_limit.h"
 #include "service/base/service_options.h"
 #include "service/rpc/deform_server.h"
 #include "service/rpc/web_server.h"
@@ -89,6 +91,7 @@ struct Args {
   std::string http_address;
   std::string http_root;
   int http_max_connections = 64;
+  int http_max_connections_per_address = 32;
   std::vector<std::string> http_allowed_hosts;
 };
 
@@ -324,6 +327,11 @@ int main(int argc, char** argv) {
                  "Open HTTP and WebSocket connections at once")
       ->capture_default_str()
       ->check(CLI::Range(1, 65536));
+  app.add_option("--http-max-connections-per-address", args.http_max_connections_per_address,
+                 "Of them, at most this many from one peer address (so one peer cannot take them "
+                 "all)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 65536));
   app.add_option("--http-allowed-host", args.http_allowed_hosts,
                  "A Host name the HTTP port answers beside localhost, 127.0.0.1, [::1] and the "
                  "--http host (repeatable; any other Host is refused 403: DNS rebinding)")
@@ -338,6 +346,15 @@ int main(int argc, char** argv) {
   deform::service::InstallEscapingDefaultLogger();  // no control byte reaches the log
   spdlog::set_level(spdlog::level::from_str(args.log_level));
   spdlog::set_pattern("[%Y-%m-%d %H:%M:%S.%e] [%^%l%$] %v");
+  // Each connection takes a descriptor at its accept: the soft limit up to the hard one.
+  const deform::service::OpenFilesLimit files = deform::service::RaiseOpenFilesLimit();
+  if (!files.error.empty()) {
+    spdlog::warn("open files: {} (soft limit {}, hard {}); connections beyond it are refused",
+                 files.error, files.soft, files.hard);
+  } else if (files.soft != files.soft_before) {
+    spdlog::info("open files: soft limit raised from {} to {} (the hard limit {})",
+                 files.soft_before, files.soft, files.hard);
+  }
   args.server.limits.max_memory_bytes = args.max_memory_mb << 20;
   args.server.parallel_solve_min_factor_bytes =
       static_cast<std::size_t>(args.parallel_solve_min_mb * 1024 * 1024);
@@ -378,6 +395,7 @@ int main(int argc, char** argv) {
     web_options.address = args.http_address;
     web_options.static_root = args.http_root.empty() ? DefaultHttpRoot() : args.http_root;
     web_options.max_connections = args.http_max_connections;
+    web_options.max_connections_per_address = args.http_max_connections_per_address;
     web_options.allowed_hosts = args.http_allowed_hosts;
     web_options.allow_plaintext = args.server.security.allow_plaintext;
     if (web_options.static_root.empty()) {

@@ -5,6 +5,7 @@
 #include <array>
 #include <atomic>
 #include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/steady_timer.hpp>
 #include <boost/asio/strand.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
@@ -51,47 +52,78 @@ constexpr auto kRequestTimeout = std::chrono::seconds(30);
 // long (at most kDrainBytes) before the connection closes, so that the client reads the status
 // instead of a reset.
 constexpr auto kDrainTimeout = std::chrono::seconds(2);
+// A failed accept (out of descriptors) is tried again after this long, not at once.
+constexpr auto kAcceptRetry = std::chrono::milliseconds(100);
 constexpr std::size_t kDrainBytes = std::size_t{1} << 20;
 
-// The open connections, to count them against max_connections and close them at shutdown.
+// The open connections, to count them against max_connections (in all) and
+// max_connections_per_address (from one peer address), and close them at shutdown.
 class Connections {
-  struct Slot {
-    explicit Slot(std::atomic<int>* open) : open(open) {}
-    ~Slot() { open->fetch_sub(1); }
-    Slot(const Slot&) = delete;
-    Slot& operator=(const Slot&) = delete;
-    std::atomic<int>* const open;
-  };
-
  public:
-  explicit Connections(int max) : max_(max) {}
-  // A slot, or null when max_connections are open; the slot is released when the last copy goes.
-  std::shared_ptr<void> TryAcquire() {
-    if (open_.fetch_add(1) >= max_) {
-      open_.fetch_sub(1);
+  Connections(int max, int max_per_address) : max_(max), max_per_address_(max_per_address) {}
+  // Why TryAcquire refused.
+  enum class Refusal { kNone, kAll, kAddress };
+  // A slot for a connection from `peer`, or null (and *refused why) when max_connections are open
+  // or max_connections_per_address from that address; the slot is released when the last copy
+  // goes.
+  std::shared_ptr<void> TryAcquire(const asio::ip::address& peer, Refusal* refused) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (open_ >= max_) {
+      *refused = Refusal::kAll;
       return nullptr;
     }
-    return std::make_shared<Slot>(&open_);
+    int& from_peer = per_address_[peer];
+    if (from_peer >= max_per_address_) {
+      if (from_peer == 0) per_address_.erase(peer);
+      *refused = Refusal::kAddress;
+      return nullptr;
+    }
+    ++from_peer;
+    ++open_;
+    *refused = Refusal::kNone;
+    return std::make_shared<Slot>(this, peer);
   }
-  int open() const { return open_.load(); }
-  void Track(const std::shared_ptr<Abortable>& connection) {
+  int open() const {
     std::lock_guard<std::mutex> lock(mutex_);
+    return open_;
+  }
+  void Track(const std::shared_ptr<Abortable>& connection) {
+    std::lock_guard<std::mutex> lock(tracked_mutex_);
     for (auto it = tracked_.begin(); it != tracked_.end();) {
       it = it->expired() ? tracked_.erase(it) : std::next(it);
     }
     tracked_.push_back(connection);
   }
   void AbortAll() {
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::lock_guard<std::mutex> lock(tracked_mutex_);
     for (const auto& weak : tracked_) {
       if (auto connection = weak.lock()) connection->Abort();
     }
   }
 
  private:
+  struct Slot {
+    Slot(Connections* connections, asio::ip::address peer)
+        : connections(connections), peer(std::move(peer)) {}
+    ~Slot() { connections->Release(peer); }
+    Slot(const Slot&) = delete;
+    Slot& operator=(const Slot&) = delete;
+    Connections* const connections;
+    const asio::ip::address peer;
+  };
+  void Release(const asio::ip::address& peer) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    --open_;
+    auto it = per_address_.find(peer);
+    if (it != per_address_.end() && --it->second <= 0) per_address_.erase(it);
+  }
+
   const int max_;
-  std::atomic<int> open_{0};
-  std::mutex mutex_;
+  const int max_per_address_;
+  mutable std::mutex mutex_;  // open_ and per_address_
+  int open_ = 0;
+  std::map<asio::ip::address, int> per_address_;
+  std::mutex tracked_mutex_;
   std::vector<std::weak_ptr<Abortable>> tracked_;
 };
 
@@ -490,18 +522,39 @@ StatusOr<tcp::endpoint> ParseEndpoint(const std::string& address) {
 
 struct WebServer::Impl {
   Impl(service::ServiceContext* context, WebOptions options)
-      : shared{context, options, Connections(options.max_connections),
+      : shared{context, options,
+               Connections(options.max_connections, options.max_connections_per_address),
                HttpHostPolicy(options.address, options.allowed_hosts)},
         io(options.threads),
-        acceptor(asio::make_strand(io)) {}
+        acceptor(asio::make_strand(io)),
+        accept_retry(acceptor.get_executor()) {}
 
   void Accept() {
     acceptor.async_accept(asio::make_strand(io), [this](beast::error_code error,
                                                         tcp::socket socket) {
       if (error) {
         if (error == asio::error::operation_aborted || !acceptor.is_open()) return;
-        spdlog::warn("http accept failed: {}", error.message());
-      } else if (auto slot = shared.connections.TryAcquire()) {
+        // Out of descriptors (EMFILE, ENFILE) or another failure: accepting again at once would
+        // spin on the same error. Wait, then accept again (the pending connection stays in the
+        // backlog until a descriptor is free), logging within the refusal lines' budget.
+        std::uint64_t held_back = 0;
+        if (shared.context->CountRefusal(service::ServiceMetrics::Refusal::kHttpConnectionLimit,
+                                         &held_back)) {
+          spdlog::warn("http accept failed: {}; accepting again in {} ms{}", error.message(),
+                       kAcceptRetry.count(), service::HeldBackNote(held_back));
+        }
+        accept_retry.expires_after(kAcceptRetry);
+        accept_retry.async_wait([this](beast::error_code waited) {
+          if (!waited && acceptor.is_open()) Accept();
+        });
+        return;
+      }
+      beast::error_code peer_error;
+      const tcp::endpoint peer = socket.remote_endpoint(peer_error);
+      Connections::Refusal refused = Connections::Refusal::kNone;
+      if (peer_error) {
+        // The peer already went: nothing to serve.
+      } else if (auto slot = shared.connections.TryAcquire(peer.address(), &refused)) {
         auto session = std::make_shared<HttpSession>(std::move(socket), &shared, std::move(slot));
         shared.connections.Track(session);
         session->Run();
@@ -509,9 +562,19 @@ struct WebServer::Impl {
         std::uint64_t held_back = 0;
         if (shared.context->CountRefusal(service::ServiceMetrics::Refusal::kHttpConnectionLimit,
                                          &held_back)) {
-          spdlog::warn("http connection refused: {} connections open (the limit){}",
-                       shared.options.max_connections, service::HeldBackNote(held_back));
+          if (refused == Connections::Refusal::kAll) {
+            spdlog::warn("http connection refused: {} connections open (the limit){}",
+                         shared.options.max_connections, service::HeldBackNote(held_back));
+          } else {
+            spdlog::warn(
+                "http connection from {} refused: {} connections open from that address (the "
+                "limit, --http-max-connections-per-address){}",
+                peer.address().to_string(), shared.options.max_connections_per_address,
+                service::HeldBackNote(held_back));
+          }
         }
+      }
+      if (socket.is_open()) {
         beast::error_code ignored;
         socket.close(ignored);
       }
@@ -522,6 +585,8 @@ struct WebServer::Impl {
   Shared shared;
   asio::io_context io;
   tcp::acceptor acceptor;
+  // Delays the next accept after a failed one (kAcceptRetry).
+  asio::steady_timer accept_retry;
   std::vector<std::thread> threads;
   int port = 0;
   service::LoopbackPortGuard port_guard;
@@ -585,6 +650,7 @@ void WebServer::Stop(std::chrono::milliseconds grace) {
   asio::post(impl_->acceptor.get_executor(), [this] {
     beast::error_code ignored;
     impl_->acceptor.close(ignored);
+    impl_->accept_retry.cancel();
   });
   const auto deadline = std::chrono::steady_clock::now() + grace;
   while (impl_->shared.connections.open() > 0 && std::chrono::steady_clock::now() < deadline) {

@@ -17,17 +17,19 @@
 //    "deform.v1" (web_auth.h); with a token file an upgrade without a valid token is answered 401
 //    and never upgraded.
 //
-// Bounds on what a client sends: connections (max_connections, HTTP and WebSocket together; more
-// are closed at once), request line and headers 8 KiB (431 with a body), POST body
-// max_body_bytes (413 with a body; the rest of an oversized request is drained for 2 s so the
-// client reads the status), WebSocket message max_message_bytes (refused once that much of it
-// arrived, at most 64 KiB more: the stream ends RESOURCE_EXHAUSTED), messages per second per
-// WebSocket (max_messages_per_second: reading pauses until the next second), a request's line and
-// headers (or a handshake) must arrive within 5 s of the connection's last request and its body
-// within 30 s, an idle WebSocket is pinged and closed when its peer stops answering (60 s). A
-// request whose Host is not one the port is for (DNS rebinding) or from a page of another origin is
-// refused with 403 and a body before it is handled (http_host_policy.h). Logs through spdlog,
-// client strings escaped (log_text.h).
+// Bounds on what a client sends: connections (max_connections, HTTP and WebSocket together, and
+// max_connections_per_address from one peer address, so one peer cannot take every slot; more are
+// closed at once, counted and logged within the refusal lines' budget), request line and headers
+// 8 KiB (431 with a body), POST body max_body_bytes (413 with a body; the rest of an oversized
+// request is drained for 2 s so the client reads the status), WebSocket message max_message_bytes
+// (refused once that much of it arrived, at most 64 KiB more: the stream ends RESOURCE_EXHAUSTED),
+// messages per second per WebSocket (max_messages_per_second: reading pauses until the next
+// second), a request's line and headers (or a handshake) must arrive within 5 s of the connection's
+// last request and its body within 30 s, an idle WebSocket is pinged and closed when its peer stops
+// answering (60 s). A request whose Host is not one the port is for (DNS rebinding) or from a page
+// of another origin is refused with 403 and a body before it is handled (http_host_policy.h). A
+// failed accept (out of descriptors) is tried again 100 ms later, so the port serves again once
+// descriptors are free and never spins. Logs through spdlog, client strings escaped (log_text.h).
 //
 // Life cycle: Start() binds and serves on its own threads; Stop() (DeformServer's shutdown, after
 // the streams were drained, before the worker pool stops) stops accepting, waits up to `grace`
@@ -53,6 +55,8 @@ struct WebOptions {
   // The directory whose files are served; nothing outside it.
   std::filesystem::path static_root;
   int max_connections = 64;
+  // Of them, at most this many from one peer address. Default: 32.
+  int max_connections_per_address = 32;
   std::size_t max_body_bytes = std::size_t{64} << 10;
   // Largest WebSocket message from a client (a LoadMesh chunk is the largest); default 4 MiB.
   std::size_t max_message_bytes = std::size_t{4} << 20;

@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <string>
 #include <thread>
 #include <vector>
@@ -26,9 +27,17 @@ namespace {
 
 using ::testing::HasSubstr;
 
-// A TCP connection to 127.0.0.1:port that sends nothing; -1 when it cannot connect.
-int IdleConnection(int port) {
+// A TCP connection to 127.0.0.1:port from `from` (a loopback address: all of 127/8 is the
+// loopback interface's) that sends nothing; -1 when it cannot connect.
+int IdleConnection(int port, const char* from = "127.0.0.1") {
   const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in source{};
+  source.sin_family = AF_INET;
+  ::inet_pton(AF_INET, from, &source.sin_addr);
+  if (fd >= 0 && ::bind(fd, reinterpret_cast<sockaddr*>(&source), sizeof(source)) != 0) {
+    ::close(fd);
+    return -1;
+  }
   sockaddr_in address{};
   address.sin_family = AF_INET;
   address.sin_port = htons(static_cast<unsigned short>(port));
@@ -91,6 +100,55 @@ TEST(HttpLimitsTest, HalfOpenConnectionsGiveTheirSlotsBackWithinTheHeaderTimeout
   ::close(second);
   std::this_thread::sleep_for(std::chrono::milliseconds(200));
   EXPECT_EQ(RawHttpExchange(server.web_port(), kGet + "\r\n").status, 200);
+}
+
+// The status of a GET sent on `fd` (0 when the server closed it without answering).
+int StatusOfGet(int fd) {
+  const std::string request = kGet + "\r\n";
+  if (::send(fd, request.data(), request.size(), MSG_NOSIGNAL) !=
+      static_cast<ssize_t>(request.size())) {
+    return 0;
+  }
+  timeval timeout{10, 0};
+  ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &timeout, sizeof(timeout));
+  std::string reply;
+  char buffer[512];
+  for (ssize_t got; reply.find("\r\n") == std::string::npos &&
+                    (got = ::recv(fd, buffer, sizeof(buffer), 0)) > 0;) {
+    reply.append(buffer, got);
+  }
+  return reply.rfind("HTTP/1.1 ", 0) == 0 ? std::atoi(reply.c_str() + 9) : 0;
+}
+
+// One peer address cannot take every slot: its connections over the per-address bound are closed
+// at once and counted, while another address is served; a slot given back is taken again.
+TEST(HttpLimitsTest, OnePeerAddressCannotTakeEverySlot) {
+  web::WebOptions options;
+  options.max_connections = 8;
+  options.max_connections_per_address = 2;
+  TestServer server(TestServerOptions(), "", true, options);
+  const int first = IdleConnection(server.web_port());
+  const int second = IdleConnection(server.web_port());
+  ASSERT_GE(first, 0);
+  ASSERT_GE(second, 0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));  // both accepted
+  const int third = IdleConnection(server.web_port());
+  ASSERT_GE(third, 0);
+  EXPECT_LT(SecondsUntilClosed(third, 10), 2.0);  // refused at once, not at the header timeout
+  ::close(third);
+  const int other = IdleConnection(server.web_port(), "127.0.0.2");
+  ASSERT_GE(other, 0) << "cannot connect from 127.0.0.2";
+  EXPECT_EQ(StatusOfGet(other), 200);
+  ::close(other);
+  ::close(first);
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  const int again = IdleConnection(server.web_port());
+  ASSERT_GE(again, 0);
+  EXPECT_EQ(StatusOfGet(again), 200);
+  ::close(again);
+  ::close(second);
+  const std::string page = server.server().context().metrics().Serialize();
+  EXPECT_THAT(page, HasSubstr("deformd_refused_total{reason=\"http_connection_limit\"} 1"));
 }
 
 TEST(HttpLimitsTest, AWebSocketMessageOverTheLimitEndsTheStreamResourceExhausted) {

@@ -124,6 +124,7 @@ class DeformdProcess {
   std::string target() const { return "127.0.0.1:" + std::to_string(port_); }
 
   void Signal(int signal_number) { kill(pid_, signal_number); }
+  pid_t pid() const { return pid_; }
 
   // The exit code once the process has exited (-signal if a signal ended it), or nullopt on
   // timeout.
