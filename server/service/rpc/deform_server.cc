@@ -11,6 +11,7 @@
 
 #include "health.pb.h"
 #include "service/base/annotated_mutex.h"
+#include "service/base/listen_address.h"
 #include "service/base/log_text.h"
 #include "service/context/service_context.h"
 #include "service/load/load_request.h"
@@ -105,8 +106,8 @@ Status DeformServer::Start() {
                             &certificate));
   // A fixed port: the other loopback family's address first (loopback_port_guard.h).
   const std::string& address = impl_->options.listen_address;
-  const std::size_t colon = address.rfind(':');
-  const int fixed_port = colon == std::string::npos ? 0 : std::atoi(address.c_str() + colon + 1);
+  const ListenHostAndPort split = SplitListenAddress(address);
+  const int fixed_port = split.has_port ? std::atoi(std::string(split.port).c_str()) : 0;
   std::string bind_address = address;
   if (fixed_port > 0) {
     auto guard = LoopbackPortGuard::Hold(address, fixed_port);
@@ -114,7 +115,7 @@ Status DeformServer::Start() {
     impl_->port_guard = std::move(*guard);
   } else if (const int picked = LoopbackPortGuard::PickFreePort(address, &impl_->port_guard)) {
     // Port 0 on a loopback address: a port free on both families, so the guard cannot fail.
-    bind_address = address.substr(0, colon) + ":" + std::to_string(picked);
+    bind_address = std::string(split.host) + ":" + std::to_string(picked);
   }
   grpc::ServerBuilder builder;
   builder.AddListeningPort(bind_address, credentials, &impl_->port);
@@ -232,10 +233,8 @@ int DeformServer::metrics_port() const {
 }
 
 std::string DeformServer::listening_address() const {
-  const std::string& address = impl_->options.listen_address;
-  const std::size_t colon = address.rfind(':');
-  const std::string host = colon == std::string::npos ? address : address.substr(0, colon);
-  return host + ":" + std::to_string(impl_->port);
+  return std::string(SplitListenAddress(impl_->options.listen_address).host) + ":" +
+         std::to_string(impl_->port);
 }
 
 StatusOr<std::shared_ptr<const MeshEntry>> DeformServer::Preload(ModelInput input,

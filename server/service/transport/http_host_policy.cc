@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cctype>
 
+#include "service/base/listen_address.h"
+
 namespace deform::web {
 namespace {
 
@@ -60,8 +62,7 @@ HttpHostPolicy::HttpHostPolicy(std::string_view listen_address,
     if (IsWildcard(lower)) return;
     if (std::find(names_.begin(), names_.end(), lower) == names_.end()) names_.push_back(lower);
   };
-  const std::size_t colon = listen_address.rfind(':');
-  add(colon == std::string_view::npos ? listen_address : listen_address.substr(0, colon));
+  add(service::SplitListenAddress(listen_address).host);
   for (const std::string& host : extra_hosts) add(host);
 }
 

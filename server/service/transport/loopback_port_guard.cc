@@ -9,13 +9,13 @@
 #include <cstring>
 #include <utility>
 
+#include "service/base/listen_address.h"
+
 namespace deform::service {
 
 StatusOr<LoopbackPortGuard> LoopbackPortGuard::Hold(const std::string& listen_address, int port) {
   LoopbackPortGuard guard;
-  const std::size_t colon = listen_address.rfind(':');
-  const std::string host =
-      colon == std::string::npos ? listen_address : listen_address.substr(0, colon);
+  const std::string_view host = SplitListenAddress(listen_address).host;
   const bool v4 = host == "127.0.0.1";
   if ((!v4 && host != "[::1]") || port <= 0 || port > 65535) return guard;
   const int fd = ::socket(v4 ? AF_INET6 : AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
@@ -52,9 +52,7 @@ StatusOr<LoopbackPortGuard> LoopbackPortGuard::Hold(const std::string& listen_ad
 }
 
 int LoopbackPortGuard::PickFreePort(const std::string& listen_address, LoopbackPortGuard* guard) {
-  const std::size_t colon = listen_address.rfind(':');
-  const std::string host =
-      colon == std::string::npos ? listen_address : listen_address.substr(0, colon);
+  const std::string_view host = SplitListenAddress(listen_address).host;
   const bool v4 = host == "127.0.0.1";
   if (!v4 && host != "[::1]") return 0;
   for (int attempt = 0; attempt < 16; ++attempt) {

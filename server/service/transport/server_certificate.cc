@@ -14,6 +14,8 @@
 #include <ctime>
 #include <memory>
 
+#include "service/base/listen_address.h"
+
 namespace deform::service {
 namespace {
 
@@ -205,9 +207,7 @@ std::vector<std::string> CertificateWarnings(const ServerCertificate& certificat
                        std::to_string((certificate.not_after - now) / 86400) +
                        " days: renew it before clients refuse it");
   }
-  const std::size_t colon = listen_address.rfind(':');
-  const std::string_view host =
-      colon == std::string_view::npos ? listen_address : listen_address.substr(0, colon);
+  const std::string_view host = SplitListenAddress(listen_address).host;
   const std::string address = CanonicalAddress(host);
   const bool any_address = address == "0.0.0.0" || address == "::";
   if (!host.empty() && !any_address && !CertificateNamesHost(certificate, host)) {

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "service/base/listen_address.h"
 #include "service/transport/server_certificate.h"
 
 namespace deform::service {
@@ -25,9 +26,7 @@ StatusOr<std::string> ReadPemFile(const std::string& path, const char* what) {
 }  // namespace
 
 bool IsLoopbackAddress(const std::string& listen_address) {
-  const std::size_t colon = listen_address.rfind(':');
-  const std::string host =
-      colon == std::string::npos ? listen_address : listen_address.substr(0, colon);
+  const std::string_view host = SplitListenAddress(listen_address).host;
   if (host == "[::1]" || host == "localhost") return true;
   if (host.rfind("127.", 0) != 0) return false;
   // A dotted IPv4 address in 127.0.0.0/8, not a name that starts with "127.".
