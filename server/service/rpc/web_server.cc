@@ -5,7 +5,6 @@
 #include <array>
 #include <atomic>
 #include <boost/asio/ip/tcp.hpp>
-#include <boost/asio/steady_timer.hpp>
 #include <boost/asio/strand.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
@@ -52,8 +51,6 @@ constexpr auto kRequestTimeout = std::chrono::seconds(30);
 // long (at most kDrainBytes) before the connection closes, so that the client reads the status
 // instead of a reset.
 constexpr auto kDrainTimeout = std::chrono::seconds(2);
-// A failed accept (out of descriptors) is tried again after this long, not at once.
-constexpr auto kAcceptRetry = std::chrono::milliseconds(100);
 constexpr std::size_t kDrainBytes = std::size_t{1} << 20;
 
 // The open connections, to count them against max_connections (in all) and
@@ -526,27 +523,15 @@ struct WebServer::Impl {
                Connections(options.max_connections, options.max_connections_per_address),
                HttpHostPolicy(options.address, options.allowed_hosts)},
         io(options.threads),
-        acceptor(asio::make_strand(io)),
-        accept_retry(acceptor.get_executor()) {}
+        acceptor(asio::make_strand(io)) {}
 
   void Accept() {
     acceptor.async_accept(asio::make_strand(io), [this](beast::error_code error,
                                                         tcp::socket socket) {
       if (error) {
         if (error == asio::error::operation_aborted || !acceptor.is_open()) return;
-        // Out of descriptors (EMFILE, ENFILE) or another failure: accepting again at once would
-        // spin on the same error. Wait, then accept again (the pending connection stays in the
-        // backlog until a descriptor is free), logging within the refusal lines' budget.
-        std::uint64_t held_back = 0;
-        if (shared.context->CountRefusal(service::ServiceMetrics::Refusal::kHttpConnectionLimit,
-                                         &held_back)) {
-          spdlog::warn("http accept failed: {}; accepting again in {} ms{}", error.message(),
-                       kAcceptRetry.count(), service::HeldBackNote(held_back));
-        }
-        accept_retry.expires_after(kAcceptRetry);
-        accept_retry.async_wait([this](beast::error_code waited) {
-          if (!waited && acceptor.is_open()) Accept();
-        });
+        spdlog::warn("http accept failed: {}", error.message());
+        Accept();
         return;
       }
       beast::error_code peer_error;
@@ -585,8 +570,6 @@ struct WebServer::Impl {
   Shared shared;
   asio::io_context io;
   tcp::acceptor acceptor;
-  // Delays the next accept after a failed one (kAcceptRetry).
-  asio::steady_timer accept_retry;
   std::vector<std::thread> threads;
   int port = 0;
   service::LoopbackPortGuard port_guard;
@@ -650,7 +633,6 @@ void WebServer::Stop(std::chrono::milliseconds grace) {
   asio::post(impl_->acceptor.get_executor(), [this] {
     beast::error_code ignored;
     impl_->acceptor.close(ignored);
-    impl_->accept_retry.cancel();
   });
   const auto deadline = std::chrono::steady_clock::now() + grace;
   while (impl_->shared.connections.open() > 0 && std::chrono::steady_clock::now() < deadline) {

@@ -27,9 +27,8 @@
 // second), a request's line and headers (or a handshake) must arrive within 5 s of the connection's
 // last request and its body within 30 s, an idle WebSocket is pinged and closed when its peer stops
 // answering (60 s). A request whose Host is not one the port is for (DNS rebinding) or from a page
-// of another origin is refused with 403 and a body before it is handled (http_host_policy.h). A
-// failed accept (out of descriptors) is tried again 100 ms later, so the port serves again once
-// descriptors are free and never spins. Logs through spdlog, client strings escaped (log_text.h).
+// of another origin is refused with 403 and a body before it is handled (http_host_policy.h). Logs
+// through spdlog, client strings escaped (log_text.h).
 //
 // Life cycle: Start() binds and serves on its own threads; Stop() (DeformServer's shutdown, after
 // the streams were drained, before the worker pool stops) stops accepting, waits up to `grace`

@@ -32,7 +32,6 @@
 #include "service/context/service_context.h"
 #include "service/deform/deform_outbox.h"
 #include "tests/service/support/deformd_process.h"
-#include "tests/service/support/raw_http.h"
 #include "tests/service/support/service_fixture.h"
 #include "tests/service/support/stream_recorder.h"
 
@@ -331,54 +330,6 @@ TEST(HostileDeployment, TheOpenFilesSoftLimitIsRaisedToTheHardOneAtStart) {
               HasSubstr("open files: soft limit raised from 256 to " + std::to_string(expected)));
   server.Signal(SIGTERM);
   EXPECT_EQ(server.Wait(std::chrono::seconds(10)), std::optional<int>(0));
-}
-
-// Out of descriptors (here a hard limit of 64, through prlimit), the HTTP port's accept fails with
-// EMFILE until some are free. It tries again 100 ms later, where it tried again at once (a spin
-// writing a warning each time), logs within the refusal lines' budget, and serves the next client
-// within a second of the descriptors coming back.
-TEST(HostileDeployment, TheHttpPortOutOfDescriptorsWaitsAndServesAgain) {
-  DeformdProcess server({"--nofile=64:64", DEFORMD_PATH, "--listen", "127.0.0.1:0", "--workers",
-                         "1", "--http", "127.0.0.1:0", "--http-max-connections", "1000",
-                         "--http-max-connections-per-address", "1000"},
-                        "", "/usr/bin/prlimit");
-  const std::optional<std::string> port_text =
-      server.WaitForOutput("http listening on 127\\.0\\.0\\.1:([0-9]+)", std::chrono::seconds(60));
-  ASSERT_TRUE(port_text.has_value()) << server.output();
-  const int port = std::stoi(*port_text);
-  std::vector<int> idle;
-  for (int i = 0; i < 100; ++i) {
-    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-    sockaddr_in address{};
-    address.sin_family = AF_INET;
-    address.sin_port = htons(static_cast<unsigned short>(port));
-    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    if (fd >= 0 && ::connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof(address)) == 0) {
-      idle.push_back(fd);
-    } else if (fd >= 0) {
-      ::close(fd);
-    }
-  }
-  EXPECT_TRUE(server.WaitForLog("http accept failed", std::chrono::seconds(10))) << server.output();
-  std::this_thread::sleep_for(std::chrono::milliseconds(1500));  // about 15 tries at 100 ms
-  for (const int fd : idle) ::close(fd);
-  const auto freed = std::chrono::steady_clock::now();
-  int status = 0;
-  while (status != 200 && std::chrono::steady_clock::now() - freed < std::chrono::seconds(1)) {
-    status = RawHttpExchange(port, "GET / HTTP/1.1\r\nHost: localhost\r\nConnection: close\r\n\r\n")
-                 .status;
-  }
-  EXPECT_EQ(status, 200) << server.output();
-  const std::string log = server.output();
-  int failures = 0;
-  for (std::size_t at = log.find("http accept failed"); at != std::string::npos;
-       at = log.find("http accept failed", at + 1)) {
-    ++failures;
-  }
-  EXPECT_GE(failures, 1);
-  EXPECT_LE(failures, static_cast<int>(service::ServiceContext::kRefusalLineBurst) + 3) << log;
-  server.Signal(SIGTERM);
-  EXPECT_TRUE(server.Wait(std::chrono::seconds(30)).has_value());
 }
 
 TEST(HostileDeployment, SecondServerOnATakenAddressExitsNonZero) {
