@@ -6,6 +6,8 @@
 #include <limits>
 #include <utility>
 
+#include "core/geometry/rotated_fields.h"
+
 namespace deform {
 namespace {
 
@@ -141,13 +143,14 @@ StatusOr<std::shared_ptr<const SkinConstraints>> SkinConstraints::Create(
   constraints->keeps_volume_ =
       options.keep_volume && any_free && std::abs(constraints->rest_volume_) > 1e-9 * cube;
   if (constraints->keeps_volume_) {
-    constraints->rest_gradient_.resize(3 * static_cast<std::size_t>(mesh.num_vertices()));
-    constraints->closure_->Gradient(mesh.vertices.data(), constraints->rest_gradient_.data());
+    // The rest volume's gradient, zero off the free vertices.
+    std::vector<double> rest_gradient(3 * static_cast<std::size_t>(mesh.num_vertices()));
+    constraints->closure_->Gradient(mesh.vertices.data(), rest_gradient.data());
     std::vector<char> used(model.skeleton().num_bones(), 0);
     const BoneWeights& weights = model.bone_weights();
     for (int i = 0; i < mesh.num_vertices(); ++i) {
       if (!constraints->volume_free_[i]) {
-        std::fill_n(constraints->rest_gradient_.begin() + 3 * i, 3, 0.0);
+        std::fill_n(rest_gradient.begin() + 3 * i, 3, 0.0);
         continue;
       }
       for (int e = weights.offsets[i]; e < weights.offsets[i + 1]; ++e) used[weights.bones[e]] = 1;
@@ -155,8 +158,24 @@ StatusOr<std::shared_ptr<const SkinConstraints>> SkinConstraints::Create(
     for (int k = 0; k < model.skeleton().num_bones(); ++k) {
       if (used[k]) constraints->direction_bones_.push_back(k);
     }
-    for (int i = 0; i < mesh.num_vertices(); ++i) {
-      if (constraints->volume_free_[i]) constraints->free_vertices_.push_back(i);
+    // h_ik g_rest_i per direction bone k, by coordinate: the posed gradient is their sum, each
+    // turned by its bone.
+    const std::size_t n = static_cast<std::size_t>(mesh.num_vertices());
+    std::vector<int> slot(model.skeleton().num_bones(), -1);
+    for (std::size_t d = 0; d < constraints->direction_bones_.size(); ++d) {
+      slot[constraints->direction_bones_[d]] = static_cast<int>(d);
+    }
+    std::vector<float>& fields = constraints->gradient_fields_;
+    fields.assign(3 * constraints->direction_bones_.size() * n, 0.0f);
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!constraints->volume_free_[i]) continue;
+      for (int e = weights.offsets[i]; e < weights.offsets[i + 1]; ++e) {
+        const std::size_t d = static_cast<std::size_t>(slot[weights.bones[e]]);
+        for (std::size_t c = 0; c < 3; ++c) {
+          fields[(3 * d + c) * n + i] +=
+              static_cast<float>(weights.weights[e] * rest_gradient[3 * i + c]);
+        }
+      }
     }
   }
   return std::shared_ptr<const SkinConstraints>(std::move(constraints));
@@ -188,7 +207,7 @@ ConstraintScratch SkinConstraints::MakeScratch() const {
     s.gradient.resize(3 * rows);
     s.h.resize(3 * rows);
     s.bone_directions.resize(direction_bones_.size() * 3 * rows);
-    s.rotations.resize(model_->skeleton().num_bones());
+    s.rotations.resize(direction_bones_.size());
   }
   if (k > 0) {
     s.unit_work.assign(model_->default_factorization()->factor().UnitSolvesWorkSize(), 0.0);
@@ -217,8 +236,8 @@ std::size_t SkinConstraints::ScratchBytes() const {
                         std::max(factor.WorkSize(), six_columns ? factor.WorkSizeMany(6) : 0);
   std::size_t bytes = 0;
   if (keeps_volume_) {
-    doubles += 6 * rows + direction_bones_.size() * 3 * rows;
-    bytes += model_->skeleton().num_bones() * sizeof(Eigen::Matrix3d);
+    doubles += 6 * rows;
+    bytes += direction_bones_.size() * (sizeof(Eigen::Matrix3d) + 3 * rows * sizeof(float));
   }
   if (six_columns) doubles += 6 * rows + k;
   if (k > 0) {
@@ -299,52 +318,36 @@ void SkinConstraints::PoseVolumeDirections(const MaterialFactorization& factoriz
                                            const std::vector<RigidTransform>& bones,
                                            ConstraintScratch* s, ConstraintReport* report) const {
   const std::size_t rows = rows_;
-  const int n = model_->mesh().num_vertices();
+  const std::size_t n = static_cast<std::size_t>(model_->mesh().num_vertices());
   const int directions = static_cast<int>(direction_bones_.size());
-  const BoneWeights& weights = model_->bone_weights();
   if (s->directions_serial != factorization.serial()) {
     // D_k = M^-1 (h_k g_rest) for this factorization: once per stream and stiffness. Each is
-    // solved in s->h, then laid out by rows (row r's D_k side by side), so that posing them is
-    // one pass over the rows.
+    // solved in s->h, then laid out by coordinate, as SumRotatedFields reads it.
     for (int d = 0; d < directions; ++d) {
       double* column = s->h.data();
       std::fill(column, column + 3 * rows, 0.0);
-      for (int i = 0; i < n; ++i) {
-        for (int e = weights.offsets[i]; e < weights.offsets[i + 1]; ++e) {
-          if (weights.bones[e] != direction_bones_[d]) continue;
-          for (int c = 0; c < 3; ++c)
-            column[3 * i + c] = weights.weights[e] * rest_gradient_[3 * i + c];
-        }
+      for (std::size_t c = 0; c < 3; ++c) {
+        const float* field = gradient_fields_.data() + (3 * d + c) * n;
+        for (std::size_t i = 0; i < n; ++i) column[3 * i + c] = field[i];
       }
       Solved(factorization.factor().Solve3(column, column, s->solve_work.data()));
       ++report->solves;
-      for (std::size_t r = 0; r < rows; ++r) {
-        std::copy_n(column + 3 * r, 3, s->bone_directions.data() + 3 * (r * directions + d));
+      for (std::size_t c = 0; c < 3; ++c) {
+        float* field = s->bone_directions.data() + (3 * d + c) * rows;
+        for (std::size_t r = 0; r < rows; ++r) field[r] = static_cast<float>(column[3 * r + c]);
       }
     }
     s->directions_serial = factorization.serial();
   }
-  // g = sum_k h_ik R_k g_rest_i and its direction M^-1 g = sum_k D_k R_k^T, by rows. The rows of
-  // g outside the free vertices stay zero (MakeScratch).
-  for (std::size_t k = 0; k < bones.size(); ++k) {
-    s->rotations[k] = bones[k].rotation.toRotationMatrix();
+  // g = sum_k h_ik R_k g_rest_i and its direction M^-1 g = sum_k D_k R_k^T: both stream their
+  // fields once. The rows of g past the vertices (the joint nodes) stay zero (MakeScratch).
+  for (int d = 0; d < directions; ++d) {
+    s->rotations[d] = bones[direction_bones_[d]].rotation.toRotationMatrix();
   }
-  for (int i : free_vertices_) {
-    const Vec3 g(rest_gradient_.data() + 3 * i);
-    Eigen::Vector3d posed = Eigen::Vector3d::Zero();
-    for (int e = weights.offsets[i]; e < weights.offsets[i + 1]; ++e) {
-      posed += weights.weights[e] * (s->rotations[weights.bones[e]] * g);
-    }
-    Eigen::Map<Eigen::Vector3d>(s->gradient.data() + 3 * i) = posed;
-  }
-  const double* column = s->bone_directions.data();
-  for (std::size_t r = 0; r < rows; ++r) {
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    for (int d = 0; d < directions; ++d, column += 3) {
-      sum += s->rotations[direction_bones_[d]] * Vec3(column);
-    }
-    Eigen::Map<Eigen::Vector3d>(s->h.data() + 3 * r) = sum;
-  }
+  SumRotatedFields(gradient_fields_.data(), n, n, directions, s->rotations.data(),
+                   s->gradient.data());
+  SumRotatedFields(s->bone_directions.data(), rows, rows, directions, s->rotations.data(),
+                   s->h.data());
 }
 
 bool SkinConstraints::Apply(const MaterialFactorization& factorization, DeformScratch* frame,

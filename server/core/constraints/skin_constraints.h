@@ -138,12 +138,14 @@ struct ConstraintScratch {
   std::vector<double> base;      // x*, (n + m) by 3
   std::vector<double> gradient;  // g, (n + m) by 3 (zero on the joint nodes' and rigid rows)
   std::vector<double> h;         // M^-1 g
-  // D_k = M^-1 (h_k g_rest) per bone that weighs a free vertex, (n + m) by 3 each, by rows (row
-  // r of every D_k side by side), for the factorization with this serial
-  // (MaterialFactorization::serial; 0: none yet).
-  std::vector<double> bone_directions;
+  // D_k = M^-1 (h_k g_rest) per bone that weighs a free vertex, (n + m) by 3 each, by coordinate
+  // (SumRotatedFields' layout), for the factorization with this serial
+  // (MaterialFactorization::serial; 0: none yet). In float: h is a direction, and every use of it
+  // reads the same rounded h (the contacts' shares, the exact volume step), so its rounding only
+  // tilts the step by 1e-7, and posing it streams half the bytes.
+  std::vector<float> bone_directions;
   std::uint64_t directions_serial = 0;
-  std::vector<Eigen::Matrix3d> rotations;  // the frame's bone rotations, K
+  std::vector<Eigen::Matrix3d> rotations;  // the frame's rotations of the direction bones
   // Right-hand side, then M^-1 sum lambda_j e_{i_j} n_j^T; with the volume, beside it (six
   // columns a row) M^-1 sum nu_j e_{i_j} n_j^T.
   std::vector<double> correction;
@@ -220,10 +222,11 @@ class SkinConstraints {
   std::shared_ptr<const BoneContacts> bones_;
   ConstraintOptions options_;
   std::unique_ptr<VolumeClosure> closure_;
-  std::vector<char> volume_free_;      // per vertex: carries the volume gradient (not a rigid zone)
-  std::vector<double> rest_gradient_;  // the rest volume's gradient, zero off the free vertices
-  std::vector<int> direction_bones_;   // bones that weigh a free vertex
-  std::vector<int> free_vertices_;     // the vertices outside the rigid zones
+  std::vector<char> volume_free_;     // per vertex: carries the volume gradient (not a rigid zone)
+  std::vector<int> direction_bones_;  // bones that weigh a free vertex
+  // h_ik g_rest_i for each direction bone k, n by 3 each, by coordinate (SumRotatedFields'). In
+  // float like the directions: g only linearises the volume, whose step is then exact.
+  std::vector<float> gradient_fields_;
   double rest_volume_ = 0;
   bool keeps_volume_ = false;
   double margin_ = 0;  // model units

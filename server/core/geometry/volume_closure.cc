@@ -7,6 +7,8 @@
 #include <unordered_set>
 #include <utility>
 
+#include "core/base/cpu_features.h"
+
 namespace deform {
 namespace {
 
@@ -169,11 +171,6 @@ __attribute__((target("avx2,fma"))) void TriangleCubicFma(const int* t, int face
                                                           const double* direction, double c[4]) {
   TriangleCubic(t, faces, xyz, direction, c);
 }
-
-bool HasAvx2Fma() {
-  static const bool has = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-  return has;
-}
 #endif
 
 }  // namespace
@@ -182,7 +179,7 @@ void VolumeClosure::VolumeAlong(const double* xyz, const double* direction, doub
   const int* t = triangles_.data();
   const int faces = static_cast<int>(triangles_.rows());
 #if defined(__x86_64__) && defined(__GNUC__)
-  if (HasAvx2Fma()) {
+  if (CpuHasAvx2Fma()) {
     TriangleCubicFma(t, faces, xyz, direction, c);
   } else {
     TriangleCubic(t, faces, xyz, direction, c);

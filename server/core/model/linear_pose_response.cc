@@ -5,38 +5,15 @@
 #include <memory>
 #include <utility>
 
+#include "core/base/cpu_features.h"
+#include "core/geometry/rotated_fields.h"
+
 namespace deform {
 namespace {
 
 // Vertices per block: the block's three coordinate accumulators (6 KB) stay in L1 while every
 // response vector streams through once.
 constexpr int kBlock = 256;
-
-// Forced inline so the AVX2 entry point below gets its own vector code for the whole evaluation.
-#if defined(__GNUC__)
-#define DEFORM_ALWAYS_INLINE inline __attribute__((always_inline))
-#else
-#define DEFORM_ALWAYS_INLINE inline
-#endif
-
-// x, y, z[0, count) += (cx, cy, cz) * column[0, count). Vectorized by the compiler.
-DEFORM_ALWAYS_INLINE void AddScaledColumn(const double* __restrict column, int count, double cx,
-                                          double cy, double cz, double* __restrict x,
-                                          double* __restrict y, double* __restrict z) {
-  for (int i = 0; i < count; ++i) {
-    x[i] += cx * column[i];
-    y[i] += cy * column[i];
-    z[i] += cz * column[i];
-  }
-}
-
-// x, y, z[0, count) += r * (the three response vectors at u, one column of r each).
-DEFORM_ALWAYS_INLINE void AddRotated(const Eigen::Matrix3d& r, const double* u, std::size_t n,
-                                     int count, double* x, double* y, double* z) {
-  for (int c = 0; c < 3; ++c) {
-    AddScaledColumn(u + c * n, count, r(0, c), r(1, c), r(2, c), x, y, z);
-  }
-}
 
 // The whole evaluation, written once and compiled for AVX2 + FMA and for any x86-64 (or other)
 // CPU; Evaluate() picks one at run time.
@@ -57,14 +34,14 @@ DEFORM_ALWAYS_INLINE void EvaluateBlocks(int n, const std::vector<int>& bones,
     for (std::size_t b = 0; b < bones.size(); ++b) {
       const RigidTransform& transform = transforms[bones[b]];
       const double* u = columns + 4 * b * stride + begin;
-      AddRotated(transform.rotation.toRotationMatrix(), u, stride, count, x, y, z);
+      AddRotatedField(transform.rotation.toRotationMatrix(), u, stride, count, x, y, z);
       const Eigen::Vector3d& t = transform.translation;
       AddScaledColumn(u + 3 * stride, count, t.x(), t.y(), t.z(), x, y, z);
     }
     for (int k = 0; k < plan.num_knots(); ++k) {
-      AddRotated(plan.KnotRotation(k, transforms).toRotationMatrix(),
-                 knot_columns + 3 * static_cast<std::size_t>(k) * stride + begin, stride, count, x,
-                 y, z);
+      AddRotatedField(plan.KnotRotation(k, transforms).toRotationMatrix(),
+                      knot_columns + 3 * static_cast<std::size_t>(k) * stride + begin, stride,
+                      count, x, y, z);
     }
     double* out = positions + 3 * static_cast<std::size_t>(begin);
     for (int i = 0; i < count; ++i) {
@@ -84,10 +61,6 @@ __attribute__((target("avx2,fma"))) void EvaluateAvx2(int n, const std::vector<i
   EvaluateBlocks(n, bones, plan, columns, transforms, positions);
 }
 
-bool HasAvx2Fma() {
-  static const bool has = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-  return has;
-}
 #endif
 
 }  // namespace
@@ -106,7 +79,7 @@ LinearPoseResponse::LinearPoseResponse(int num_vertices, std::vector<int> bones,
 void LinearPoseResponse::Evaluate(const std::vector<RigidTransform>& bone_transforms,
                                   double* positions) const {
 #if defined(__x86_64__) && defined(__GNUC__)
-  if (HasAvx2Fma()) {
+  if (CpuHasAvx2Fma()) {
     EvaluateAvx2(num_vertices_, bones_, *plan_, columns_.data(), bone_transforms, positions);
     return;
   }

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <vector>
 
+#include "core/base/cpu_features.h"
+
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
 #endif
@@ -154,17 +156,12 @@ __attribute__((target("avx2"))) void ApplySupernodeAvx2(const Value* block, int 
   }
 }
 
-bool CpuHasAvx2() {
-  __builtin_cpu_init();
-  return __builtin_cpu_supports("avx2");
-}
 #else
 template <typename Value>
 void ApplySupernodeAvx2(const Value* block, int width, std::int64_t rows, const int* row_index,
                         double* y, double* work) {
   ApplySupernode(block, width, rows, row_index, y, work);
 }
-bool CpuHasAvx2() { return false; }
 #endif
 
 template <typename Value>

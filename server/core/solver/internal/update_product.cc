@@ -2,6 +2,8 @@
 
 #include <Eigen/Core>
 
+#include "core/base/cpu_features.h"
+
 #if defined(__x86_64__) && defined(__GNUC__)
 #include <immintrin.h>
 #define DEFORM_UPDATE_PRODUCT_AVX2 1
@@ -89,11 +91,6 @@ __attribute__((target("avx2,fma"))) void ProductAvx2(const double* a, std::int64
   }
 }
 
-bool CpuHasAvx2() {
-  __builtin_cpu_init();
-  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-}
-
 #endif
 
 }  // namespace
@@ -106,8 +103,7 @@ void UpdateProductPortable(const double* a, std::int64_t m, const double* b, int
 
 bool UpdateProductUsesAvx2() {
 #ifdef DEFORM_UPDATE_PRODUCT_AVX2
-  static const bool has = CpuHasAvx2();
-  return has;
+  return CpuHasAvx2Fma();
 #else
   return false;
 #endif
