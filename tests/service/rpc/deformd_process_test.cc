@@ -29,6 +29,22 @@ std::string TokenLine(const std::string& token, const std::string& tenant) {
   return service::Sha256Hex(token) + " " + tenant + " tenant\n";
 }
 
+std::string ReadFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+// Runs a command line with its stdout discarded and its stderr kept: a failing expectation on the
+// exit status shows what the command said.
+struct CommandResult {
+  int status;
+  std::string stderr_text;
+};
+CommandResult RunCommand(const std::string& command, const std::string& stderr_path) {
+  const int status = std::system((command + " >/dev/null 2>" + stderr_path).c_str());
+  return {status, ReadFile(stderr_path)};
+}
+
 grpc::Status List(const std::string& target, const std::string& token) {
   client::ClientOptions options;
   options.token = token;
@@ -89,26 +105,21 @@ TEST(DeformdProcessTest, CommandLineClientsTalkTlsWithAToken) {
                           certificates.Path("client.pem") + " --tls-key " +
                           certificates.Path("client.key") + " --tls-server-name localhost";
   const std::string probe = std::string(DEFORM_PROBE_PATH) + " --target " + deformd.target();
-  EXPECT_EQ(std::system((probe + tls + " >/dev/null 2>&1").c_str()), 0);
-  EXPECT_NE(std::system((probe + " >/dev/null 2>&1").c_str()), 0);  // plaintext: refused
+  const CommandResult probed = RunCommand(probe + tls, dir.Path("probe.err"));
+  EXPECT_EQ(probed.status, 0) << probed.stderr_text << deformd.Log();
+  EXPECT_NE(RunCommand(probe, dir.Path("plain.err")).status, 0);  // plaintext: refused
 
   const std::string vr = std::string(DEFORM_VR_PATH) + " --target " + deformd.target() +
                          " --phantom-vertices 300 --pose knee:flexion:30 --frames 1 --out " +
                          dir.Path("bent.obj");
-  EXPECT_EQ(std::system(("DEFORM_TOKEN=vr-token " + vr + tls + " >/dev/null 2>&1").c_str()), 0);
+  const CommandResult bent = RunCommand("DEFORM_TOKEN=vr-token " + vr + tls, dir.Path("bent.err"));
+  EXPECT_EQ(bent.status, 0) << bent.stderr_text << deformd.Log();
   EXPECT_TRUE(std::ifstream(dir.Path("bent.obj")).good());
-  const int without_token = std::system((vr + tls + " 2>" + dir.Path("vr.err")).c_str());
-  EXPECT_NE(without_token, 0);
-  std::ifstream err(dir.Path("vr.err"));
-  std::string line;
-  std::getline(err, line);
-  EXPECT_THAT(line, HasSubstr("UNAUTHENTICATED"));
+  const CommandResult without_token = RunCommand(vr + tls, dir.Path("vr.err"));
+  EXPECT_NE(without_token.status, 0);
+  EXPECT_THAT(without_token.stderr_text.substr(0, without_token.stderr_text.find('\n')),
+              HasSubstr("UNAUTHENTICATED"));
   EXPECT_EQ(deformd.Stop(), 0);
-}
-
-std::string ReadFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 
 TEST(DeformdProcessTest, StoreBringsAMeshBackAfterARestart) {
@@ -121,8 +132,9 @@ TEST(DeformdProcessTest, StoreBringsAMeshBackAfterARestart) {
     ASSERT_TRUE(deformd.WaitForListening()) << deformd.Log();
     const std::string vr = std::string(DEFORM_VR_PATH) + " --target " + deformd.target() +
                            " --phantom-vertices 300 --pose knee:flexion:60 --frames 1 --keep-mesh" +
-                           " --out " + dir.Path("before.obj") + " >/dev/null 2>&1";
-    ASSERT_EQ(std::system(vr.c_str()), 0);
+                           " --out " + dir.Path("before.obj");
+    const CommandResult before = RunCommand(vr, dir.Path("before.err"));
+    ASSERT_EQ(before.status, 0) << before.stderr_text << deformd.Log();
     client::DeformClient client(deformd.target());
     std::vector<v1::MeshSummary> meshes;
     ASSERT_TRUE(client.ListMeshes(&meshes).ok());
@@ -135,8 +147,9 @@ TEST(DeformdProcessTest, StoreBringsAMeshBackAfterARestart) {
   EXPECT_THAT(restarted.Log(), HasSubstr("store: mesh=" + mesh_id + " tenant=default restored"));
   const std::string vr = std::string(DEFORM_VR_PATH) + " --target " + restarted.target() +
                          " --mesh-id " + mesh_id + " --pose knee:flexion:60 --frames 1 --out " +
-                         dir.Path("after.obj") + " >/dev/null 2>&1";
-  ASSERT_EQ(std::system(vr.c_str()), 0);
+                         dir.Path("after.obj");
+  const CommandResult after = RunCommand(vr, dir.Path("after.err"));
+  ASSERT_EQ(after.status, 0) << after.stderr_text << restarted.Log();
   EXPECT_EQ(ReadFile(dir.Path("after.obj")), ReadFile(dir.Path("before.obj")));
   client::DeformClient client(restarted.target());
   ASSERT_TRUE(client.UnloadMesh(mesh_id).ok());
