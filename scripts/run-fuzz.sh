@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets (tests/fuzz: every mesh reader, the glTF rig reader, the skeleton
-# and skin-weight readers, the phantom's size, and the request conversions: pose, stiffness update,
-# LoadMesh header) with ASan and UBSan, and runs each from its seed corpus
+# and skin-weight readers, the phantom's size, the request conversions: pose, stiffness update,
+# LoadMesh header, and the Deform and LoadMesh stream handlers end to end through a scripted
+# transport) with ASan and UBSan, and runs each from its seed corpus
 # (tests/fuzz/corpus/<target>/) for DEFORM_FUZZ_SECONDS seconds (default 20). Prints every
 # target's executions; exits non-zero on any crash, sanitizer report, timeout or leak (the input
 # is kept under $DEFORM_FUZZ_ARTIFACTS, default build-asan/fuzz-artifacts), or when fewer than
@@ -24,7 +25,7 @@ MIN_TOTAL_RUNS="${DEFORM_FUZZ_MIN_RUNS:-1000000}"
 ARTIFACTS="${DEFORM_FUZZ_ARTIFACTS:-$BUILD_DIR/fuzz-artifacts}"
 TARGETS=(mesh_obj_fuzz mesh_off_fuzz mesh_ply_fuzz mesh_stl_fuzz gltf_fuzz skeleton_tgf_fuzz
   skeleton_json_fuzz weights_dmat_fuzz weights_csv_fuzz phantom_fuzz pose_request_fuzz
-  stiffness_request_fuzz load_header_fuzz)
+  stiffness_request_fuzz load_header_fuzz deform_stream_fuzz load_mesh_stream_fuzz)
 
 scripts/install-deps.sh scripts/packages/build.txt scripts/packages/checks.txt
 
