@@ -142,7 +142,12 @@ void LoadMeshReactor::OnReadDone(bool ok) {
         status = Status::InvalidArgument("empty LoadMeshRequest (neither header nor chunk)");
         break;
     }
-    if (status.ok()) StartRead(&request_);
+    if (status.ok()) {
+      // Not after a finish (a cancel, a failed write or the upload watchdog on another thread):
+      // the call is ending and its reads are over.
+      MutexLock lock(&mutex_);
+      if (!pump_.finish_requested()) StartRead(&request_);
+    }
   }
   if (!status.ok()) Fail(status);
 }
