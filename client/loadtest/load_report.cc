@@ -22,19 +22,37 @@ double Median(std::vector<double> values) {
 }
 
 ServerTimings MedianTimings(const std::vector<ServerTimings>& timings) {
-  std::vector<double> queue, rhs, solve, encode;
+  std::vector<double> queue, rhs, solve, encode, constraint;
   queue.reserve(timings.size());
   rhs.reserve(timings.size());
   solve.reserve(timings.size());
   encode.reserve(timings.size());
+  constraint.reserve(timings.size());
   for (const ServerTimings& t : timings) {
     queue.push_back(t.queue_ms);
     rhs.push_back(t.rhs_ms);
     solve.push_back(t.solve_ms);
     encode.push_back(t.encode_ms);
+    constraint.push_back(t.constraint_ms);
   }
-  return {Median(std::move(queue)), Median(std::move(rhs)), Median(std::move(solve)),
-          Median(std::move(encode))};
+  ServerTimings median;
+  median.queue_ms = Median(std::move(queue));
+  median.rhs_ms = Median(std::move(rhs));
+  median.solve_ms = Median(std::move(solve));
+  median.encode_ms = Median(std::move(encode));
+  median.constraint_ms = Median(std::move(constraint));
+  return median;
+}
+
+void Merge(const ConstraintStats& from, ConstraintStats* into) {
+  into->frames += from.frames;
+  into->frames_penetrating += from.frames_penetrating;
+  into->frames_unresolved += from.frames_unresolved;
+  into->penetrating_after_max = std::max(into->penetrating_after_max, from.penetrating_after_max);
+  into->max_depth_after = std::max(into->max_depth_after, from.max_depth_after);
+  into->contacts_sum += from.contacts_sum;
+  into->contacts_max = std::max(into->contacts_max, from.contacts_max);
+  into->volume_change_max_abs = std::max(into->volume_change_max_abs, from.volume_change_max_abs);
 }
 
 void CountError(LoadReport* report, const std::string& code, std::uint64_t count) {
@@ -76,6 +94,7 @@ LoadReport BuildReport(const RunDescription& run, const LoadPlan& plan, RunOutco
     report.latency_ms.insert(report.latency_ms.end(), stats.latency_ms.begin(),
                              stats.latency_ms.end());
     timings.insert(timings.end(), stats.timings.begin(), stats.timings.end());
+    Merge(stats.constraints, &report.constraints);
     factor_ms.insert(factor_ms.end(), stats.stiffness_factor_ms.begin(),
                      stats.stiffness_factor_ms.end());
     stats.latency_ms = {};
@@ -90,7 +109,7 @@ LoadReport BuildReport(const RunDescription& run, const LoadPlan& plan, RunOutco
   std::vector<double> server_total, outside_server;
   for (std::size_t i = 0; i < timings.size() && i < report.latency_ms.size(); ++i) {
     const ServerTimings& t = timings[i];
-    const double total = t.queue_ms + t.rhs_ms + t.solve_ms + t.encode_ms;
+    const double total = t.queue_ms + t.rhs_ms + t.solve_ms + t.constraint_ms + t.encode_ms;
     server_total.push_back(total);
     outside_server.push_back(report.latency_ms[i] - total);
   }
@@ -155,7 +174,21 @@ nlohmann::ordered_json ReportJson(const LoadReport& report) {
   out["server_ms_p50"] = {{"queue", Ms(report.server_p50.queue_ms)},
                           {"rhs", Ms(report.server_p50.rhs_ms)},
                           {"solve", Ms(report.server_p50.solve_ms)},
+                          {"constraints", Ms(report.server_p50.constraint_ms)},
                           {"encode", Ms(report.server_p50.encode_ms)}};
+  const ConstraintStats& c = report.constraints;
+  out["constraints"] = {
+      {"frames", c.frames},
+      {"frames_penetrating", c.frames_penetrating},
+      {"frames_unresolved", c.frames_unresolved},
+      {"penetrating_after_max", c.penetrating_after_max},
+      {"max_depth_after", c.max_depth_after},
+      {"contacts_mean",
+       Round(c.frames == 0 ? 0.0
+                           : static_cast<double>(c.contacts_sum) / static_cast<double>(c.frames),
+             2)},
+      {"contacts_max", c.contacts_max},
+      {"volume_change_max_abs", c.volume_change_max_abs}};
   out["server_total_ms"] = {{"p50", Ms(report.server_total.p50)},
                             {"p99", Ms(report.server_total.p99)},
                             {"max", Ms(report.server_total.max)}};
@@ -194,9 +227,18 @@ std::string ReportText(const LoadReport& report) {
   add("latency ms: p50 %.3f  p90 %.3f  p99 %.3f  p99.9 %.3f  max %.3f  (mean %.3f)\n", l.p50, l.p90,
       l.p99, l.p999, l.max, l.mean);
   add("largest gap between frames of one stream: %.3f ms\n", report.max_gap_ms);
-  add("server ms (median): queue %.3f  rhs %.3f  solve %.3f  encode %.3f\n",
+  add("server ms (median): queue %.3f  rhs %.3f  solve %.3f  constraints %.3f  encode %.3f\n",
       report.server_p50.queue_ms, report.server_p50.rhs_ms, report.server_p50.solve_ms,
-      report.server_p50.encode_ms);
+      report.server_p50.constraint_ms, report.server_p50.encode_ms);
+  if (report.constraints.frames > 0) {
+    const ConstraintStats& c = report.constraints;
+    add("constraints: %llu frames left skin inside a bone (at most %u vertices, %.3g deep), %llu "
+        "unresolved; contacts mean %.1f max %u; |volume change| at most %.3g\n",
+        static_cast<unsigned long long>(c.frames_penetrating), c.penetrating_after_max,
+        c.max_depth_after, static_cast<unsigned long long>(c.frames_unresolved),
+        static_cast<double>(c.contacts_sum) / static_cast<double>(c.frames), c.contacts_max,
+        c.volume_change_max_abs);
+  }
   add("server total ms: p50 %.3f  p99 %.3f; outside the server (gRPC, wake-ups): p50 %.3f  p99 "
       "%.3f\n",
       report.server_total.p50, report.server_total.p99, report.outside_server.p50,

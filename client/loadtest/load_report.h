@@ -46,9 +46,10 @@ struct LoadReport {
   std::uint64_t stiffness_sent = 0;
   std::uint64_t stiffness_applied = 0;
   double stiffness_factor_ms_p50 = 0;
-  ServerTimings server_p50;  // median of each server timing over measured frames
-  // Per measured frame: the server's share (queue + rhs + solve + encode) and the rest of the
-  // latency (gRPC, the network and both sides' thread wake-ups).
+  ServerTimings server_p50;     // median of each server timing over measured frames
+  ConstraintStats constraints;  // merged over streams
+  // Per measured frame: the server's share (queue + rhs + solve + constraints + encode) and the
+  // rest of the latency (gRPC, the network and both sides' thread wake-ups).
   LatencySummary server_total;
   LatencySummary outside_server;
   // Over measured frames: the mean frames per pass over the factor their solve was part of, and

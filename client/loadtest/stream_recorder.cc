@@ -1,6 +1,7 @@
 #include "loadtest/stream_recorder.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "cli/frame_encoding_flag.h"
 #include "lib/deform_client.h"
@@ -39,8 +40,20 @@ void StreamRecorder::OnFrame(const deform::v1::DeformFrame& frame) {
     stats_.skipped_by_server += frame.skipped_poses();
     stats_.latency_ms.push_back(static_cast<double>(now_ns - frame.client_timestamp_ns()) * 1e-6);
     stats_.timings.push_back({t.queue_ms(), t.rhs_ms(), t.solve_ms(), t.encode_ms(),
-                              static_cast<int>(t.batch_frames()),
-                              static_cast<int>(t.solve_parts())});
+                              static_cast<int>(t.batch_frames()), static_cast<int>(t.solve_parts()),
+                              t.constraint_ms()});
+    if (frame.has_constraints()) {
+      const deform::v1::FrameConstraints& c = frame.constraints();
+      ConstraintStats& out = stats_.constraints;
+      ++out.frames;
+      out.frames_penetrating += c.penetrating_after() > 0 ? 1 : 0;
+      out.frames_unresolved += c.unresolved() ? 1 : 0;
+      out.penetrating_after_max = std::max(out.penetrating_after_max, c.penetrating_after());
+      out.max_depth_after = std::max(out.max_depth_after, c.max_depth_after());
+      out.contacts_sum += c.contacts();
+      out.contacts_max = std::max(out.contacts_max, c.contacts());
+      out.volume_change_max_abs = std::max(out.volume_change_max_abs, std::abs(c.volume_change()));
+    }
   }
   if (frame.sequence() > last_settled_sequence_) {
     last_settled_sequence_ = frame.sequence();

@@ -21,8 +21,21 @@ struct ServerTimings {
   double rhs_ms = 0;
   double solve_ms = 0;
   double encode_ms = 0;
-  int batch_frames = 1;  // frames solved in the same pass over the factor
-  int solve_parts = 1;   // threads the frame's solve was split over
+  int batch_frames = 1;      // frames solved in the same pass over the factor
+  int solve_parts = 1;       // threads the frame's solve was split over
+  double constraint_ms = 0;  // the constraints' corrections after the solve
+};
+
+// What the measured frames' constraints (FrameConstraints) did: bone surfaces, volume, tools.
+struct ConstraintStats {
+  std::uint64_t frames = 0;              // measured frames that carry a constraints report
+  std::uint64_t frames_penetrating = 0;  // ... with skin left inside a bone (penetrating_after)
+  std::uint64_t frames_unresolved = 0;   // ... flagged unresolved
+  std::uint32_t penetrating_after_max = 0;
+  double max_depth_after = 0;      // model units
+  std::uint64_t contacts_sum = 0;  // for the mean over `frames`
+  std::uint32_t contacts_max = 0;
+  double volume_change_max_abs = 0;  // relative, over `frames`
 };
 
 // Counts and samples of one stream. A frame counts as measured when the pose it answers is one of
@@ -30,6 +43,7 @@ struct ServerTimings {
 struct StreamStats {
   std::vector<double> latency_ms;           // measured frames: receipt minus echoed send time
   std::vector<ServerTimings> timings;       // measured frames
+  ConstraintStats constraints;              // measured frames
   std::uint64_t frames_received = 0;        // measured frames
   std::uint64_t frames_received_total = 0;  // including the warm-up
   std::uint64_t skipped_by_server = 0;      // sum of measured frames' skipped_poses

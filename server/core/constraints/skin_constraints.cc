@@ -177,6 +177,18 @@ StatusOr<std::shared_ptr<const SkinConstraints>> SkinConstraints::Create(
         }
       }
     }
+    const MaterialFactorization& factorization = *model.default_factorization();
+    const std::size_t rows = constraints->rows_;
+    constraints->default_directions_.resize(constraints->direction_bones_.size() * 3 * rows);
+    std::vector<double> column(3 * rows);
+    std::vector<double> work(factorization.factor().WorkSize());
+    constraints->SolveBoneDirections(factorization, constraints->default_directions_.data(),
+                                     column.data(), work.data());
+    constraints->default_products_.resize(constraints->direction_bones_.size() *
+                                          constraints->direction_bones_.size());
+    constraints->GradientProducts(constraints->default_directions_.data(),
+                                  constraints->default_products_.data());
+    constraints->default_serial_ = factorization.serial();
   }
   return std::shared_ptr<const SkinConstraints>(std::move(constraints));
 }
@@ -207,6 +219,7 @@ ConstraintScratch SkinConstraints::MakeScratch() const {
     s.gradient.resize(3 * rows);
     s.h.resize(3 * rows);
     s.bone_directions.resize(direction_bones_.size() * 3 * rows);
+    s.direction_products.resize(direction_bones_.size() * direction_bones_.size());
     s.rotations.resize(direction_bones_.size());
   }
   if (k > 0) {
@@ -237,7 +250,8 @@ std::size_t SkinConstraints::ScratchBytes() const {
   std::size_t bytes = 0;
   if (keeps_volume_) {
     doubles += 6 * rows;
-    bytes += direction_bones_.size() * (sizeof(Eigen::Matrix3d) + 3 * rows * sizeof(float));
+    bytes += direction_bones_.size() * (sizeof(Eigen::Matrix3d) + 3 * rows * sizeof(float)) +
+             direction_bones_.size() * direction_bones_.size() * sizeof(Eigen::Matrix3d);
   }
   if (six_columns) doubles += 6 * rows + k;
   if (k > 0) {
@@ -314,40 +328,86 @@ void SkinConstraints::MoveContact(int from, int to, int set, ConstraintScratch* 
   s->inverse_block[to * k + to] = s->inverse_block[from * k + from];
 }
 
-void SkinConstraints::PoseVolumeDirections(const MaterialFactorization& factorization,
-                                           const std::vector<RigidTransform>& bones,
-                                           ConstraintScratch* s, ConstraintReport* report) const {
+double SkinConstraints::PoseVolumeDirections(const MaterialFactorization& factorization,
+                                             const std::vector<RigidTransform>& bones,
+                                             ConstraintScratch* s, ConstraintReport* report) const {
   const std::size_t rows = rows_;
-  const std::size_t n = static_cast<std::size_t>(model_->mesh().num_vertices());
   const int directions = static_cast<int>(direction_bones_.size());
-  if (s->directions_serial != factorization.serial()) {
-    // D_k = M^-1 (h_k g_rest) for this factorization: once per stream and stiffness. Each is
-    // solved in s->h, then laid out by coordinate, as SumRotatedFields reads it.
-    for (int d = 0; d < directions; ++d) {
-      double* column = s->h.data();
-      std::fill(column, column + 3 * rows, 0.0);
-      for (std::size_t c = 0; c < 3; ++c) {
-        const float* field = gradient_fields_.data() + (3 * d + c) * n;
-        for (std::size_t i = 0; i < n; ++i) column[3 * i + c] = field[i];
-      }
-      Solved(factorization.factor().Solve3(column, column, s->solve_work.data()));
-      ++report->solves;
-      for (std::size_t c = 0; c < 3; ++c) {
-        float* field = s->bone_directions.data() + (3 * d + c) * rows;
-        for (std::size_t r = 0; r < rows; ++r) field[r] = static_cast<float>(column[3 * r + c]);
-      }
+  const float* bone_directions = default_directions_.data();
+  const Eigen::Matrix3d* products = default_products_.data();
+  if (factorization.serial() != default_serial_) {
+    // Another stiffness: its D_k once per stream and factorization, solved through s->h.
+    if (s->directions_serial != factorization.serial()) {
+      report->solves += SolveBoneDirections(factorization, s->bone_directions.data(), s->h.data(),
+                                            s->solve_work.data());
+      GradientProducts(s->bone_directions.data(), s->direction_products.data());
+      s->directions_serial = factorization.serial();
     }
-    s->directions_serial = factorization.serial();
+    bone_directions = s->bone_directions.data();
+    products = s->direction_products.data();
   }
-  // g = sum_k h_ik R_k g_rest_i and its direction M^-1 g = sum_k D_k R_k^T: both stream their
-  // fields once. The rows of g past the vertices (the joint nodes) stay zero (MakeScratch).
+  // M^-1 g = sum_k D_k R_k^T streams the fields once.
   for (int d = 0; d < directions; ++d) {
     s->rotations[d] = bones[direction_bones_[d]].rotation.toRotationMatrix();
   }
-  SumRotatedFields(gradient_fields_.data(), n, n, directions, s->rotations.data(),
-                   s->gradient.data());
-  SumRotatedFields(s->bone_directions.data(), rows, rows, directions, s->rotations.data(),
-                   s->h.data());
+  SumRotatedFields(bone_directions, rows, rows, directions, s->rotations.data(), s->h.data());
+  return GradientDotDirection(products, s->rotations.data());
+}
+
+void SkinConstraints::GradientProducts(const float* directions, Eigen::Matrix3d* products) const {
+  const std::size_t rows = rows_;
+  const std::size_t n = static_cast<std::size_t>(model_->mesh().num_vertices());
+  const std::size_t count = direction_bones_.size();
+  for (std::size_t k = 0; k < count; ++k) {
+    for (std::size_t l = 0; l < count; ++l) {
+      Eigen::Matrix3d& c = products[k * count + l];
+      for (int a = 0; a < 3; ++a) {
+        for (int b = 0; b < 3; ++b) {
+          const float* d = directions + (3 * l + a) * rows;
+          const float* f = gradient_fields_.data() + (3 * k + b) * n;
+          double sum = 0;
+          for (std::size_t i = 0; i < n; ++i) sum += static_cast<double>(d[i]) * f[i];
+          c(a, b) = sum;
+        }
+      }
+    }
+  }
+}
+
+double SkinConstraints::GradientDotDirection(const Eigen::Matrix3d* products,
+                                             const Eigen::Matrix3d* rotations) const {
+  // g_i . h_i = sum_kl (R_k f_ki) . (R_l d_li) = sum_kl tr(R_k^T R_l d_li f_ki^T).
+  const std::size_t count = direction_bones_.size();
+  double dot = 0;
+  for (std::size_t k = 0; k < count; ++k) {
+    for (std::size_t l = 0; l < count; ++l) {
+      const Eigen::Matrix3d turn = rotations[k].transpose() * rotations[l];
+      dot += turn.cwiseProduct(products[k * count + l].transpose()).sum();
+    }
+  }
+  return dot;
+}
+
+int SkinConstraints::SolveBoneDirections(const MaterialFactorization& factorization,
+                                         float* bone_directions, double* column,
+                                         double* work) const {
+  const std::size_t rows = rows_;
+  const std::size_t n = static_cast<std::size_t>(model_->mesh().num_vertices());
+  const int directions = static_cast<int>(direction_bones_.size());
+  // Each D_k is solved in `column`, then laid out by coordinate, as SumRotatedFields reads it.
+  for (int d = 0; d < directions; ++d) {
+    std::fill(column, column + 3 * rows, 0.0);
+    for (std::size_t c = 0; c < 3; ++c) {
+      const float* field = gradient_fields_.data() + (3 * d + c) * n;
+      for (std::size_t i = 0; i < n; ++i) column[3 * i + c] = field[i];
+    }
+    Solved(factorization.factor().Solve3(column, column, work));
+    for (std::size_t c = 0; c < 3; ++c) {
+      float* field = bone_directions + (3 * d + c) * rows;
+      for (std::size_t r = 0; r < rows; ++r) field[r] = static_cast<float>(column[3 * r + c]);
+    }
+  }
+  return directions;
 }
 
 bool SkinConstraints::Apply(const MaterialFactorization& factorization, DeformScratch* frame,
@@ -390,7 +450,12 @@ bool SkinConstraints::Apply(const MaterialFactorization& factorization, DeformSc
     closure_->VolumeAlong(s->base.data(), s->h.data(), cubic);
     cubic_known = true;
   };
-  if (keeps_volume_) PoseVolumeDirections(factorization, frame->bone_transforms, s, report);
+  // g . M^-1 g, and g itself (s->gradient) once a round needs it: a round after a correction.
+  double gradient_dot_h = 0;
+  bool gradient_posed = false;
+  if (keeps_volume_) {
+    gradient_dot_h = PoseVolumeDirections(factorization, frame->bone_transforms, s, report);
+  }
   for (int round = 0;; ++round) {
     // The contacts each kind holds now (a tool contact may have taken a bone's plane).
     int bone_held = 0;
@@ -523,10 +588,20 @@ bool SkinConstraints::Apply(const MaterialFactorization& factorization, DeformSc
     bool volume_row = false;
     double volume_target = 0;
     if (keeps_volume_) {
+      // g = sum_k h_ik R_k g_rest_i, its rows past the vertices (the joint nodes) zero
+      // (MakeScratch). Before a round's first correction x is x*, and g . (x - x*) is 0.
       double moved = 0;
-      for (std::size_t v = 0; v < values; ++v) moved += s->gradient[v] * (x[v] - s->base[v]);
+      if (round > 0) {
+        if (!gradient_posed) {
+          SumRotatedFields(gradient_fields_.data(), static_cast<std::size_t>(n),
+                           static_cast<std::size_t>(n), static_cast<int>(direction_bones_.size()),
+                           s->rotations.data(), s->gradient.data());
+          gradient_posed = true;
+        }
+        for (std::size_t v = 0; v < values; ++v) moved += s->gradient[v] * (x[v] - s->base[v]);
+      }
       volume_target = rest_volume_ - volume + moved;
-      volume_row = Dot(s->gradient.data(), s->h.data(), values) > 0;
+      volume_row = gradient_dot_h > 0;
     }
 
     // The multipliers, dropping contacts that pull the skin inward until none does.
@@ -551,7 +626,7 @@ bool SkinConstraints::Apply(const MaterialFactorization& factorization, DeformSc
         }
       }
       if (volume_row) {
-        s->system[set * stride + set] = Dot(s->gradient.data(), s->h.data(), values);
+        s->system[set * stride + set] = gradient_dot_h;
         s->multipliers[set] = volume_target;
       }
       if (q == 0) break;

@@ -11,13 +11,15 @@
 // (x_c the frame of the previous round, x* in the first). The volume's gradient g is taken as the
 // frame's bones turn the rest gradient (g_i = sum_k h_ik R_k g_rest_i on the vertices outside the
 // rigid zones, zero on them), so that its direction in the solve's metric is
-// M^-1 g = sum_k D_k R_k^T with D_k = M^-1 (h_k g_rest) solved once per stream and factorization:
-// no solve per frame. Without contacts the volume along x* + mu M^-1 g is a cubic in mu, solved
-// exactly, so the volume is kept in one round. With contacts the linearised row decides which
-// contacts stay, and the step is exact along d = M^-1 g - M^-1 N nu (A nu = N^T M^-1 g, A the
-// contacts' block, N their normals), which leaves every contact on its plane (N^T d = 0): the
-// volume along it is a cubic again. The contacts' correction and d's are one six-column backward
-// pass (CholeskyFactor::SolveBackwardMany), so a frame whose contacts hold needs one round.
+// M^-1 g = sum_k D_k R_k^T with D_k = M^-1 (h_k g_rest) solved once for the model's default
+// factorization, here, and read by every stream (another stiffness: once per stream and
+// factorization): no solve per frame. Without contacts the volume along x* + mu M^-1 g is a cubic
+// in mu, solved exactly, so the volume is kept in one round. With contacts the linearised row
+// decides which contacts stay, and the step is exact along d = M^-1 g - M^-1 N nu (A nu = N^T M^-1
+// g, A the contacts' block, N their normals), which leaves every contact on its plane (N^T d = 0):
+// the volume along it is a cubic again. The contacts' correction and d's are one six-column
+// backward pass (CholeskyFactor::SolveBackwardMany), so a frame whose contacts hold needs one
+// round.
 //
 // With M = A^T A = P^T L L^T P, the one factorization: x = x* + sum_j lambda_j M^-1 e_{i_j} n_j^T +
 // mu M^-1 g. The contacts need (M^-1)_{i_l i_j} = y_l . y_j with y_j = L^-1 P e_{i_j}, each a
@@ -138,12 +140,11 @@ struct ConstraintScratch {
   std::vector<double> base;      // x*, (n + m) by 3
   std::vector<double> gradient;  // g, (n + m) by 3 (zero on the joint nodes' and rigid rows)
   std::vector<double> h;         // M^-1 g
-  // D_k = M^-1 (h_k g_rest) per bone that weighs a free vertex, (n + m) by 3 each, by coordinate
-  // (SumRotatedFields' layout), for the factorization with this serial
-  // (MaterialFactorization::serial; 0: none yet). In float: h is a direction, and every use of it
-  // reads the same rounded h (the contacts' shares, the exact volume step), so its rounding only
-  // tilts the step by 1e-7, and posing it streams half the bytes.
+  // D_k (SkinConstraints::default_directions_) for a factorization other than the model's
+  // default (a stiffness change), the one with this serial (MaterialFactorization::serial; 0:
+  // none yet): solved by the stream's first frame on it.
   std::vector<float> bone_directions;
+  std::vector<Eigen::Matrix3d> direction_products;  // their GradientProducts
   std::uint64_t directions_serial = 0;
   std::vector<Eigen::Matrix3d> rotations;  // the frame's rotations of the direction bones
   // Right-hand side, then M^-1 sum lambda_j e_{i_j} n_j^T; with the volume, beside it (six
@@ -212,11 +213,24 @@ class SkinConstraints {
   double PathDot(const CholeskyFactor& factor, const ConstraintScratch& s, int l, int j) const;
   // Moves contact `from` to slot `to` (its path and its row and column of the inverse block).
   void MoveContact(int from, int to, int set, ConstraintScratch* s) const;
-  // The frame's volume gradient g (into s->gradient) and its direction M^-1 g (into s->h), from
-  // the bone directions (solved first when the scratch holds another factorization's).
-  void PoseVolumeDirections(const MaterialFactorization& factorization,
-                            const std::vector<RigidTransform>& bones, ConstraintScratch* s,
-                            ConstraintReport* report) const;
+  // The frame's volume direction M^-1 g (into s->h), from the bone directions (solved first when
+  // the scratch holds another factorization's), and the rotations that pose g (s->rotations).
+  // Returns the frame's g . M^-1 g; g itself is posed only when a round needs it (contacts).
+  double PoseVolumeDirections(const MaterialFactorization& factorization,
+                              const std::vector<RigidTransform>& bones, ConstraintScratch* s,
+                              ConstraintReport* report) const;
+  // D_k = M^-1 (h_k g_rest) of every direction bone with `factorization` into `directions`
+  // ((n + m) by 3 each, by coordinate), through `column` (3 (n + m) doubles) and the solve's
+  // `work`; returns the solves made.
+  int SolveBoneDirections(const MaterialFactorization& factorization, float* directions,
+                          double* column, double* work) const;
+  // C_kl = sum_i D_l,i (h_ik g_rest_i)^T over the vertices, for every pair of direction bones
+  // (k major): g . M^-1 g = sum_kl tr(R_k^T R_l C_kl), a frame's volume row without a pass over
+  // the rows, so that a frame without contacts never poses g.
+  void GradientProducts(const float* directions, Eigen::Matrix3d* products) const;
+  // g . M^-1 g of the frame whose direction bones turn by `rotations`.
+  double GradientDotDirection(const Eigen::Matrix3d* products,
+                              const Eigen::Matrix3d* rotations) const;
 
   const DeformationModel* model_ = nullptr;
   std::shared_ptr<const BoneContacts> bones_;
@@ -227,6 +241,15 @@ class SkinConstraints {
   // h_ik g_rest_i for each direction bone k, n by 3 each, by coordinate (SumRotatedFields'). In
   // float like the directions: g only linearises the volume, whose step is then exact.
   std::vector<float> gradient_fields_;
+  // D_k = M^-1 (h_k g_rest) per direction bone with the model's default factorization, (n + m)
+  // by 3 each, by coordinate (SumRotatedFields' layout), solved once here and read by every
+  // stream: so many streams' frames pose one cache-resident copy, not one each. In float: h is a
+  // direction, and every use of it reads the same rounded h (the contacts' shares, the exact
+  // volume step), so its rounding only tilts the step by 1e-7, and posing it streams half the
+  // bytes.
+  std::vector<float> default_directions_;
+  std::vector<Eigen::Matrix3d> default_products_;  // their GradientProducts
+  std::uint64_t default_serial_ = 0;
   double rest_volume_ = 0;
   bool keeps_volume_ = false;
   double margin_ = 0;  // model units

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <memory>
 #include <string>
 #include <vector>
@@ -168,6 +169,38 @@ TEST(SkinConstraints, ApplyAllocatesNothingAndRefusesForeignScratch) {
   ConstraintScratch other_scratch = other_constraints->MakeScratch();
   EXPECT_FALSE(
       constraints->Apply(*model.default_factorization(), &scratch, &other_scratch, &report));
+}
+
+// The volume's directions D_k are solved once for the model's default factorization and read by
+// every stream; a stream on another factorization solves its own on its first frame there, and
+// both give the same frame when the two factorizations hold the same weights.
+TEST(SkinConstraints, VolumeDirectionsAreSharedForTheDefaultAndSolvedForAnother) {
+  const Limb limb = PhantomLimb(800);
+  const DeformationModel& model = *limb.model;
+  const auto constraints = *SkinConstraints::Create(model, limb.bones);
+  const auto same_weights = model.Factorize(Stiffness{});
+  ASSERT_TRUE(same_weights.ok()) << same_weights.status().ToString();
+  ASSERT_NE((*same_weights)->serial(), model.default_factorization()->serial());
+  const Pose pose = PoseFrom(model.skeleton(), "knee:flexion:120");
+  auto frame_on = [&](const MaterialFactorization& factorization, ConstraintScratch* s,
+                      ConstraintReport* report) {
+    DeformScratch scratch = model.MakeScratch();
+    EXPECT_TRUE(model.Deform(factorization, pose, &scratch));
+    EXPECT_TRUE(constraints->Apply(factorization, &scratch, s, report));
+    return Positions(scratch.positions());
+  };
+  ConstraintScratch on_default = constraints->MakeScratch();
+  ConstraintScratch on_other = constraints->MakeScratch();
+  ConstraintReport report;
+  const Positions shared = frame_on(*model.default_factorization(), &on_default, &report);
+  EXPECT_EQ(report.solves, 0);
+  EXPECT_LT(std::abs(report.volume_change_after), constraints->options().volume_tolerance);
+  const Positions own = frame_on(**same_weights, &on_other, &report);
+  EXPECT_GT(report.solves, 0);
+  EXPECT_LT(std::abs(report.volume_change_after), constraints->options().volume_tolerance);
+  EXPECT_LT((shared - own).cwiseAbs().maxCoeff(), 1e-9 * model.bounding_box_diagonal());
+  frame_on(**same_weights, &on_other, &report);
+  EXPECT_EQ(report.solves, 0);  // solved once per stream and factorization
 }
 
 TEST(SkinConstraints, RefuseBonesTheRestSkinEntersAndBadOptions) {
