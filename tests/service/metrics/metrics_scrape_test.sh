@@ -75,6 +75,18 @@ loadtest)
   echo "loadtest frames_received=$received; server frames during=$during after=$after" \
     "bytes=$bytes; streams open during=$open_during"
   [ "$received" -gt 100 ] || fail "too few frames received ($received)"
+  # The phantom carries its bones: every frame reports its constraints, and the load test counts
+  # them (the skin kept outside the bones, the volume kept) and their share of the server's time.
+  constrained=$(json_field "$WORK/run.json" 'r["constraints"]["frames"]')
+  penetrating=$(json_field "$WORK/run.json" 'r["constraints"]["frames_penetrating"]')
+  volume_kept=$(json_field "$WORK/run.json" 'int(r["constraints"]["volume_change_max_abs"] <= 1e-4)')
+  constraint_ms=$(json_field "$WORK/run.json" 'int(r["server_ms_p50"]["constraints"] > 0)')
+  echo "loadtest constraints: frames=$constrained penetrating=$penetrating" \
+    "volume_kept=$volume_kept constraint_ms_positive=$constraint_ms"
+  [ "$constrained" -eq "$received" ] || fail "$constrained of $received frames report constraints"
+  [ "$penetrating" -eq 0 ] || fail "$penetrating frames left skin inside a bone"
+  [ "$volume_kept" -eq 1 ] || fail "a frame's volume moved by more than its tolerance"
+  [ "$constraint_ms" -eq 1 ] || fail "the constraints' share of the server's time is not counted"
   [ "$after" -eq "$received" ] || fail "server counted $after frames, the loadtest $received"
   [ "$during" -gt 0 ] && [ "$during" -lt "$after" ] || fail "frames not counted live ($during)"
   [ "$open_during" -eq 4 ] || fail "streams open during the run: $open_during, expected 4"
