@@ -16,6 +16,7 @@ StatusOr<std::shared_ptr<const BoneContacts>> BoneContacts::Create(
   for (BoneSurface& surface : surfaces) {
     Surface entry;
     entry.bvh = std::make_unique<TriangleBvh>(surface.mesh);
+    entry.side = SurfaceSide::Make(*entry.bvh);
     for (int i = 0; i < skin.num_vertices(); ++i) {
       const bool carried = i < static_cast<int>(rigid_bones.size()) &&
                            rigid_bones[i] == surface.bone && surface.blend_bone < 0;
@@ -65,8 +66,17 @@ bool BoneContacts::Penetration(int s, const RigidTransform& pose, const Eigen::V
       (in_box.array() > surface.box_upper.array()).any()) {
     return false;
   }
-  if (!surface.bvh->Contains(local)) return false;
-  const TriangleBvh::SurfacePoint nearest = surface.bvh->ClosestPoint(local);
+  TriangleBvh::SurfacePoint nearest;
+  if (surface.side != nullptr) {
+    // One nearest-point query answers the side and the depth; rays only where it is unsure.
+    nearest = surface.bvh->ClosestPoint(local);
+    const SurfaceSide::Side side = surface.side->Of(local, nearest);
+    if (side == SurfaceSide::Side::kOutside) return false;
+    if (side == SurfaceSide::Side::kUnsure && !surface.bvh->Contains(local)) return false;
+  } else {
+    if (!surface.bvh->Contains(local)) return false;
+    nearest = surface.bvh->ClosestPoint(local);
+  }
   // Outward: from the inside point to its nearest surface point; on the surface, the face's.
   const double scale = (surface.bvh->upper() - surface.bvh->lower()).norm();
   const Eigen::Vector3d normal = nearest.distance > 1e-9 * scale

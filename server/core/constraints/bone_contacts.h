@@ -11,6 +11,7 @@
 #include "core/geometry/mesh.h"
 #include "core/geometry/pose.h"
 #include "core/geometry/skeleton.h"
+#include "core/geometry/surface_side.h"
 #include "core/geometry/triangle_bvh.h"
 
 namespace deform {
@@ -77,6 +78,9 @@ class BoneContacts {
   struct Surface {
     BoneSurface surface;
     std::unique_ptr<TriangleBvh> bvh;
+    // Its pseudo-normals when they answer for it (SurfaceSide::Make): the side of a point from
+    // its nearest point alone; null: the tree's ray parity (TriangleBvh::Contains).
+    std::unique_ptr<SurfaceSide> side;
     std::vector<int> candidates;  // skin vertices that may enter it
     // Its tight box: in the frame of its principal axes (rest frame to box frame), the bounds.
     Eigen::Matrix3d box_axes = Eigen::Matrix3d::Identity();

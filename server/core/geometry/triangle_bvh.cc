@@ -57,26 +57,49 @@ double SquaredDistanceToBox(const Eigen::Vector3d& p, const Eigen::Vector3d& low
   return (p - clamped).squaredNorm();
 }
 
-// Closest point of triangle abc to p (Ericson, Real-Time Collision Detection, 5.1.5).
+using Feature = TriangleBvh::Feature;
+
+// Closest point of triangle abc to p (Ericson, Real-Time Collision Detection, 5.1.5), and the
+// Voronoi region it was found in (`feature`, when given).
 Eigen::Vector3d ClosestPointOnTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
-                                       const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+                                       const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+                                       Feature* feature = nullptr) {
+  Feature ignored;
+  Feature& region = feature != nullptr ? *feature : ignored;
   const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
   const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0 && d2 <= 0) return a;
+  if (d1 <= 0 && d2 <= 0) {
+    region = Feature::kCorner0;
+    return a;
+  }
   const Eigen::Vector3d bp = p - b;
   const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0 && d4 <= d3) return b;
+  if (d3 >= 0 && d4 <= d3) {
+    region = Feature::kCorner1;
+    return b;
+  }
   const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + d1 / (d1 - d3) * ab;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) {
+    region = Feature::kEdge01;
+    return a + d1 / (d1 - d3) * ab;
+  }
   const Eigen::Vector3d cp = p - c;
   const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0 && d5 <= d6) return c;
+  if (d6 >= 0 && d5 <= d6) {
+    region = Feature::kCorner2;
+    return c;
+  }
   const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + d2 / (d2 - d6) * ac;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) {
+    region = Feature::kEdge20;
+    return a + d2 / (d2 - d6) * ac;
+  }
   const double va = d3 * d6 - d5 * d4;
   if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+    region = Feature::kEdge12;
     return b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b);
   }
+  region = Feature::kFace;
   const double denominator = 1.0 / (va + vb + vc);
   return a + ab * (vb * denominator) + ac * (vc * denominator);
 }
@@ -433,12 +456,13 @@ TriangleBvh::SurfacePoint TriangleBvh::ClosestPoint(const Eigen::Vector3d& point
     if (node.count > 0) {
       for (int p = node.first; p < node.first + node.count; ++p) {
         const int f = order_[p];
+        Feature feature;
         const Eigen::Vector3d closest =
             ClosestPointOnTriangle(point, positions_.row(triangles_(f, 0)).transpose(),
                                    positions_.row(triangles_(f, 1)).transpose(),
-                                   positions_.row(triangles_(f, 2)).transpose());
+                                   positions_.row(triangles_(f, 2)).transpose(), &feature);
         const double distance = (closest - point).norm();
-        if (distance < best.distance) best = {closest, f, distance};
+        if (distance < best.distance) best = {closest, f, distance, feature};
       }
     } else {
       // Nearer child last, so it is popped first.

@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <cstdint>
 #include <vector>
 
 #include "core/geometry/mesh.h"
@@ -40,12 +41,24 @@ class TriangleBvh {
   // The smallest distance from `point` to the surface (exact, by descending the tree).
   double DistanceToSurface(const Eigen::Vector3d& point) const;
 
-  // The point of the surface nearest to `point`, the triangle it lies on and its distance
-  // (exact, by descending the tree). For an empty mesh: triangle -1, distance infinity.
+  // Where on its triangle a nearest point lies: inside the face, on an edge (between the
+  // triangle's corners 0 and 1, 1 and 2, 2 and 0) or at a corner.
+  enum class Feature : std::uint8_t {
+    kFace,
+    kEdge01,
+    kEdge12,
+    kEdge20,
+    kCorner0,
+    kCorner1,
+    kCorner2
+  };
+  // The point of the surface nearest to `point`, the triangle it lies on, where on it, and its
+  // distance (exact, by descending the tree). For an empty mesh: triangle -1, distance infinity.
   struct SurfacePoint {
     Eigen::Vector3d point = Eigen::Vector3d::Zero();
     int triangle = -1;
     double distance = 0;
+    Feature feature = Feature::kFace;
   };
   SurfacePoint ClosestPoint(const Eigen::Vector3d& point) const;
   // The closest pair between the segment [from, to] (from == to: a point) and the surface: the
