@@ -15,22 +15,26 @@ std::int64_t DirectedEdge(int from, int to) {
   return (static_cast<std::int64_t>(from) << 32) | static_cast<std::uint32_t>(to);
 }
 
-// Whether every edge is run once in each direction: closed and consistently oriented (an edge of
-// three or more triangles runs some direction twice).
-bool ClosedAndOriented(const Triangles& triangles) {
-  std::unordered_map<std::int64_t, int> runs;
-  runs.reserve(3 * static_cast<std::size_t>(triangles.rows()));
+using FaceOfEdge = std::unordered_map<std::int64_t, int>;  // directed edge -> its triangle
+
+// The triangle running each directed edge, when every edge is run once in each direction: the
+// surface is closed and consistently oriented (an edge of three or more triangles runs some
+// direction twice). Empty otherwise.
+FaceOfEdge FacesOfClosedOrientedEdges(const Triangles& triangles) {
+  FaceOfEdge face_of;
+  face_of.reserve(3 * static_cast<std::size_t>(triangles.rows()));
   for (int f = 0; f < triangles.rows(); ++f) {
     for (int e = 0; e < 3; ++e) {
-      if (++runs[DirectedEdge(triangles(f, e), triangles(f, (e + 1) % 3))] > 1) return false;
+      if (!face_of.emplace(DirectedEdge(triangles(f, e), triangles(f, (e + 1) % 3)), f).second)
+        return {};
     }
   }
-  for (const auto& [edge, count] : runs) {
+  for (const auto& [edge, face] : face_of) {
     const int from = static_cast<int>(edge >> 32);
     const int to = static_cast<int>(edge & 0xffffffff);
-    if (runs.find(DirectedEdge(to, from)) == runs.end()) return false;
+    if (face_of.find(DirectedEdge(to, from)) == face_of.end()) return {};
   }
-  return true;
+  return face_of;
 }
 
 // Whether the triangles around every vertex form one fan. On a closed, oriented surface each
@@ -114,8 +118,8 @@ std::unique_ptr<SurfaceSide> SurfaceSide::Make(const TriangleBvh& bvh) {
       at_vertex[triangles(f, c)] += angle * side->face_normals_[f];
     }
   }
-  if (!ClosedAndOriented(triangles) ||
-      !OneFanAtEveryCorner(triangles, static_cast<int>(positions.rows())) ||
+  const FaceOfEdge face_of = FacesOfClosedOrientedEdges(triangles);
+  if (face_of.empty() || !OneFanAtEveryCorner(triangles, static_cast<int>(positions.rows())) ||
       !EveryPieceOutward(positions, triangles) || bvh.CountIntersectingTrianglePairs() != 0) {
     return nullptr;
   }
@@ -124,12 +128,6 @@ std::unique_ptr<SurfaceSide> SurfaceSide::Make(const TriangleBvh& bvh) {
     for (int c = 0; c < 3; ++c) side->corner_normals_[3 * f + c] = at_vertex[triangles(f, c)];
   }
   // Each edge's pseudo-normal: the sum of its two triangles' normals, stored with both.
-  std::unordered_map<std::int64_t, int> face_of;  // directed edge -> the triangle running it
-  face_of.reserve(3 * static_cast<std::size_t>(faces));
-  for (int f = 0; f < faces; ++f) {
-    for (int e = 0; e < 3; ++e)
-      face_of[DirectedEdge(triangles(f, e), triangles(f, (e + 1) % 3))] = f;
-  }
   side->edge_normals_.resize(3 * static_cast<std::size_t>(faces));
   for (int f = 0; f < faces; ++f) {
     for (int e = 0; e < 3; ++e) {
