@@ -10,7 +10,7 @@
 // oriented); the triangles around every corner one fan (no two cones touching at a vertex); no two
 // triangles passing through each other (TriangleBvh::CountIntersectingTrianglePairs); and every
 // connected piece enclosing a positive volume (outward normals; a cavity's inward piece is left to
-// the rays). Real segmented bones fail these as often as not: the rays stay their fallback.
+// the rays). Real segmented bones may fail these: the rays stay their fallback.
 //
 // Immutable after Make; Side is const, allocation-free and safe from any number of threads.
 #pragma once
