@@ -177,18 +177,14 @@ nlohmann::ordered_json ReportJson(const LoadReport& report) {
                           {"constraints", Ms(report.server_p50.constraint_ms)},
                           {"encode", Ms(report.server_p50.encode_ms)}};
   const ConstraintStats& c = report.constraints;
-  out["constraints"] = {
-      {"frames", c.frames},
-      {"frames_penetrating", c.frames_penetrating},
-      {"frames_unresolved", c.frames_unresolved},
-      {"penetrating_after_max", c.penetrating_after_max},
-      {"max_depth_after", c.max_depth_after},
-      {"contacts_mean",
-       Round(c.frames == 0 ? 0.0
-                           : static_cast<double>(c.contacts_sum) / static_cast<double>(c.frames),
-             2)},
-      {"contacts_max", c.contacts_max},
-      {"volume_change_max_abs", c.volume_change_max_abs}};
+  out["constraints"] = {{"frames", c.frames},
+                        {"frames_penetrating", c.frames_penetrating},
+                        {"frames_unresolved", c.frames_unresolved},
+                        {"penetrating_after_max", c.penetrating_after_max},
+                        {"max_depth_after", c.max_depth_after},
+                        {"contacts_mean", Round(c.contacts_mean(), 2)},
+                        {"contacts_max", c.contacts_max},
+                        {"volume_change_max_abs", c.volume_change_max_abs}};
   out["server_total_ms"] = {{"p50", Ms(report.server_total.p50)},
                             {"p99", Ms(report.server_total.p99)},
                             {"max", Ms(report.server_total.max)}};
@@ -235,9 +231,8 @@ std::string ReportText(const LoadReport& report) {
     add("constraints: %llu frames left skin inside a bone (at most %u vertices, %.3g deep), %llu "
         "unresolved; contacts mean %.1f max %u; |volume change| at most %.3g\n",
         static_cast<unsigned long long>(c.frames_penetrating), c.penetrating_after_max,
-        c.max_depth_after, static_cast<unsigned long long>(c.frames_unresolved),
-        static_cast<double>(c.contacts_sum) / static_cast<double>(c.frames), c.contacts_max,
-        c.volume_change_max_abs);
+        c.max_depth_after, static_cast<unsigned long long>(c.frames_unresolved), c.contacts_mean(),
+        c.contacts_max, c.volume_change_max_abs);
   }
   add("server total ms: p50 %.3f  p99 %.3f; outside the server (gRPC, wake-ups): p50 %.3f  p99 "
       "%.3f\n",

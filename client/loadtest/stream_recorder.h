@@ -36,6 +36,10 @@ struct ConstraintStats {
   std::uint64_t contacts_sum = 0;  // for the mean over `frames`
   std::uint32_t contacts_max = 0;
   double volume_change_max_abs = 0;  // relative, over `frames`
+
+  double contacts_mean() const {
+    return frames == 0 ? 0.0 : static_cast<double>(contacts_sum) / static_cast<double>(frames);
+  }
 };
 
 // Counts and samples of one stream. A frame counts as measured when the pose it answers is one of
