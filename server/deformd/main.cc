@@ -5,6 +5,7 @@
 //           [--max-upload-mb N] [--max-bone-surface-mb N] [--log-level LEVEL]
 //           [--preload MESH:SKELETON]... [--preload-phantom N]... [--shutdown-grace-s S]
 //           [--keepalive-s S] [--keepalive-timeout-s S] [--idle-timeout-s S]
+//           [--max-connections N] [--max-connections-per-address N]
 //           [--tls-cert PEM --tls-key PEM [--tls-client-ca PEM]] [--plaintext]
 //           [--token-file FILE] [--tenant-max-meshes N] [--tenant-max-streams N]
 //           [--tenant-max-memory-mb N] [--preload-tenant NAME] [--store DIR [--store-key FILE]]
@@ -317,6 +318,17 @@ int main(int argc, char** argv) {
                  "Close a connection without any call for this many seconds")
       ->capture_default_str()
       ->check(CLI::Range(0.1, 86400.0));
+  app.add_option("--max-connections", args.server.connections.max_connections,
+                 "Open gRPC connections at once; more are closed at their accept (0: from the "
+                 "open-files limit, two descriptors each and 256 kept for the rest)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 1 << 20));
+  app.add_option("--max-connections-per-address",
+                 args.server.connections.max_connections_per_address,
+                 "Of them, at most this many from one peer address (so one peer cannot take them "
+                 "all; a balancer in front is one address)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1 << 20));
   app.add_option("--http", args.http_address,
                  "Also serve the browser viewer, the API over HTTP and its streams over "
                  "WebSockets on ADDR (host:port; port 0 = any); plaintext: loopback only unless "

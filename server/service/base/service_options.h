@@ -66,6 +66,14 @@ struct ConnectionOptions {
   // Clients may ping at most this often (their keepalives); more often is answered with GOAWAY.
   // Default: 10 s (GRPC_ARG_HTTP2_MIN_RECV_PING_INTERVAL_WITHOUT_DATA_MS).
   int min_client_ping_interval_ms = 10'000;
+  // Open connections to the gRPC port in all; 0: from the open-files limit, two descriptors per
+  // connection and 256 kept for the rest (connection_acceptor.h). More are closed at their accept.
+  int max_connections = 0;
+  // Open connections to the gRPC port from one peer address. Default: 256, the stream slots'.
+  int max_connections_per_address = 256;
+  // A connection that has not finished its TLS and HTTP/2 handshake this long after its accept
+  // is closed (GRPC_ARG_SERVER_HANDSHAKE_TIMEOUT_MS). Default: 10 s.
+  int handshake_timeout_ms = 10'000;
 };
 
 struct ServerOptions {

@@ -132,6 +132,8 @@ class ServiceContext {
        LogBudget(kRefusalLinesPerSecond, kRefusalLineBurst),
        LogBudget(kRefusalLinesPerSecond, kRefusalLineBurst),
        LogBudget(kRefusalLinesPerSecond, kRefusalLineBurst),
+       LogBudget(kRefusalLinesPerSecond, kRefusalLineBurst),
+       LogBudget(kRefusalLinesPerSecond, kRefusalLineBurst),
        LogBudget(kRefusalLinesPerSecond, kRefusalLineBurst)}};
 };
 

@@ -156,6 +156,10 @@ const char* ServiceMetrics::RefusalName(Refusal reason) {
       return "http_too_large";
     case Refusal::kMetricsScrape:
       return "metrics_scrape";
+    case Refusal::kGrpcConnectionLimit:
+      return "grpc_connection_limit";
+    case Refusal::kNoDescriptors:
+      return "no_descriptors";
   }
   return "other";
 }

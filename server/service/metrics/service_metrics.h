@@ -72,9 +72,11 @@ class ServiceMetrics {
     kHttpConnectionLimit,
     kHttpHostOrOrigin,
     kHttpTooLarge,
-    kMetricsScrape,  // a scrape without a valid metrics or operator token
+    kMetricsScrape,        // a scrape without a valid metrics or operator token
+    kGrpcConnectionLimit,  // a gRPC connection beyond --max-connections(-per-address)
+    kNoDescriptors,        // a waiting connection closed unserved: out of open files
   };
-  static constexpr int kRefusals = 5;
+  static constexpr int kRefusals = 7;
   static const char* RefusalName(Refusal reason);
 
   ServiceMetrics();

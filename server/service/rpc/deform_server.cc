@@ -12,6 +12,7 @@
 #include "health.pb.h"
 #include "service/base/annotated_mutex.h"
 #include "service/base/listen_address.h"
+#include "service/base/log_budget.h"
 #include "service/base/log_text.h"
 #include "service/context/service_context.h"
 #include "service/load/load_request.h"
@@ -20,6 +21,7 @@
 #include "service/registry/mesh_store.h"
 #include "service/rpc/deform_service.h"
 #include "service/rpc/metrics_endpoint.h"
+#include "service/transport/connection_acceptor.h"
 #include "service/transport/loopback_port_guard.h"
 #include "service/transport/server_certificate.h"
 #include "service/transport/transport_security.h"
@@ -27,10 +29,10 @@
 namespace deform::service {
 namespace {
 
-// One server per address (gRPC turns SO_REUSEPORT on by default: a second server would start and
-// take half the connections), keepalive pings and an idle limit.
+// Keepalive pings, an idle limit and a handshake deadline. (The port itself is deformd's:
+// ConnectionAcceptor binds it without SO_REUSEPORT, so no second server can share it.)
 void ApplyConnectionOptions(const ConnectionOptions& options, grpc::ServerBuilder* builder) {
-  builder->AddChannelArgument(GRPC_ARG_ALLOW_REUSEPORT, 0);
+  builder->AddChannelArgument(GRPC_ARG_SERVER_HANDSHAKE_TIMEOUT_MS, options.handshake_timeout_ms);
   builder->AddChannelArgument(GRPC_ARG_KEEPALIVE_TIME_MS, options.keepalive_time_ms);
   builder->AddChannelArgument(GRPC_ARG_KEEPALIVE_TIMEOUT_MS, options.keepalive_timeout_ms);
   builder->AddChannelArgument(GRPC_ARG_KEEPALIVE_PERMIT_WITHOUT_CALLS, 1);
@@ -79,6 +81,9 @@ struct DeformServer::Impl {
   ServiceContext context;
   DeformServiceImpl service;
   std::unique_ptr<grpc::Server> server;
+  // Accepts the gRPC port's connections and hands them to `server` (connection_acceptor.h).
+  std::unique_ptr<ConnectionAcceptor> acceptor;
+  std::unique_ptr<grpc::experimental::ExternalConnectionAcceptor> handoff;
   std::unique_ptr<MetricsEndpoint> metrics;  // null without options.metrics_address
   int port = 0;
   LoopbackPortGuard port_guard;  // the other loopback family's address on `port`
@@ -117,8 +122,14 @@ Status DeformServer::Start() {
     // Port 0 on a loopback address: a port free on both families, so the guard cannot fail.
     bind_address = std::string(split.host) + ":" + std::to_string(picked);
   }
+  ConnectionLimits limits;
+  limits.max_connections = impl_->options.connections.max_connections;
+  limits.max_connections_per_address = impl_->options.connections.max_connections_per_address;
+  DEFORM_ASSIGN_OR_RETURN(impl_->acceptor, ConnectionAcceptor::Listen(bind_address, limits));
+  impl_->port = impl_->acceptor->port();
   grpc::ServerBuilder builder;
-  builder.AddListeningPort(bind_address, credentials, &impl_->port);
+  impl_->handoff = builder.experimental().AddExternalConnectionAcceptor(
+      grpc::ServerBuilder::experimental_type::ExternalConnectionType::FROM_FD, credentials);
   builder.RegisterService(&impl_->service);
   builder.SetMaxReceiveMessageSize(impl_->options.max_message_bytes);
   builder.SetMaxSendMessageSize(impl_->options.max_message_bytes);
@@ -138,8 +149,8 @@ Status DeformServer::Start() {
                             }));
   }
   impl_->server = builder.BuildAndStart();
-  if (impl_->server == nullptr || impl_->port == 0) {
-    impl_->server.reset();
+  if (impl_->server == nullptr) {
+    impl_->acceptor.reset();
     impl_->metrics.reset();
     impl_->port_guard = LoopbackPortGuard();
     return Status::FailedPrecondition("cannot listen on '" + impl_->options.listen_address + "'");
@@ -157,8 +168,11 @@ Status DeformServer::Start() {
   if (grpc::HealthCheckServiceInterface* health = impl_->server->GetHealthCheckService()) {
     health->SetServingStatus(v1::DeformService::service_full_name(), true);
   }
-  spdlog::info("listening on {} ({}) with {} workers", listening_address(), transport,
-               impl_->context.pool().size());
+  StartAccepting();
+  spdlog::info("listening on {} ({}) with {} workers, at most {} connections ({} per address)",
+               listening_address(), transport, impl_->context.pool().size(),
+               impl_->acceptor->limits().max_connections,
+               impl_->acceptor->limits().max_connections_per_address);
   if (!impl_->options.security.cert_file.empty()) {
     const std::string& path = impl_->options.security.cert_file;
     impl_->context.metrics().SetCertificateExpiry(certificate.not_after);
@@ -176,6 +190,49 @@ Status DeformServer::Start() {
         Identity::Implicit().tenant);
   }
   return Status::Ok();
+}
+
+void DeformServer::StartAccepting() {
+  grpc::experimental::ExternalConnectionAcceptor* handoff = impl_->handoff.get();
+  ServiceContext* context = &impl_->context;
+  const ConnectionLimits limits = impl_->acceptor->limits();
+  impl_->acceptor->Start(
+      [handoff](int listener_fd, int fd) {
+        grpc::experimental::ExternalConnectionAcceptor::NewConnectionParameters connection;
+        connection.listener_fd = listener_fd;
+        connection.fd = fd;
+        handoff->HandleNewConnection(&connection);
+      },
+      [context, limits](ConnectionAcceptor::Refusal reason, const std::string& peer) {
+        std::uint64_t held_back = 0;
+        const bool no_descriptors = reason == ConnectionAcceptor::Refusal::kNoDescriptors;
+        if (!context->CountRefusal(no_descriptors ? ServiceMetrics::Refusal::kNoDescriptors
+                                                  : ServiceMetrics::Refusal::kGrpcConnectionLimit,
+                                   &held_back)) {
+          return;
+        }
+        switch (reason) {
+          case ConnectionAcceptor::Refusal::kAll:
+            spdlog::warn(
+                "connection from {} refused: {} connections open (the limit, "
+                "--max-connections){}",
+                peer, limits.max_connections, HeldBackNote(held_back));
+            break;
+          case ConnectionAcceptor::Refusal::kPerAddress:
+            spdlog::warn(
+                "connection from {} refused: {} connections open from that address (the "
+                "limit, --max-connections-per-address){}",
+                peer, limits.max_connections_per_address, HeldBackNote(held_back));
+            break;
+          case ConnectionAcceptor::Refusal::kNoDescriptors:
+            spdlog::error(
+                "out of open files: a waiting connection was closed unserved; accepting "
+                "again shortly (raise the open-files limit, or lower "
+                "--max-connections){}",
+                HeldBackNote(held_back));
+            break;
+        }
+      });
 }
 
 Status DeformServer::UseStore(const std::string& dir, int* restored, const std::string& key_file) {
@@ -232,6 +289,10 @@ int DeformServer::metrics_port() const {
   return impl_->metrics != nullptr ? impl_->metrics->port() : 0;
 }
 
+int DeformServer::open_connections() const {
+  return impl_->acceptor != nullptr ? impl_->acceptor->open_connections() : 0;
+}
+
 std::string DeformServer::listening_address() const {
   return std::string(SplitListenAddress(impl_->options.listen_address).host) + ":" +
          std::to_string(impl_->port);
@@ -260,6 +321,7 @@ void DeformServer::Shutdown(std::chrono::milliseconds grace) {
     if (grpc::HealthCheckServiceInterface* health = impl_->server->GetHealthCheckService()) {
       health->SetServingStatus(false);
     }
+    impl_->acceptor->Stop();  // no new connections
     impl_->context.streams().DrainAll();
     impl_->context.shutting_down().Cancel();  // builds in progress stop at the end of their phase
     impl_->server->Shutdown(std::chrono::system_clock::now() + grace);

@@ -40,6 +40,8 @@ class DeformServer {
   int port() const;
   // The metrics port (options.metrics_address, metrics_endpoint.h) once started, or 0.
   int metrics_port() const;
+  // Open connections to the gRPC port (connection_acceptor.h); 0 before Start().
+  int open_connections() const;
   // "host:port" with the bound port.
   std::string listening_address() const;
 
@@ -78,6 +80,8 @@ class DeformServer {
   ServiceContext& context();
 
  private:
+  // Starts handing the acceptor's connections to gRPC, refusals counted and logged in a budget.
+  void StartAccepting();
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "tests/service/support/raw_http.h"
+#include "tests/service/support/raw_tcp.h"
 #include "tests/service/support/stream_recorder.h"
 #include "tests/service/support/test_server.h"
 #include "tests/service/support/websocket_deform_stream.h"
@@ -26,38 +27,6 @@ namespace deform::test_support {
 namespace {
 
 using ::testing::HasSubstr;
-
-// A TCP connection to 127.0.0.1:port from `from` (a loopback address: all of 127/8 is the
-// loopback interface's) that sends nothing; -1 when it cannot connect.
-int IdleConnection(int port, const char* from = "127.0.0.1") {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in source{};
-  source.sin_family = AF_INET;
-  ::inet_pton(AF_INET, from, &source.sin_addr);
-  if (fd >= 0 && ::bind(fd, reinterpret_cast<sockaddr*>(&source), sizeof(source)) != 0) {
-    ::close(fd);
-    return -1;
-  }
-  sockaddr_in address{};
-  address.sin_family = AF_INET;
-  address.sin_port = htons(static_cast<unsigned short>(port));
-  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  if (fd < 0 || ::connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof(address)) != 0) {
-    if (fd >= 0) ::close(fd);
-    return -1;
-  }
-  return fd;
-}
-
-// Seconds until the server closes `fd` (reads return 0), at most `limit`.
-double SecondsUntilClosed(int fd, double limit) {
-  const auto start = std::chrono::steady_clock::now();
-  timeval timeout{static_cast<time_t>(limit) + 1, 0};
-  ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &timeout, sizeof(timeout));
-  char byte;
-  (void)::recv(fd, &byte, 1, 0);
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 const std::string kGet = "GET /index.html HTTP/1.1\r\nHost: localhost\r\nConnection: close\r\n";
 

@@ -1,0 +1,69 @@
+// Raw TCP connections for the tests of the ports' connection bounds: idle ones (from a chosen
+// loopback address) and how soon the server closes one.
+#pragma once
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <sys/time.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+
+namespace deform::test_support {
+
+// A TCP connection to 127.0.0.1:port from `from` (a loopback address: all of 127/8 is the
+// loopback interface's) that sends nothing; -1 when it cannot connect.
+inline int IdleConnection(int port, const char* from = "127.0.0.1") {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in source{};
+  source.sin_family = AF_INET;
+  ::inet_pton(AF_INET, from, &source.sin_addr);
+  if (fd >= 0 && ::bind(fd, reinterpret_cast<sockaddr*>(&source), sizeof(source)) != 0) {
+    ::close(fd);
+    return -1;
+  }
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_port = htons(static_cast<unsigned short>(port));
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  if (fd < 0 || ::connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof(address)) != 0) {
+    if (fd >= 0) ::close(fd);
+    return -1;
+  }
+  return fd;
+}
+
+// Seconds until the server closes `fd` (reads return 0 or fail), at most about `limit`.
+inline double SecondsUntilClosed(int fd, double limit) {
+  const auto start = std::chrono::steady_clock::now();
+  const auto whole = static_cast<time_t>(limit);
+  timeval timeout{whole, static_cast<suseconds_t>((limit - static_cast<double>(whole)) * 1e6)};
+  ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &timeout, sizeof(timeout));
+  char byte;
+  (void)::recv(fd, &byte, 1, 0);
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// What the server does with `fd` within `limit` seconds: the bytes it sent before closing it (0:
+// closed unserved), or -1 when it is still open then.
+inline long BytesBeforeClose(int fd, double limit) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(limit);
+  long bytes = 0;
+  char buffer[4096];
+  while (std::chrono::steady_clock::now() < deadline) {
+    const double left =
+        std::chrono::duration<double>(deadline - std::chrono::steady_clock::now()).count();
+    const auto whole = static_cast<time_t>(left);
+    timeval timeout{whole, static_cast<suseconds_t>((left - static_cast<double>(whole)) * 1e6) + 1};
+    ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &timeout, sizeof(timeout));
+    const ssize_t got = ::recv(fd, buffer, sizeof buffer, 0);
+    if (got == 0) return bytes;
+    if (got < 0) return errno == EAGAIN || errno == EWOULDBLOCK ? -1 : bytes;
+    bytes += got;
+  }
+  return -1;
+}
+
+}  // namespace deform::test_support
