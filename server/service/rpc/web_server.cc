@@ -5,6 +5,7 @@
 #include <array>
 #include <atomic>
 #include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/steady_timer.hpp>
 #include <boost/asio/strand.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
@@ -523,15 +524,26 @@ struct WebServer::Impl {
                Connections(options.max_connections, options.max_connections_per_address),
                HttpHostPolicy(options.address, options.allowed_hosts)},
         io(options.threads),
-        acceptor(asio::make_strand(io)) {}
+        acceptor(asio::make_strand(io)),
+        accept_pause(acceptor.get_executor()) {}
 
   void Accept() {
     acceptor.async_accept(asio::make_strand(io), [this](beast::error_code error,
                                                         tcp::socket socket) {
       if (error) {
         if (error == asio::error::operation_aborted || !acceptor.is_open()) return;
-        spdlog::warn("http accept failed: {}", error.message());
-        Accept();
+        // Out of descriptors or buffers, the listener stays ready: accepting again at once would
+        // spin. Rest, count and log within the refusal budget, then accept again.
+        std::uint64_t held_back = 0;
+        if (shared.context->CountRefusal(service::ServiceMetrics::Refusal::kNoDescriptors,
+                                         &held_back)) {
+          spdlog::error("http accept failed: {}; accepting again shortly{}", error.message(),
+                        service::HeldBackNote(held_back));
+        }
+        accept_pause.expires_after(std::chrono::milliseconds(100));
+        accept_pause.async_wait([this](beast::error_code waited) {
+          if (!waited && acceptor.is_open()) Accept();
+        });
         return;
       }
       beast::error_code peer_error;
@@ -570,6 +582,7 @@ struct WebServer::Impl {
   Shared shared;
   asio::io_context io;
   tcp::acceptor acceptor;
+  asio::steady_timer accept_pause;  // the rest after a failed accept
   std::vector<std::thread> threads;
   int port = 0;
   service::LoopbackPortGuard port_guard;
@@ -633,6 +646,7 @@ void WebServer::Stop(std::chrono::milliseconds grace) {
   asio::post(impl_->acceptor.get_executor(), [this] {
     beast::error_code ignored;
     impl_->acceptor.close(ignored);
+    impl_->accept_pause.cancel();
   });
   const auto deadline = std::chrono::steady_clock::now() + grace;
   while (impl_->shared.connections.open() > 0 && std::chrono::steady_clock::now() < deadline) {

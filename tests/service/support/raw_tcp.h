@@ -3,6 +3,7 @@
 #pragma once
 
 #include <arpa/inet.h>
+#include <dirent.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
 #include <sys/time.h>
@@ -64,6 +65,16 @@ inline long BytesBeforeClose(int fd, double limit) {
     bytes += got;
   }
   return -1;
+}
+
+// The descriptors this process has open.
+inline int OpenDescriptors() {
+  int count = 0;
+  if (DIR* dir = ::opendir("/proc/self/fd")) {
+    while (::readdir(dir) != nullptr) ++count;
+    ::closedir(dir);
+  }
+  return count;
 }
 
 }  // namespace deform::test_support

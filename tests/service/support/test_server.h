@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cstdint>
 #include <memory>
 #include <string>
 
@@ -56,6 +57,13 @@ class TestServer {
   int web_port() const { return web_ != nullptr ? web_->port() : 0; }
 
   service::DeformServer& server() { return *server_; }
+  // deformd_refused_total{reason="..."} as the server counted it now (0 when absent).
+  std::uint64_t Refused(const std::string& reason) {
+    const std::string page = server_->context().metrics().Serialize();
+    const std::string name = "deformd_refused_total{reason=\"" + reason + "\"} ";
+    const std::size_t at = page.find(name);
+    return at == std::string::npos ? 0 : std::stoull(page.substr(at + name.size()));
+  }
   const std::string& target() const { return target_; }
   // A new client (its own channel, so its own connection).
   std::unique_ptr<client::DeformClient> NewClient(client::ClientOptions options = {}) const {
