@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "service/base/annotated_mutex.h"
+#include "service/base/listen_address.h"
 #include "service/base/log_budget.h"
 #include "service/base/log_text.h"
 #include "service/transport/transport_security.h"
@@ -101,12 +102,12 @@ int LogMessage(const mg_connection* connection, const char* message) {
 // civetweb's listening_ports entry for "host:port": IPv4 as is, "[::1]:port" as is, "localhost"
 // as 127.0.0.1.
 StatusOr<std::string> CivetPort(const std::string& address, std::string* host) {
-  const std::size_t colon = address.rfind(':');
-  if (colon == std::string::npos || colon + 1 == address.size()) {
+  const ListenHostAndPort split = SplitListenAddress(address);
+  if (!split.has_port || split.port.empty()) {
     return Status::InvalidArgument("--metrics '" + EscapeForLog(address) + "' is not HOST:PORT");
   }
-  *host = address.substr(0, colon);
-  const std::string port = address.substr(colon + 1);
+  *host = std::string(split.host);
+  const std::string port(split.port);
   if (port.find_first_not_of("0123456789") != std::string::npos || port.size() > 5) {
     return Status::InvalidArgument("--metrics '" + EscapeForLog(address) +
                                    "': the port is not a number");

@@ -18,6 +18,7 @@
 #include <thread>
 #include <vector>
 
+#include "service/base/listen_address.h"
 #include "service/base/log_budget.h"
 #include "service/base/log_text.h"
 #include "service/deform/deform_stream_reactor.h"
@@ -490,20 +491,21 @@ grpc::StatusCode CodeOf(const Status& status) { return service::ToGrpcCode(statu
 
 // "host:port" -> endpoint; "localhost" is 127.0.0.1, "[::1]" an IPv6 literal.
 StatusOr<tcp::endpoint> ParseEndpoint(const std::string& address) {
-  const std::size_t colon = address.rfind(':');
-  if (colon == std::string::npos) {
+  const service::ListenHostAndPort split = service::SplitListenAddress(address);
+  if (!split.has_port) {
     return Status::InvalidArgument("--http '" + address + "' is not HOST:PORT");
   }
-  std::string host = address.substr(0, colon);
+  std::string host(split.host);
   if (host.size() >= 2 && host.front() == '[' && host.back() == ']') {
     host = host.substr(1, host.size() - 2);
   }
   if (host == "localhost") host = "127.0.0.1";
   int port = -1;
   try {
+    const std::string digits(split.port);
     std::size_t used = 0;
-    port = std::stoi(address.substr(colon + 1), &used);
-    if (used != address.size() - colon - 1) port = -1;
+    port = std::stoi(digits, &used);
+    if (used != digits.size()) port = -1;
   } catch (const std::exception&) {
     port = -1;
   }
