@@ -62,6 +62,12 @@ StatusOr<BoneSurface> LoadBoneSurfaceSpec(std::string_view spec, const Skeleton&
 
 Status WritePosedBoneSurfaces(const std::vector<BoneSurface>& surfaces, const Skeleton& skeleton,
                               const std::vector<RigidTransform>& bones, const std::string& dir) {
+  std::error_code error;
+  std::filesystem::create_directories(dir, error);
+  if (error || !std::filesystem::is_directory(dir, error)) {
+    return Status::FailedPrecondition("cannot create the directory '" + dir +
+                                      "': " + (error ? error.message() : "not a directory"));
+  }
   for (const BoneSurface& surface : surfaces) {
     const RigidTransform pose = BoneSurfaceTransform(surface, skeleton, bones);
     TriangleMesh posed = surface.mesh;

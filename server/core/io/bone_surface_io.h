@@ -23,7 +23,8 @@ StatusOr<BoneSurface> LoadBoneSurfaceSpec(std::string_view spec, const Skeleton&
                                           const MeshLimits& limits = {});
 
 // Writes `surfaces` posed by `bones` (ForwardKinematics of the frame) as DIR/NAME.obj, one file per
-// surface (NAME with anything but letters, digits, '-', '_' and '.' replaced by '_').
+// surface (NAME with anything but letters, digits, '-', '_' and '.' replaced by '_'), creating DIR
+// (and its parents) when missing. FAILED_PRECONDITION naming DIR when it cannot be created.
 Status WritePosedBoneSurfaces(const std::vector<BoneSurface>& surfaces, const Skeleton& skeleton,
                               const std::vector<RigidTransform>& bones, const std::string& dir);
 
