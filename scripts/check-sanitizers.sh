@@ -6,7 +6,8 @@
 #   ASan+UBSan: build-asan ($DEFORM_ASAN_BUILD_DIR, shared with scripts/run-fuzz.sh:
 #               scripts/sanitizers/asan-build.sh), everything ctest runs (the test programs,
 #               deformd and the clients the process tests start, the C API, the Python stubs, the
-#               viewer's files; no benchmarks), then ctest, 2 at a time: every test of the suite, the
+#               viewer's files; no benchmarks), then ctest, 2 at a time: every test of the suite (but
+#               the OutOfDescriptors tests, whose emptied descriptor table the runtime needs), the
 #               tests on the large shared meshes as they are (durations: docs/testing.md). The
 #               benchmarks' ctest tests (bench/animation) are not built here (Release suite only).
 #               A skipped test fails the suite as in the Release run (scripts/run-ctest.sh).
@@ -59,8 +60,12 @@ if [ "$only" = all ] || [ "$only" = asan ]; then
   # the clients the process tests start, the C API, the Python stubs, the viewer's files.
   cmake --build "$ASAN_DIR" --parallel "$(nproc)"
   echo "check-sanitizers: ASan+UBSan build done after $(($(date +%s) - start)) s"
+  # The tests that run a server out of descriptors are the Release suite's alone: the sanitizer
+  # runtime needs descriptors of its own (UBSan's vptr check opens a pipe to probe memory), so
+  # with none left it reports every virtual call of ours as a bad object.
   (export_sanitizer_options &&
-    scripts/run-ctest.sh "$ASAN_DIR" --output-on-failure --parallel "$(nproc)" --timeout 1200)
+    scripts/run-ctest.sh "$ASAN_DIR" --output-on-failure --parallel "$(nproc)" --timeout 1200 \
+      -E 'OutOfDescriptors')
   echo "check-sanitizers: ASan+UBSan suite passed after $(($(date +%s) - start)) s"
 fi
 
