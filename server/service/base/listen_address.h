@@ -16,4 +16,8 @@ struct ListenHostAndPort {
 // Views into `address`, which must outlive them.
 ListenHostAndPort SplitListenAddress(std::string_view address);
 
+// The port of a split address: 0 to 65535 written in 1 to 5 decimal digits; -1 for anything else
+// (no colon, no digits, a sign, a space, more than 65535).
+int ListenPort(const ListenHostAndPort& split);
+
 }  // namespace deform::service

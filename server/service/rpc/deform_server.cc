@@ -109,16 +109,19 @@ Status DeformServer::Start() {
       std::shared_ptr<grpc::ServerCredentials> credentials,
       MakeServerCredentials(impl_->options.security, impl_->options.listen_address, &transport,
                             &certificate));
-  // A fixed port: the other loopback family's address first (loopback_port_guard.h).
+  // A fixed port: the other loopback family's address first (loopback_port_guard.h). No valid
+  // port (-1): ConnectionAcceptor::Listen refuses the address as it is.
   const std::string& address = impl_->options.listen_address;
   const ListenHostAndPort split = SplitListenAddress(address);
-  const int fixed_port = split.has_port ? std::atoi(std::string(split.port).c_str()) : 0;
+  const int fixed_port = ListenPort(split);
   std::string bind_address = address;
   if (fixed_port > 0) {
     auto guard = LoopbackPortGuard::Hold(address, fixed_port);
     if (!guard.ok()) return guard.status();
     impl_->port_guard = std::move(*guard);
-  } else if (const int picked = LoopbackPortGuard::PickFreePort(address, &impl_->port_guard)) {
+  } else if (const int picked = fixed_port == 0
+                                    ? LoopbackPortGuard::PickFreePort(address, &impl_->port_guard)
+                                    : 0) {
     // Port 0 on a loopback address: a port free on both families, so the guard cannot fail.
     bind_address = std::string(split.host) + ":" + std::to_string(picked);
   }

@@ -107,12 +107,12 @@ StatusOr<std::string> CivetPort(const std::string& address, std::string* host) {
     return Status::InvalidArgument("--metrics '" + EscapeForLog(address) + "' is not HOST:PORT");
   }
   *host = std::string(split.host);
-  const std::string port(split.port);
-  if (port.find_first_not_of("0123456789") != std::string::npos || port.size() > 5) {
+  const int port = ListenPort(split);
+  if (port < 0) {
     return Status::InvalidArgument("--metrics '" + EscapeForLog(address) +
-                                   "': the port is not a number");
+                                   "': the port is not a number from 0 to 65535");
   }
-  return (*host == "localhost" ? std::string("127.0.0.1") : *host) + ":" + port;
+  return (*host == "localhost" ? std::string("127.0.0.1") : *host) + ":" + std::to_string(port);
 }
 
 }  // namespace

@@ -500,16 +500,8 @@ StatusOr<tcp::endpoint> ParseEndpoint(const std::string& address) {
     host = host.substr(1, host.size() - 2);
   }
   if (host == "localhost") host = "127.0.0.1";
-  int port = -1;
-  try {
-    const std::string digits(split.port);
-    std::size_t used = 0;
-    port = std::stoi(digits, &used);
-    if (used != digits.size()) port = -1;
-  } catch (const std::exception&) {
-    port = -1;
-  }
-  if (port < 0 || port > 65535) {
+  const int port = service::ListenPort(split);
+  if (port < 0) {
     return Status::InvalidArgument("--http '" + address + "' has no valid port");
   }
   beast::error_code error;

@@ -159,12 +159,8 @@ StatusOr<std::unique_ptr<ConnectionAcceptor>> ConnectionAcceptor::Listen(
     return Status::FailedPrecondition("cannot listen on '" + listen_address + "': " + why);
   };
   const ListenHostAndPort split = SplitListenAddress(listen_address);
-  const std::string port_text(split.port);
-  if (!split.has_port || port_text.empty() ||
-      port_text.find_first_not_of("0123456789") != std::string::npos || port_text.size() > 5 ||
-      std::stoi(port_text) > 65535) {
-    return refuse("not HOST:PORT with a port from 0 to 65535");
-  }
+  int port = ListenPort(split);
+  if (port < 0) return refuse("not HOST:PORT with a port from 0 to 65535");
   if (limits.max_connections == 0) {
     rlimit files{};
     limits.max_connections = DefaultMaxConnections(::getrlimit(RLIMIT_NOFILE, &files) == 0
@@ -179,7 +175,6 @@ StatusOr<std::unique_ptr<ConnectionAcceptor>> ConnectionAcceptor::Listen(
   if (!resolved.ok()) return refuse(resolved.status().message());
   std::unique_ptr<ConnectionAcceptor> acceptor(new ConnectionAcceptor());
   acceptor->limits_ = limits;
-  int port = std::stoi(port_text);
   for (Resolved& address : *resolved) {
     if (wildcard && !acceptor->listeners_.empty()) break;  // the dual-stack one took IPv4 too
     SetPort(&address, port);

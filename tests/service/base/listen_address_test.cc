@@ -25,5 +25,15 @@ TEST(ListenAddressTest, SplitsAtTheLastColonKeepingAnIpv6LiteralsBrackets) {
   EXPECT_FALSE(bare.has_port);
 }
 
+TEST(ListenPort, DecimalDigitsUpTo65535Only) {
+  EXPECT_EQ(ListenPort(SplitListenAddress("127.0.0.1:50051")), 50051);
+  EXPECT_EQ(ListenPort(SplitListenAddress("[::1]:0")), 0);
+  EXPECT_EQ(ListenPort(SplitListenAddress("h:65535")), 65535);
+  for (const char* bad :
+       {"h:65536", "h:", "h", "h:+80", "h: 80", "h:80 ", "h:-1", "h:099999", "h:abc", "h:8o"}) {
+    EXPECT_EQ(ListenPort(SplitListenAddress(bad)), -1) << bad;
+  }
+}
+
 }  // namespace
 }  // namespace deform::service

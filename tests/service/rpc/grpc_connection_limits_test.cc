@@ -3,7 +3,6 @@
 // a connection given back is taken again, and a server that ran out of descriptors serves a new
 // client within a second once they are free again.
 #include <gtest/gtest.h>
-#include <sys/resource.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -79,29 +78,33 @@ TEST(GrpcConnectionLimitsTest, OverAllAddressesTheTotalHolds) {
   for (std::size_t i = 1; i < idle.size(); ++i) ::close(idle[i]);
 }
 
+// A port that is not a number is refused, never replaced by one the kernel picks.
+TEST(GrpcConnectionLimitsTest, AListenAddressWithABadPortIsRefused) {
+  for (const char* address : {"127.0.0.1:http", "127.0.0.1:65536", "127.0.0.1:", "127.0.0.1"}) {
+    service::ServerOptions options = TestServerOptions();
+    options.listen_address = address;
+    service::DeformServer server(options);
+    const Status started = server.Start();
+    EXPECT_EQ(started.code(), StatusCode::kFailedPrecondition) << address;
+    EXPECT_NE(started.message().find("cannot listen on"), std::string::npos) << started.ToString();
+    EXPECT_EQ(server.port(), 0) << address;
+  }
+}
+
 // gRPC's own listener stops accepting for good after one EMFILE; this server accepts again.
 TEST(GrpcConnectionLimitsTest, OutOfDescriptorsTheServerRecoversOnceTheyAreFree) {
   TestServer server;
   ASSERT_TRUE(ServedWithin(server, 2.0));
-  rlimit before{};
-  ASSERT_EQ(::getrlimit(RLIMIT_NOFILE, &before), 0);
-  rlimit lowered = before;
-  lowered.rlim_cur = static_cast<rlim_t>(OpenDescriptors() + 24);
-  ASSERT_EQ(::setrlimit(RLIMIT_NOFILE, &lowered), 0);
   // More connections than the process has descriptors left for: the clients' ends take some,
   // the server's accepts the rest, and the last ones wait in the backlog with none left.
-  std::vector<int> idle;
-  for (int i = 0; i < 64; ++i) {
-    const int fd = IdleConnection(server.server().port());
-    if (fd < 0) break;
-    idle.push_back(fd);
-  }
+  DescriptorShortage shortage(server.server().port());
+  ASSERT_TRUE(shortage.ok());
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
   const std::uint64_t refused = server.Refused("no_descriptors");
-  for (const int fd : idle) ::close(fd);
-  EXPECT_GE(refused, 1u) << idle.size() << " connections opened";
+  const std::size_t opened = shortage.connections();
+  shortage.CloseConnections();  // descriptors free again, under the same lowered limit
+  EXPECT_GE(refused, 1u) << opened << " connections opened";
   EXPECT_TRUE(ServedWithin(server, 1.0)) << "not served within a second of the descriptors' return";
-  ASSERT_EQ(::setrlimit(RLIMIT_NOFILE, &before), 0);
 }
 
 }  // namespace

@@ -8,7 +8,6 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <netinet/in.h>
-#include <sys/resource.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -125,22 +124,13 @@ TEST(HttpLimitsTest, OnePeerAddressCannotTakeEverySlot) {
 // and serves again once descriptors are free.
 TEST(HttpLimitsTest, OutOfDescriptorsThePortRestsAndServesAgain) {
   TestServer server(TestServerOptions(), "", true);
-  rlimit before{};
-  ASSERT_EQ(::getrlimit(RLIMIT_NOFILE, &before), 0);
-  rlimit lowered = before;
-  lowered.rlim_cur = static_cast<rlim_t>(OpenDescriptors() + 24);
-  ASSERT_EQ(::setrlimit(RLIMIT_NOFILE, &lowered), 0);
-  std::vector<int> idle;
-  for (int i = 0; i < 64; ++i) {
-    const int fd = IdleConnection(server.web_port());
-    if (fd < 0) break;
-    idle.push_back(fd);
-  }
+  DescriptorShortage shortage(server.web_port());
+  ASSERT_TRUE(shortage.ok());
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
   const std::uint64_t refused = server.Refused("no_descriptors");
-  for (const int fd : idle) ::close(fd);
-  ASSERT_EQ(::setrlimit(RLIMIT_NOFILE, &before), 0);
-  EXPECT_GE(refused, 1u) << idle.size() << " connections opened";
+  const std::size_t opened = shortage.connections();
+  shortage.End();
+  EXPECT_GE(refused, 1u) << opened << " connections opened";
   EXPECT_LE(refused, 20u) << "the accept was tried again without a rest";
   std::this_thread::sleep_for(std::chrono::milliseconds(150));
   const int again = IdleConnection(server.web_port());

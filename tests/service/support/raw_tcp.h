@@ -5,12 +5,14 @@
 #include <arpa/inet.h>
 #include <dirent.h>
 #include <netinet/in.h>
+#include <sys/resource.h>
 #include <sys/socket.h>
 #include <sys/time.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <chrono>
+#include <vector>
 
 namespace deform::test_support {
 
@@ -76,5 +78,47 @@ inline int OpenDescriptors() {
   }
   return count;
 }
+
+// While alive, this process is short of descriptors: the soft limit sits `spare` above those
+// open at its construction, and the idle connections it opens to 127.0.0.1:port (up to `most`,
+// until a socket cannot be made) leave the server's accepts none. Closes them and restores the
+// limit when destroyed (or at End()). ok() is false when the limit could not be changed.
+class DescriptorShortage {
+ public:
+  DescriptorShortage(int port, int spare = 24, int most = 64) {
+    if (::getrlimit(RLIMIT_NOFILE, &before_) != 0) return;
+    rlimit lowered = before_;
+    lowered.rlim_cur = static_cast<rlim_t>(OpenDescriptors() + spare);
+    if (::setrlimit(RLIMIT_NOFILE, &lowered) != 0) return;
+    lowered_ = true;
+    for (int i = 0; i < most; ++i) {
+      const int fd = IdleConnection(port);
+      if (fd < 0) break;
+      idle_.push_back(fd);
+    }
+  }
+  ~DescriptorShortage() { End(); }
+  DescriptorShortage(const DescriptorShortage&) = delete;
+  DescriptorShortage& operator=(const DescriptorShortage&) = delete;
+
+  bool ok() const { return lowered_; }
+  std::size_t connections() const { return idle_.size(); }
+  // Closes the connections (the limit stays lowered). Idempotent.
+  void CloseConnections() {
+    for (const int fd : idle_) ::close(fd);
+    idle_.clear();
+  }
+  // Closes the connections and restores the limit now. Idempotent.
+  void End() {
+    CloseConnections();
+    if (lowered_) ::setrlimit(RLIMIT_NOFILE, &before_);
+    lowered_ = false;
+  }
+
+ private:
+  rlimit before_{};
+  bool lowered_ = false;
+  std::vector<int> idle_;
+};
 
 }  // namespace deform::test_support
