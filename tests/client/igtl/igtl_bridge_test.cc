@@ -196,8 +196,11 @@ TEST_P(IgtlBridgeTest, ServesTopologyFramesBonesAndTakesJointAngles) {
   // Malformed angles are refused (logged, escaped) and the bridge goes on.
   ASSERT_TRUE(receiver.SendString("joint1:x"));
   ASSERT_TRUE(receiver.SendString("nosuchjoint:x:5\n\x1b[31m"));
+  // Both refusals logged; the second's newline and ESC written as escapes, never as the bytes.
   EXPECT_TRUE(bridge.WaitForLog("refused", std::chrono::seconds(10))) << bridge.Log();
-  EXPECT_NE(bridge.Log().find("\\x1b"), std::string::npos) << "escaped in the log";
+  EXPECT_TRUE(bridge.WaitForLog("nosuchjoint:x:5\\n\\x1b[31m", std::chrono::seconds(10)))
+      << bridge.Log();
+  EXPECT_EQ(bridge.Log().find('\x1b'), std::string::npos) << "a raw ESC in the log";
   Observation after = Observe(receiver, 0.5, leg.vertices);
   EXPECT_TRUE(after.error.empty()) << after.error;
   EXPECT_GT(after.frames, 5);
