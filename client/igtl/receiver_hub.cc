@@ -25,6 +25,9 @@ using service::EscapeForLog;
 // connection (reading it whole would let one receiver make the bridge read without bound).
 constexpr std::uint64_t kMaxBodyBytes = 64 * 1024;
 
+// SO_SNDBUF of a receiver's connection (Linux doubles it).
+constexpr int kSendBufferBytes = 128 * 1024;
+
 // Reads exactly `size` bytes; false on end of stream or error.
 bool ReadAll(int fd, void* data, std::size_t size) {
   auto* bytes = static_cast<char*>(data);
@@ -165,6 +168,10 @@ void ReceiverHub::AcceptLoop() {
     }
     const int one = 1;
     setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof(one));
+    // A small send buffer: frames wait in the hub, where a newer one replaces them, rather than
+    // queue in the kernel behind a receiver that reads slower than they come.
+    const int send_buffer = kSendBufferBytes;
+    setsockopt(fd, SOL_SOCKET, SO_SNDBUF, &send_buffer, sizeof(send_buffer));
     auto receiver = std::make_unique<Receiver>();
     receiver->fd = fd;
     receiver->peer = peer;
