@@ -172,6 +172,10 @@ int RunBridge(client::DeformClient& client, const deform::v1::MeshSummary& summa
   for (std::int64_t k = 1; !stop.load() && !ended; ++k) {
     ended = end.WaitUntil(t0 + std::chrono::duration_cast<Clock::duration>(k * period));
     if (!ended && ticking && !stop.load()) poses.SendCurrent();
+    // Ticks missed (a stalled machine) are skipped, not made up for with a burst of poses.
+    const auto due =
+        static_cast<std::int64_t>(std::chrono::duration<double>(Clock::now() - t0) / period);
+    if (due > k) k = due;
   }
   if (!ended) {
     stream->Close();

@@ -23,6 +23,10 @@ bool JointAngleInput::Apply(const std::string& text, std::string* error) {
     return true;
   }
   deform::v1::PoseUpdate parsed;
+  if (trimmed.empty()) {
+    *error = "no joint angles: expected JOINT:AXIS:DEGREES[,...] or rest";
+    return false;
+  }
   if (!client::ParsePoseAngles(std::string(trimmed), &parsed, error)) return false;
   std::vector<Term> updated = terms_;
   for (const deform::v1::JointAngle& angle : parsed.angles()) {
