@@ -5,7 +5,8 @@
 //  - "Skin", POLYDATA with points and triangles: the rest pose's topology, once per connection,
 //    before anything else;
 //  - "SkinPoints", POLYDATA with the points alone (no vertices, lines, polygons, strips or
-//    attributes): one per frame, point i being point i of "Skin";
+//    attributes): one per frame, point i being point i of "Skin" (with --full-frames, "Skin"
+//    again instead, triangles included);
 //  - one TRANSFORM per skeleton bone (BoneDeviceNames), per frame: the bone's motion from its rest
 //    pose, posed = T rest.
 // Everything in RAS millimetres (ras_frame.h).

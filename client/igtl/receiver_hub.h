@@ -7,7 +7,7 @@
 // sends reach `on_string`; other message types are read and ignored.
 //
 // Thread safety: Publish and receivers() may be called from any thread; on_string runs on the
-// receivers' reading threads, one receiver at a time.
+// receivers' reading threads, so for two receivers at once (it serializes what it shares).
 #pragma once
 
 #include <condition_variable>
