@@ -192,6 +192,36 @@ TEST_P(IgtlBridgeTest, ServesTopologyFramesBonesAndTakesJointAngles) {
   ASSERT_TRUE(bent.error.empty()) << bent.error;
   EXPECT_NEAR(Trace3(bent.last_transform[kBoneDevices[1]]), 1 + 2 * std::cos(M_PI / 3), 1e-3);
   EXPECT_NEAR(Trace3(bent.last_transform[kBoneDevices[0]]), 3.0f, 1e-4);
+  // The vertex that moved most (at the toes, far from the knee, carried rigidly by the bones
+  // below it) is where the calf's transform takes its rest position: the transforms move RAS
+  // millimetre rest geometry as the points show it.
+  {
+    std::size_t far = 0;
+    float far_moved = 0;
+    for (std::size_t v = 0; v < leg.vertices; ++v) {
+      float moved = 0;
+      for (std::size_t a = 0; a < 3; ++a) {
+        moved =
+            std::max(moved, std::abs(bent.last_points[3 * v + a] - rest.last_points[3 * v + a]));
+      }
+      if (moved > far_moved) {
+        far = v;
+        far_moved = moved;
+      }
+    }
+    const ReceivedMessage& calf = bent.last_transform[kBoneDevices[1]];
+    float error = 0;
+    for (std::size_t r = 0; r < 3; ++r) {
+      const float* p = &topology.points[3 * far];
+      const float posed = calf.matrix[r][0] * p[0] + calf.matrix[r][1] * p[1] +
+                          calf.matrix[r][2] * p[2] + calf.matrix[r][3];
+      error = std::max(error, std::abs(posed - bent.last_points[3 * far + r]));
+    }
+    std::cout << leg.mesh << ": vertex " << far << " moved " << far_moved
+              << " mm; the calf's transform puts it within " << error << " mm" << std::endl;
+    EXPECT_GT(far_moved, 100.0f);
+    EXPECT_LT(error, 0.05f * far_moved);
+  }
 
   // Malformed angles are refused (logged, escaped) and the bridge goes on.
   ASSERT_TRUE(receiver.SendString("joint1:x"));
