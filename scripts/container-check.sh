@@ -9,13 +9,19 @@
 # prints the image size. Exits non-zero on any failure with the reason on its last line.
 #
 # DEFORM_IMAGE (default localhost/deformd:check) and DEFORM_CHECK_PORT (default 50051) let two
-# checks run side by side.
+# checks run side by side. DEFORM_IMAGE_FROM_BUILD=BUILD_DIR checks the image of an existing
+# build instead (docker/Dockerfile's target `prebuilt`, staged by scripts/stage-prebuilt-image.sh:
+# nothing compiled) with the same checks, and also that its deformd serves the browser viewer's
+# page from the image (--http on 127.0.0.1:DEFORM_CHECK_PORT+1). CI (.ci/run) checks the full
+# build's image.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 
 IMAGE="${DEFORM_IMAGE:-localhost/deformd:check}"
 CONTAINER="deformd-check-$$"
 PORT="${DEFORM_CHECK_PORT:-50051}"  # given to the container as DEFORMD_PORT
+FROM_BUILD="${DEFORM_IMAGE_FROM_BUILD:-}"
+HTTP_PORT=$((PORT + 1))
 BASE_IMAGE="docker.io/library/debian:bookworm-slim"
 WORK="$(mktemp -d)"
 
@@ -46,9 +52,11 @@ PODMAN=(podman --runtime runc)
 # machines like this one lack; explicit limits at or below the host's start everywhere.
 RUN_FLAGS=(--network host --ulimit nofile=16384:16384 --ulimit nproc=16384:16384)
 
-if ss -ltn 2>/dev/null | grep -q ":$PORT "; then
-  fail "port $PORT is in use on this host (the container runs with host networking)"
-fi
+for port in "$PORT" ${FROM_BUILD:+"$HTTP_PORT"}; do
+  if ss -ltn 2>/dev/null | grep -q ":$port "; then
+    fail "port $port is in use on this host (the container runs with host networking)"
+  fi
+done
 
 if ! "${PODMAN[@]}" image exists "$BASE_IMAGE"; then
   step "making the base image $BASE_IMAGE with mmdebstrap"
@@ -58,18 +66,34 @@ if ! "${PODMAN[@]}" image exists "$BASE_IMAGE"; then
     fail "podman could not import the base image"
 fi
 
-# The builder stage compiles the shipped programs only (DEFORM_IMAGE_TESTS=0: .ci/run has run the
-# suite on these sources with this compiler before) through the host's ccache, mounted at /ccache.
-CCACHE_HOST_DIR="${DEFORM_IMAGE_CCACHE:-$(ccache -k cache_dir 2>/dev/null || echo "$HOME/.cache/ccache")}"
-mkdir -p "$CCACHE_HOST_DIR" || fail "could not make the ccache directory $CCACHE_HOST_DIR"
-step "building $IMAGE (the shipped programs, through the ccache in $CCACHE_HOST_DIR)"
+EXTRA_FLAGS=(--log-level debug)
 build_start=$(date +%s)
-"${PODMAN[@]}" build --isolation chroot --network host --format docker \
-  --build-arg DEFORM_IMAGE_TESTS=0 --volume "$CCACHE_HOST_DIR:/ccache" \
-  -f docker/Dockerfile -t "$IMAGE" . >"$WORK/build.log" 2>&1 || {
-  tail -40 "$WORK/build.log"
-  fail "image build failed (log above)"
-}
+if [ -n "$FROM_BUILD" ]; then
+  # The existing build's programs and viewer files in the same runtime stage: nothing compiled.
+  step "building $IMAGE from the build in $FROM_BUILD (target prebuilt)"
+  scripts/stage-prebuilt-image.sh "$FROM_BUILD" "$WORK/context" >"$WORK/build.log" 2>&1 || {
+    cat "$WORK/build.log"
+    fail "could not stage the build in $FROM_BUILD"
+  }
+  "${PODMAN[@]}" build --isolation chroot --network host --format docker --target prebuilt \
+    -f docker/Dockerfile -t "$IMAGE" "$WORK/context" >>"$WORK/build.log" 2>&1 || {
+    tail -40 "$WORK/build.log"
+    fail "image build failed (log above)"
+  }
+  EXTRA_FLAGS+=(--http "127.0.0.1:$HTTP_PORT")
+else
+  # The builder stage compiles the shipped programs only (DEFORM_IMAGE_TESTS=0: .ci/run has run the
+  # suite on these sources with this compiler before) through the host's ccache, mounted at /ccache.
+  CCACHE_HOST_DIR="${DEFORM_IMAGE_CCACHE:-$(ccache -k cache_dir 2>/dev/null || echo "$HOME/.cache/ccache")}"
+  mkdir -p "$CCACHE_HOST_DIR" || fail "could not make the ccache directory $CCACHE_HOST_DIR"
+  step "building $IMAGE (the shipped programs, through the ccache in $CCACHE_HOST_DIR)"
+  "${PODMAN[@]}" build --isolation chroot --network host --format docker \
+    --build-arg DEFORM_IMAGE_TESTS=0 --volume "$CCACHE_HOST_DIR:/ccache" \
+    -f docker/Dockerfile -t "$IMAGE" . >"$WORK/build.log" 2>&1 || {
+    tail -40 "$WORK/build.log"
+    fail "image build failed (log above)"
+  }
+fi
 step "image built in $(($(date +%s) - build_start)) s"
 
 step "checking the runtime image holds no compiler and no -dev package"
@@ -84,10 +108,10 @@ esac
 leftovers=$(printf '%s\n' "$inventory" | grep -v '^inventory-complete$' || true)
 [ -z "$leftovers" ] || fail "runtime image contains build tools or -dev packages: $leftovers"
 
-step "starting the container hardened (read-only, no capabilities, no-new-privileges) with --log-level debug"
+step "starting the container hardened (read-only, no capabilities, no-new-privileges) with ${EXTRA_FLAGS[*]}"
 "${PODMAN[@]}" run -d --name "$CONTAINER" "${RUN_FLAGS[@]}" --read-only --cap-drop=ALL \
   --security-opt=no-new-privileges -e DEFORMD_PORT="$PORT" -e DEFORMD_PRELOAD=phantom:500 \
-  "$IMAGE" --log-level debug >/dev/null || fail "container did not start"
+  "$IMAGE" "${EXTRA_FLAGS[@]}" >/dev/null || fail "container did not start"
 
 step "waiting for the health check to pass"
 healthy=0
@@ -107,6 +131,14 @@ printf '%s\n' "$logs" | grep -q "listening on 0.0.0.0:$PORT " ||
 printf '%s\n' "$logs" | grep -q "\[debug\]" || fail "the extra --log-level debug was not applied"
 "${PODMAN[@]}" exec "$CONTAINER" deformd-healthcheck >/dev/null ||
   fail "the health check script does not reach port $PORT"
+
+if [ -n "$FROM_BUILD" ]; then
+  step "checking that deformd serves the viewer's page from the image"
+  page=$(curl -sf "http://127.0.0.1:$HTTP_PORT/") || fail "no page on 127.0.0.1:$HTTP_PORT"
+  printf '%s\n' "$page" | grep -q 'viewer.js' || fail "the page served is not the viewer's"
+  curl -sf -o /dev/null "http://127.0.0.1:$HTTP_PORT/vendor/three.module.js" ||
+    fail "the viewer's libraries are not served"
+fi
 
 step "checking the server process runs as non-root"
 uid=$("${PODMAN[@]}" exec "$CONTAINER" awk '/^Uid:/ {print $2}' /proc/1/status)
