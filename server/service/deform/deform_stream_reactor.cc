@@ -44,11 +44,12 @@ void CountWritten(const v1::DeformResponse& message, ServiceMetrics* metrics) {
   if (!message.has_frame()) return;
   const v1::DeformFrame& frame = message.frame();
   const v1::FrameTimings& t = frame.timings();
-  const double server_ms =
-      t.queue_ms() + t.rhs_ms() + t.solve_ms() + t.constraint_ms() + t.encode_ms();
+  // The frame's own timings split its server time: the wait before its solve, and the rest.
+  const double compute_ms = t.rhs_ms() + t.solve_ms() + t.constraint_ms() + t.encode_ms();
   const int encoding =
       frame.has_encoded() ? frame.encoded().encoding() : v1::FRAME_ENCODING_FLOAT32;
-  metrics->FrameWritten(encoding, message.ByteSizeLong(), server_ms * 1e-3, frame.skipped_poses());
+  metrics->FrameWritten(encoding, message.ByteSizeLong(), t.queue_ms() * 1e-3, compute_ms * 1e-3,
+                        frame.skipped_poses());
   if (frame.has_constraints()) {
     metrics->ConstrainedFrameWritten(t.constraint_ms() * 1e-3, frame.constraints().unresolved());
   }

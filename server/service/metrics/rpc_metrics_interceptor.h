@@ -1,6 +1,9 @@
-// A gRPC server interceptor that counts every finished RPC by method and status code
-// (ServiceMetrics::RpcFinished), whatever path finished it: the service's reactors, a call
-// refused before a reactor existed, or gRPC itself (a deadline, a cancelled or unknown call).
+// A gRPC server interceptor that counts every RPC: deformd_rpcs_total by method and status code
+// (ServiceMetrics::RpcFinished), whatever path finished it (the service's reactors, a call
+// refused before a reactor existed, or gRPC itself: a deadline, a cancelled or unknown call), and
+// the standard grpc_server_* metrics for the methods of grpc_methods.h: the call's start (when
+// gRPC creates the interceptor), each message received and sent, and its status with the time
+// since its start.
 #pragma once
 
 #include <grpcpp/support/server_interceptor.h>

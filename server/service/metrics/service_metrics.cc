@@ -1,13 +1,18 @@
 #include "service/metrics/service_metrics.h"
 
+#include <prometheus/collectable.h>
 #include <prometheus/counter.h>
 #include <prometheus/gauge.h>
 #include <prometheus/histogram.h>
 #include <prometheus/registry.h>
 #include <prometheus/text_serializer.h>
 
+#include <iterator>
+#include <vector>
+
 #include "core/base/build_info.h"
 #include "core/base/status.h"
+#include "service/metrics/process_collector.h"
 
 namespace deform::service {
 namespace {
@@ -42,7 +47,8 @@ prometheus::Histogram::BucketBoundaries Exponential(double first, double factor,
 
 }  // namespace
 
-ServiceMetrics::ServiceMetrics() : registry_(std::make_shared<prometheus::Registry>()) {
+ServiceMetrics::ServiceMetrics()
+    : registry_(std::make_shared<prometheus::Registry>()), process_(MakeProcessCollector()) {
   using prometheus::BuildCounter;
   using prometheus::BuildGauge;
   using prometheus::BuildHistogram;
@@ -65,6 +71,19 @@ ServiceMetrics::ServiceMetrics() : registry_(std::make_shared<prometheus::Regist
       &BuildHistogram()
            .Name("deformd_frame_server_seconds")
            .Help("Server time of a written frame: queue, right-hand side, solve and encode")
+           .Register(*registry_)
+           .Add({}, Exponential(0.000125, 2, 14));
+  // The two parts of the server time, on the same buckets.
+  frame_queue_seconds_ =
+      &BuildHistogram()
+           .Name("deformd_frame_queue_seconds")
+           .Help("Queue time of a written frame: from the pose's arrival to its solve's start")
+           .Register(*registry_)
+           .Add({}, Exponential(0.000125, 2, 14));
+  frame_compute_seconds_ =
+      &BuildHistogram()
+           .Name("deformd_frame_compute_seconds")
+           .Help("Compute time of a written frame: right-hand side, solve, constraints, encode")
            .Register(*registry_)
            .Add({}, Exponential(0.000125, 2, 14));
   frame_constraint_seconds_ =
@@ -106,6 +125,50 @@ ServiceMetrics::ServiceMetrics() : registry_(std::make_shared<prometheus::Regist
                       .Register(*registry_);
   for (int r = 0; r < kRefusals; ++r) {
     refused_[r] = &refused.Add({{"reason", RefusalName(static_cast<Refusal>(r))}});
+  }
+  auto& started = BuildCounter()
+                      .Name("grpc_server_started_total")
+                      .Help("Total number of RPCs started on the server.")
+                      .Register(*registry_);
+  auto& handled = BuildCounter()
+                      .Name("grpc_server_handled_total")
+                      .Help(
+                          "Total number of RPCs completed on the server, regardless of success "
+                          "or failure.")
+                      .Register(*registry_);
+  auto& received = BuildCounter()
+                       .Name("grpc_server_msg_received_total")
+                       .Help("Total number of RPC stream messages received on the server.")
+                       .Register(*registry_);
+  auto& sent = BuildCounter()
+                   .Name("grpc_server_msg_sent_total")
+                   .Help("Total number of gRPC stream messages sent by the server.")
+                   .Register(*registry_);
+  auto& handling = BuildHistogram()
+                       .Name("grpc_server_handling_seconds")
+                       .Help(
+                           "Histogram of response latency (seconds) of gRPC that had been "
+                           "application-level handled by the server.")
+                       .Register(*registry_);
+  // Unary calls take milliseconds; streams last a session (minutes to an hour or more).
+  const prometheus::Histogram::BucketBoundaries handling_bounds = {
+      0.0005, 0.001, 0.0025, 0.005, 0.01, 0.025, 0.05, 0.1, 0.25, 0.5,
+      1,      2.5,   5,      10,    30,   60,    300,  900, 3600};
+  for (int m = 0; m < kGrpcMethods; ++m) {
+    const GrpcMethod& row = kServedGrpcMethods[m];
+    const prometheus::Labels labels = {{"grpc_type", GrpcTypeName(row.type)},
+                                       {"grpc_service", std::string(row.service)},
+                                       {"grpc_method", std::string(row.method)}};
+    GrpcSeries& series = grpc_[m];
+    series.started = &started.Add(labels);
+    series.received = &received.Add(labels);
+    series.sent = &sent.Add(labels);
+    series.handling_seconds = &handling.Add(labels, handling_bounds);
+    for (int c = 0; c < kStatusCodes; ++c) {
+      prometheus::Labels with_code = labels;
+      with_code.emplace("grpc_code", CanonicalStatusCodeName(c));
+      series.handled[c] = &handled.Add(with_code);
+    }
   }
   auto& builds = BuildHistogram()
                      .Name("deformd_build_seconds")
@@ -169,12 +232,14 @@ void ServiceMetrics::Refused(Refusal reason) {
   if (index >= 0 && index < kRefusals) refused_[index]->Increment();
 }
 
-void ServiceMetrics::FrameWritten(int encoding, std::size_t bytes, double server_seconds,
-                                  std::uint64_t skipped_poses) {
+void ServiceMetrics::FrameWritten(int encoding, std::size_t bytes, double queue_seconds,
+                                  double compute_seconds, std::uint64_t skipped_poses) {
   if (encoding < 0 || encoding >= kEncodings) encoding = 1;
   frames_sent_[encoding]->Increment();
   frame_bytes_sent_[encoding]->Increment(static_cast<double>(bytes));
-  frame_server_seconds_->Observe(server_seconds);
+  frame_server_seconds_->Observe(queue_seconds + compute_seconds);
+  frame_queue_seconds_->Observe(queue_seconds);
+  frame_compute_seconds_->Observe(compute_seconds);
   if (skipped_poses > 0) poses_skipped_->Increment(static_cast<double>(skipped_poses));
 }
 
@@ -191,6 +256,25 @@ void ServiceMetrics::NoticeWritten(int kind) {
 void ServiceMetrics::RpcFinished(std::string_view method, int code) {
   if (code < 0 || code >= kStatusCodes) code = 2;  // UNKNOWN
   rpcs_[MethodIndex(method)][code]->Increment();
+}
+
+void ServiceMetrics::GrpcStarted(int grpc_method) {
+  if (grpc_method >= 0 && grpc_method < kGrpcMethods) grpc_[grpc_method].started->Increment();
+}
+
+void ServiceMetrics::GrpcMessageReceived(int grpc_method) {
+  if (grpc_method >= 0 && grpc_method < kGrpcMethods) grpc_[grpc_method].received->Increment();
+}
+
+void ServiceMetrics::GrpcMessageSent(int grpc_method) {
+  if (grpc_method >= 0 && grpc_method < kGrpcMethods) grpc_[grpc_method].sent->Increment();
+}
+
+void ServiceMetrics::GrpcHandled(int grpc_method, int code, double seconds) {
+  if (grpc_method < 0 || grpc_method >= kGrpcMethods) return;
+  if (code < 0 || code >= kStatusCodes) code = 2;  // UNKNOWN
+  grpc_[grpc_method].handled[code]->Increment();
+  grpc_[grpc_method].handling_seconds->Observe(seconds);
 }
 
 void ServiceMetrics::BuildFinished(double seconds, bool ok) {
@@ -224,7 +308,11 @@ void ServiceMetrics::SetGauges(const Gauges& gauges) {
 }
 
 std::string ServiceMetrics::Serialize() const {
-  return prometheus::TextSerializer().Serialize(registry_->Collect());
+  std::vector<prometheus::MetricFamily> families = registry_->Collect();
+  std::vector<prometheus::MetricFamily> process = process_->Collect();
+  families.insert(families.end(), std::make_move_iterator(process.begin()),
+                  std::make_move_iterator(process.end()));
+  return prometheus::TextSerializer().Serialize(families);
 }
 
 }  // namespace deform::service

@@ -5,7 +5,10 @@
 //    whose write completed (what clients received), and their serialized DeformResponse bytes;
 //    encoding is float32, quantized or predicted.
 //  - deformd_frame_server_seconds: histogram of a written frame's server time (queue, right-hand
-//    side, solve and encode: DeformFrame.timings).
+//    side, solve and encode: DeformFrame.timings), the sum of its two parts:
+//    deformd_frame_queue_seconds (FrameTimings.queue_ms: the pose's wait from its arrival to the
+//    start of its solve) and deformd_frame_compute_seconds (rhs_ms + solve_ms + constraint_ms +
+//    encode_ms: from the solve's start to the frame's packing).
 //  - deformd_frame_constraint_seconds: histogram of a written constrained frame's constraint time
 //    (FrameTimings.constraint_ms); deformd_frames_unresolved_total: written frames whose skin
 //    was left inside a bone (FrameConstraints.unresolved).
@@ -28,6 +31,13 @@
 //    HTTP requests over the header or body limit.
 //  - deformd_build_info{version,commit}: always 1; the build's version and commit as labels
 //    (core/base/build_info.h), as --version prints them.
+//  - The standard gRPC server metrics (go-grpc-prometheus' names and labels), for every method
+//    of grpc_methods.h (grpc_type, grpc_service, grpc_method): grpc_server_started_total,
+//    grpc_server_handled_total{...,grpc_code}, grpc_server_msg_received_total,
+//    grpc_server_msg_sent_total and grpc_server_handling_seconds (a histogram from the call's
+//    start to its status), counted by RpcMetricsInterceptorFactory for gRPC calls only (the
+//    WebSocket and HTTP calls are in deformd_rpcs_total).
+//  - Prometheus' standard process_* metrics (process_collector.h), read at each scrape.
 //  - deformd_tls_certificate_expiry_seconds: the served certificate's end of validity, Unix
 //    seconds (as the blackbox exporter's probe_ssl_earliest_cert_expiry; alert on it minus
 //    time()); absent without TLS (SetCertificateExpiry).
@@ -36,8 +46,8 @@
 // other than OK plus the notices pose_rejected and stiffness_rejected.
 //
 // Thread safety: every method may be called from any thread. The per-frame and per-RPC calls
-// (FrameWritten, NoticeWritten, RpcFinished) take no lock and allocate nothing: every labelled
-// series they touch is created in the constructor.
+// (FrameWritten, NoticeWritten, RpcFinished, the Grpc* calls) take no lock and allocate nothing:
+// every labelled series they touch is created in the constructor.
 #pragma once
 
 #include <array>
@@ -48,8 +58,10 @@
 #include <string_view>
 
 #include "core/base/status.h"
+#include "service/metrics/grpc_methods.h"
 
 namespace prometheus {
+class Collectable;
 class Counter;
 class Gauge;
 class Histogram;
@@ -65,6 +77,7 @@ class ServiceMetrics {
   static constexpr int kNoticeKinds = 5;  // index 0 (unspecified) is never written
   static constexpr int kStatusCodes = kCanonicalStatusCodes;  // grpc::StatusCode 0..16
   static constexpr int kMethods = 7;  // six DeformService methods and "other"
+  static constexpr int kGrpcMethods = static_cast<int>(kServedGrpcMethods.size());
 
   // deformd_refused_total's reasons.
   enum class Refusal {
@@ -85,8 +98,9 @@ class ServiceMetrics {
   ServiceMetrics& operator=(const ServiceMetrics&) = delete;
 
   // A Deform frame's write completed: `encoding` as in FrameEncoding (out of range: float32),
-  // `bytes` its serialized size, `server_seconds` its server time, `skipped_poses` its count.
-  void FrameWritten(int encoding, std::size_t bytes, double server_seconds,
+  // `bytes` its serialized size, `queue_seconds` and `compute_seconds` the two parts of its server
+  // time (see above), `skipped_poses` its count.
+  void FrameWritten(int encoding, std::size_t bytes, double queue_seconds, double compute_seconds,
                     std::uint64_t skipped_poses);
   // A written frame's constraints (a mesh with constraints): their time, and whether they left
   // skin inside a bone.
@@ -96,6 +110,13 @@ class ServiceMetrics {
   // An RPC finished: `method` is the full name ("/deform.v1.DeformService/Deform"), `code` the
   // status code (out of range: UNKNOWN).
   void RpcFinished(std::string_view method, int code);
+  // A gRPC call of kServedGrpcMethods[grpc_method] (ServedGrpcMethodIndex; out of range:
+  // ignored) started, received or sent a message, or sent its status `code` (out of range:
+  // UNKNOWN) `seconds` after it started.
+  void GrpcStarted(int grpc_method);
+  void GrpcMessageReceived(int grpc_method);
+  void GrpcMessageSent(int grpc_method);
+  void GrpcHandled(int grpc_method, int code, double seconds);
   void Refused(Refusal reason);
   void BuildFinished(double seconds, bool ok);
   void RefactorizationFinished(double seconds);
@@ -123,12 +144,23 @@ class ServiceMetrics {
   std::array<prometheus::Counter*, kEncodings> frames_sent_{};
   std::array<prometheus::Counter*, kEncodings> frame_bytes_sent_{};
   prometheus::Histogram* frame_server_seconds_ = nullptr;
+  prometheus::Histogram* frame_queue_seconds_ = nullptr;
+  prometheus::Histogram* frame_compute_seconds_ = nullptr;
   prometheus::Counter* poses_skipped_ = nullptr;
   prometheus::Histogram* frame_constraint_seconds_ = nullptr;
   prometheus::Counter* frames_unresolved_ = nullptr;
   std::array<prometheus::Counter*, kNoticeKinds> notices_sent_{};
   std::array<std::array<prometheus::Counter*, kStatusCodes>, kMethods> rpcs_{};
   std::array<prometheus::Counter*, kRefusals> refused_{};
+  struct GrpcSeries {
+    prometheus::Counter* started = nullptr;
+    prometheus::Counter* received = nullptr;
+    prometheus::Counter* sent = nullptr;
+    std::array<prometheus::Counter*, kStatusCodes> handled{};
+    prometheus::Histogram* handling_seconds = nullptr;
+  };
+  std::array<GrpcSeries, kGrpcMethods> grpc_{};
+  std::unique_ptr<prometheus::Collectable> process_;
   prometheus::Histogram* build_ok_seconds_ = nullptr;
   prometheus::Histogram* build_error_seconds_ = nullptr;
   prometheus::Histogram* refactorization_seconds_ = nullptr;

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # deformd's Prometheus metrics end to end (ctest):
-#   metrics_scrape_test.sh DEFORMD LOADTEST MODE VERSION
+#   metrics_scrape_test.sh DEFORMD LOADTEST MODE VERSION [PROBE]
 #   loadtest  starts a real deformd with --metrics on ports the kernel picks; its first scrape
 #             carries deformd_build_info{commit,version} 1 with VERSION (CMake's) and the commit
 #             this checkout is at (tests/expected_commit.sh). Then it runs deform-loadtest
@@ -12,6 +12,11 @@
 #   auth      a deformd with a token file: a scrape without a token is 401, with a tenant's 403,
 #             with an operator's 200; another path is 404, POST 405; --metrics on a non-loopback
 #             address without a certificate is refused at start-up, exit 1 naming the flag.
+#   promtool  after a load test (3 streams) and a health probe, `promtool check metrics` (Debian's
+#             prometheus package) passes the scrape with no lint problem, and the standard
+#             grpc_server_handled_total counts the calls made, with grpc_code="OK": one LoadMesh,
+#             three Deform streams, one UnloadMesh, one health Check; its messages and the
+#             process_* metrics are there. PROMTOOL (environment) names another promtool.
 #   tls       a deformd serving gRPC over TLS: its metrics stay plain HTTP on loopback (scraped,
 #             with the certificate's end of validity as a gauge; an expired one refuses to start),
 #             and --metrics on a non-loopback address is refused unless --plaintext.
@@ -20,6 +25,7 @@ DEFORMD="$1"
 LOADTEST="$2"
 MODE="$3"
 VERSION="${4:-}"
+PROBE="${5:-}"
 SOURCE_DIR="$(cd "$(dirname "$0")/../../.." && pwd)"
 # shellcheck source=tests/expected_commit.sh
 source "$SOURCE_DIR/tests/expected_commit.sh"
@@ -115,6 +121,55 @@ loadtest)
   [ "$errors" -gt 0 ] || fail "the failing load test counted no error"
   [ "$errors" -eq $((rejected + stiffness + failed)) ] ||
     fail "the loadtest counted $errors errors, the server $((rejected + stiffness + failed))"
+  ;;
+promtool)
+  PROMTOOL="${PROMTOOL:-promtool}"
+  command -v "$PROMTOOL" >/dev/null ||
+    fail "no $PROMTOOL: install Debian's prometheus package (scripts/packages/build.txt)"
+  [ -x "$PROBE" ] || fail "no health probe given"
+  start_server
+  "$LOADTEST" --target "$GRPC" --streams 3 --rate 60 --duration 2 --warmup 0 --json \
+    >"$WORK/run.json" || fail "deform-loadtest failed"
+  "$PROBE" --target "$GRPC" >/dev/null || fail "the health probe failed"
+  curl -sf "$METRICS" >"$WORK/page.txt" || fail "scrape after the load test"
+  "$PROMTOOL" check metrics <"$WORK/page.txt" >"$WORK/lint.txt" 2>&1 ||
+    fail "promtool check metrics: $(cat "$WORK/lint.txt")"
+  [ ! -s "$WORK/lint.txt" ] || fail "promtool check metrics said: $(cat "$WORK/lint.txt")"
+  handled() {  # service, method, type
+    series "$WORK/page.txt" "grpc_server_handled_total{grpc_code=\"OK\",grpc_method=\"$2\",grpc_service=\"$1\",grpc_type=\"$3\"}"
+  }
+  labels() {  # service, method, type
+    echo "{grpc_method=\"$2\",grpc_service=\"$1\",grpc_type=\"$3\"}"
+  }
+  svc=deform.v1.DeformService
+  deform=$(labels $svc Deform bidi_stream)
+  echo "grpc_server_handled_total OK: LoadMesh=$(handled $svc LoadMesh bidi_stream)" \
+    "Deform=$(handled $svc Deform bidi_stream) UnloadMesh=$(handled $svc UnloadMesh unary)" \
+    "Check=$(handled grpc.health.v1.Health Check unary)"
+  [ "$(handled $svc LoadMesh bidi_stream)" -eq 1 ] || fail "the load is not counted"
+  [ "$(handled $svc Deform bidi_stream)" -eq 3 ] || fail "the three streams are not counted"
+  [ "$(handled $svc UnloadMesh unary)" -eq 1 ] || fail "the unload is not counted"
+  [ "$(handled grpc.health.v1.Health Check unary)" -eq 1 ] || fail "the health check is not counted"
+  [ "$(series "$WORK/page.txt" "grpc_server_started_total$deform")" -eq 3 ] ||
+    fail "the three streams' starts are not counted"
+  [ "$(series "$WORK/page.txt" "grpc_server_handling_seconds_count$deform")" -eq 3 ] ||
+    fail "the three streams' durations are not in grpc_server_handling_seconds"
+  received=$(json_field "$WORK/run.json" 'r["frames_received"]')
+  poses=$(json_field "$WORK/run.json" 'r["frames_sent"]')
+  sent=$(series "$WORK/page.txt" "grpc_server_msg_sent_total$deform")
+  got=$(series "$WORK/page.txt" "grpc_server_msg_received_total$deform")
+  echo "Deform messages: server sent $sent (loadtest received $received frames)," \
+    "server received $got (loadtest sent $poses poses)"
+  [ "$sent" -ge "$received" ] && [ "$received" -gt 0 ] || fail "messages sent not counted"
+  [ "$got" -ge "$poses" ] && [ "$poses" -gt 0 ] || fail "messages received not counted"
+  frames=$(series "$WORK/page.txt" 'deformd_frames_sent_total{encoding="float32"}')
+  [ "$(series "$WORK/page.txt" deformd_frame_queue_seconds_count)" -eq "$frames" ] &&
+    [ "$(series "$WORK/page.txt" deformd_frame_compute_seconds_count)" -eq "$frames" ] ||
+    fail "the queue and compute histograms do not count the $frames frames"
+  for name in process_cpu_seconds_total process_resident_memory_bytes \
+    process_virtual_memory_bytes process_open_fds process_max_fds process_start_time_seconds; do
+    grep -q "^$name [0-9]" "$WORK/page.txt" || fail "no $name"
+  done
   ;;
 auth)
   python3 - "$WORK/tokens" <<'PY'
