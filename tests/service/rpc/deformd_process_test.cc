@@ -5,6 +5,7 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 
 #include <cstdlib>
 #include <fstream>
@@ -107,7 +108,10 @@ TEST(DeformdProcessTest, CommandLineClientsTalkTlsWithAToken) {
   const std::string probe = std::string(DEFORM_PROBE_PATH) + " --target " + deformd.target();
   const CommandResult probed = RunCommand(probe + tls, dir.Path("probe.err"));
   EXPECT_EQ(probed.status, 0) << probed.stderr_text << deformd.Log();
-  EXPECT_NE(RunCommand(probe, dir.Path("plain.err")).status, 0);  // plaintext: refused
+  // Plaintext to a TLS port: no connection is made (exit 2, as grpc_health_probe's).
+  const CommandResult plain =
+      RunCommand(probe + " --connect-timeout-ms 1000", dir.Path("plain.err"));
+  EXPECT_TRUE(WIFEXITED(plain.status) && WEXITSTATUS(plain.status) == 2) << plain.stderr_text;
 
   const std::string vr = std::string(DEFORM_VR_PATH) + " --target " + deformd.target() +
                          " --phantom-vertices 300 --pose knee:flexion:30 --frames 1 --out " +
