@@ -25,6 +25,7 @@
 #include "service/transport/loopback_port_guard.h"
 #include "service/transport/server_certificate.h"
 #include "service/transport/transport_security.h"
+#include "service/workers/cpu_budget.h"
 
 namespace deform::service {
 namespace {
@@ -172,6 +173,13 @@ Status DeformServer::Start() {
     health->SetServingStatus(v1::DeformService::service_full_name(), true);
   }
   StartAccepting();
+  if (impl_->options.workers <= 0) {
+    // --workers 0: say what sized the pool (cpu_budget.h), the quota of a container included.
+    const CpuBudget budget = ReadCpuBudget();
+    spdlog::info("--workers 0: {} CPUs in the affinity mask, cgroup CPU quota {}",
+                 budget.affinity_cpus,
+                 budget.quota ? fmt::format("{:.2f} CPUs", *budget.quota) : std::string("none"));
+  }
   spdlog::info("listening on {} ({}) with {} workers, at most {} connections ({} per address)",
                listening_address(), transport, impl_->context.pool().size(),
                impl_->acceptor->limits().max_connections,

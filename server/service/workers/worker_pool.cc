@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <array>
 
+#include "service/workers/cpu_budget.h"
+
 namespace deform::service {
 
 void FrameTask::RunUrgentBatch(FrameTask* const* others, int count) {
@@ -11,7 +13,7 @@ void FrameTask::RunUrgentBatch(FrameTask* const* others, int count) {
 }
 
 int WorkerPool::ResolveThreads(int threads) {
-  if (threads <= 0) threads = static_cast<int>(std::thread::hardware_concurrency());
+  if (threads <= 0) threads = ReadCpuBudget().workers;
   return std::max(threads, 1);
 }
 

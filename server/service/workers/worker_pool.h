@@ -87,7 +87,8 @@ class WorkerPool {
   // get kMinBatchShare (at least itself), at most `max_batch`.
   static int BatchShare(int queued, int idle_workers, int max_batch);
 
-  // `threads` <= 0 means std::thread::hardware_concurrency() (at least 1). `max_batch`: tasks run
+  // `threads` <= 0 means the CPUs this process may use (ReadCpuBudget: its affinity and cgroup
+  // CPU quota, cpu_budget.h). `max_batch`: tasks run
   // together at most, clamped to [1, kMaxBatch]; 1 never batches.
   explicit WorkerPool(int threads, int max_batch = 1);
   // Calls Shutdown(), then drops the tasks posted after it (they never run).
