@@ -197,8 +197,10 @@ int main(int argc, char** argv) {
   CLI::App app{"deformd: real-time skeleton-driven deformation server (gRPC deform.v1)"};
   app.add_option("--listen", args.server.listen_address, "Address to listen on, host:port")
       ->capture_default_str();
-  app.add_option("--workers", args.server.workers,
-                 "Worker threads for solves and precomputation; 0 = one per core")
+  app.add_option(
+         "--workers", args.server.workers,
+         "Worker threads for solves and precomputation; 0 = one per CPU this process may use "
+         "(its affinity and cgroup CPU quota)")
       ->capture_default_str()
       ->check(CLI::Range(0, 1024));
   app.add_option("--batch-frames", args.server.batch_frames,
