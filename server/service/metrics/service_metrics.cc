@@ -48,7 +48,26 @@ prometheus::Histogram::BucketBoundaries Exponential(double first, double factor,
 }  // namespace
 
 ServiceMetrics::ServiceMetrics()
-    : registry_(std::make_shared<prometheus::Registry>()), process_(MakeProcessCollector()) {
+    : registry_(std::make_shared<prometheus::Registry>()),
+      // The per-frame histograms take no lock (AtomicHistogram); queue and compute time are the
+      // server time's two parts, on its buckets.
+      frame_server_seconds_(
+          "deformd_frame_server_seconds",
+          "Server time of a written frame: queue, right-hand side, solve and encode",
+          Exponential(0.000125, 2, 14)),
+      frame_queue_seconds_(
+          "deformd_frame_queue_seconds",
+          "Queue time of a written frame: from the pose's arrival to its solve's start",
+          Exponential(0.000125, 2, 14)),
+      frame_compute_seconds_(
+          "deformd_frame_compute_seconds",
+          "Compute time of a written frame: right-hand side, solve, constraints, encode",
+          Exponential(0.000125, 2, 14)),
+      frame_constraint_seconds_(
+          "deformd_frame_constraint_seconds",
+          "Constraint time of a written constrained frame (bone contacts, volume)",
+          Exponential(0.00003125, 2, 14)),
+      process_(MakeProcessCollector()) {
   using prometheus::BuildCounter;
   using prometheus::BuildGauge;
   using prometheus::BuildHistogram;
@@ -67,31 +86,6 @@ ServiceMetrics::ServiceMetrics()
   }
   frames_sent_[0] = frames_sent_[1];
   frame_bytes_sent_[0] = frame_bytes_sent_[1];
-  frame_server_seconds_ =
-      &BuildHistogram()
-           .Name("deformd_frame_server_seconds")
-           .Help("Server time of a written frame: queue, right-hand side, solve and encode")
-           .Register(*registry_)
-           .Add({}, Exponential(0.000125, 2, 14));
-  // The two parts of the server time, on the same buckets.
-  frame_queue_seconds_ =
-      &BuildHistogram()
-           .Name("deformd_frame_queue_seconds")
-           .Help("Queue time of a written frame: from the pose's arrival to its solve's start")
-           .Register(*registry_)
-           .Add({}, Exponential(0.000125, 2, 14));
-  frame_compute_seconds_ =
-      &BuildHistogram()
-           .Name("deformd_frame_compute_seconds")
-           .Help("Compute time of a written frame: right-hand side, solve, constraints, encode")
-           .Register(*registry_)
-           .Add({}, Exponential(0.000125, 2, 14));
-  frame_constraint_seconds_ =
-      &BuildHistogram()
-           .Name("deformd_frame_constraint_seconds")
-           .Help("Constraint time of a written constrained frame (bone contacts, volume)")
-           .Register(*registry_)
-           .Add({}, Exponential(0.00003125, 2, 14));
   frames_unresolved_ = &BuildCounter()
                             .Name("deformd_frames_unresolved_total")
                             .Help("Written frames whose constraints left skin inside a bone")
@@ -237,14 +231,14 @@ void ServiceMetrics::FrameWritten(int encoding, std::size_t bytes, double queue_
   if (encoding < 0 || encoding >= kEncodings) encoding = 1;
   frames_sent_[encoding]->Increment();
   frame_bytes_sent_[encoding]->Increment(static_cast<double>(bytes));
-  frame_server_seconds_->Observe(queue_seconds + compute_seconds);
-  frame_queue_seconds_->Observe(queue_seconds);
-  frame_compute_seconds_->Observe(compute_seconds);
+  frame_server_seconds_.Observe(queue_seconds + compute_seconds);
+  frame_queue_seconds_.Observe(queue_seconds);
+  frame_compute_seconds_.Observe(compute_seconds);
   if (skipped_poses > 0) poses_skipped_->Increment(static_cast<double>(skipped_poses));
 }
 
 void ServiceMetrics::ConstrainedFrameWritten(double constraint_seconds, bool unresolved) {
-  frame_constraint_seconds_->Observe(constraint_seconds);
+  frame_constraint_seconds_.Observe(constraint_seconds);
   if (unresolved) frames_unresolved_->Increment();
 }
 
@@ -309,6 +303,10 @@ void ServiceMetrics::SetGauges(const Gauges& gauges) {
 
 std::string ServiceMetrics::Serialize() const {
   std::vector<prometheus::MetricFamily> families = registry_->Collect();
+  for (const AtomicHistogram* histogram : {&frame_server_seconds_, &frame_queue_seconds_,
+                                           &frame_compute_seconds_, &frame_constraint_seconds_}) {
+    families.push_back(histogram->Collect());
+  }
   std::vector<prometheus::MetricFamily> process = process_->Collect();
   families.insert(families.end(), std::make_move_iterator(process.begin()),
                   std::make_move_iterator(process.end()));

@@ -45,9 +45,11 @@
 // A client's errors as deform-loadtest counts them are the Deform RPCs that ended with a code
 // other than OK plus the notices pose_rejected and stiffness_rejected.
 //
-// Thread safety: every method may be called from any thread. The per-frame and per-RPC calls
-// (FrameWritten, NoticeWritten, RpcFinished, the Grpc* calls) take no lock and allocate nothing:
-// every labelled series they touch is created in the constructor.
+// Thread safety: every method may be called from any thread. The per-frame calls (FrameWritten,
+// ConstrainedFrameWritten, NoticeWritten) take no lock and allocate nothing: their histograms are
+// AtomicHistograms, and every labelled series they touch is created in the constructor. The
+// per-RPC calls (RpcFinished, the Grpc* calls) allocate nothing either; GrpcHandled's histogram
+// (prometheus-cpp's) locks its series' mutex once per call.
 #pragma once
 
 #include <array>
@@ -58,6 +60,7 @@
 #include <string_view>
 
 #include "core/base/status.h"
+#include "service/metrics/atomic_histogram.h"
 #include "service/metrics/grpc_methods.h"
 
 namespace prometheus {
@@ -143,11 +146,11 @@ class ServiceMetrics {
   std::shared_ptr<prometheus::Registry> registry_;
   std::array<prometheus::Counter*, kEncodings> frames_sent_{};
   std::array<prometheus::Counter*, kEncodings> frame_bytes_sent_{};
-  prometheus::Histogram* frame_server_seconds_ = nullptr;
-  prometheus::Histogram* frame_queue_seconds_ = nullptr;
-  prometheus::Histogram* frame_compute_seconds_ = nullptr;
   prometheus::Counter* poses_skipped_ = nullptr;
-  prometheus::Histogram* frame_constraint_seconds_ = nullptr;
+  AtomicHistogram frame_server_seconds_;
+  AtomicHistogram frame_queue_seconds_;
+  AtomicHistogram frame_compute_seconds_;
+  AtomicHistogram frame_constraint_seconds_;
   prometheus::Counter* frames_unresolved_ = nullptr;
   std::array<prometheus::Counter*, kNoticeKinds> notices_sent_{};
   std::array<std::array<prometheus::Counter*, kStatusCodes>, kMethods> rpcs_{};
