@@ -43,18 +43,19 @@ constexpr char kBentKnee[] = "joint1:x:60";
 // (the 26k leg reached about 10 Hz under ASan+UBSan), so there frames must only keep coming: the
 // sanitizers are there for the bridge's memory and undefined behaviour, not its speed.
 #if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-constexpr double kMinimumRateHz = 3.0;
+#define DEFORM_IGTL_TEST_SANITIZED 1
 #elif defined(__has_feature)
 #if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
+#define DEFORM_IGTL_TEST_SANITIZED 1
+#endif
+#endif
+#ifdef DEFORM_IGTL_TEST_SANITIZED
 constexpr double kMinimumRateHz = 3.0;
 #else
 constexpr double kMinimumRateHz = 30.0;
 #endif
 // Frames a receiver must see in half a second: a sixth of the rate, 5 at 30 Hz.
 constexpr double kFramesInHalfASecond = kMinimumRateHz / 6;
-#else
-constexpr double kMinimumRateHz = 30.0;
-#endif
 
 // The first vertex of an OBJ file.
 std::array<float, 3> FirstObjVertex(const std::string& path) {
