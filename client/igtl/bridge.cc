@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "cli/command_line.h"
+#include "igtl/frame_packer.h"
 #include "igtl/igtl_messages.h"
 #include "igtl/joint_angle_input.h"
 #include "igtl/receiver_hub.h"
@@ -131,12 +132,14 @@ int RunBridge(client::DeformClient& client, const deform::v1::MeshSummary& summa
 
   StreamEnd end;
   std::shared_ptr<ReceiverHub> hub;  // set before the first pose, so before any frame
-  client::DeformClient::StreamCallbacks callbacks;
   const std::string* frame_triangles = settings.full_frames ? &geometry.triangles() : nullptr;
-  callbacks.on_frame = [&](const deform::v1::DeformFrame& frame) {
-    hub->Publish(std::make_shared<const std::string>(
-        PackFrame(frame, settings.frame, bone_names, frame_triangles)));
-  };
+  FramePacker packer(
+      [&](const deform::v1::DeformFrame& frame) {
+        return PackFrame(frame, settings.frame, bone_names, frame_triangles);
+      },
+      [&hub](std::shared_ptr<const std::string> bytes) { hub->Publish(std::move(bytes)); });
+  client::DeformClient::StreamCallbacks callbacks;
+  callbacks.on_frame = [&packer](const deform::v1::DeformFrame& frame) { packer.Offer(frame); };
   callbacks.on_notice = [](const deform::v1::Notice& notice) {
     if (notice.kind() == deform::v1::Notice::KIND_POSE_REJECTED) {
       spdlog::warn("deform stream: pose {} rejected: {}", notice.sequence(),
@@ -182,7 +185,9 @@ int RunBridge(client::DeformClient& client, const deform::v1::MeshSummary& summa
     if (!end.WaitUntil(Clock::now() + std::chrono::seconds(5))) stream->Cancel();
   }
   const grpc::Status final_status = stream->Wait();
+  packer.Stop();
   hub->Stop();
+  spdlog::info("frames skipped while packing was busy: {}", packer.skipped());
   if (ended) {
     return cli::ReportFailure(
         kProgram, final_status.ok()

@@ -121,8 +121,9 @@ Observation Observe(IgtlReceiver& receiver, double seconds, std::size_t vertices
 }
 
 // Reads until a points-only frame within `tolerance` of `target` (true) or `timeout_s`.
-bool WaitForPoints(IgtlReceiver& receiver, const std::vector<float>& target, float tolerance,
-                   double timeout_s, std::map<std::string, ReceivedMessage>* transforms) {
+bool WaitForPoints(IgtlReceiver& receiver, const std::string& device,
+                   const std::vector<float>& target, float tolerance, double timeout_s,
+                   std::map<std::string, ReceivedMessage>* transforms) {
   const Clock::time_point end = Clock::now() + std::chrono::duration_cast<Clock::duration>(
                                                    std::chrono::duration<double>(timeout_s));
   std::string error;
@@ -132,7 +133,7 @@ bool WaitForPoints(IgtlReceiver& receiver, const std::vector<float>& target, flo
     if (message.type == "TRANSFORM" && transforms != nullptr) {
       (*transforms)[message.device] = message;
     }
-    if (message.device == "SkinPoints" && MaxDifference(message.points, target) < tolerance) {
+    if (message.device == device && MaxDifference(message.points, target) < tolerance) {
       return true;
     }
   }
@@ -143,6 +144,35 @@ int LatencyPoses() {
   const char* text = std::getenv("DEFORM_IGTL_LATENCY_POSES");
   const int poses = text != nullptr ? std::atoi(text) : 20;
   return poses > 0 ? poses : 20;
+}
+
+// Pose-to-points latency, printed: from a STRING that turns the knee between `rest` and `bent` to
+// the first `device` message (SkinPoints, or Skin with --full-frames) showing that pose, over
+// DEFORM_IGTL_LATENCY_POSES round trips.
+void PrintPoseToPointsLatency(IgtlReceiver& receiver, const std::string& device,
+                              const std::string& mesh, const std::vector<float>& rest,
+                              const std::vector<float>& bent) {
+  const float tolerance = 0.05f * MaxDifference(bent, rest);
+  std::vector<double> latency_ms;
+  const int poses = LatencyPoses();
+  for (int k = 0; k < poses; ++k) {
+    const bool bend = k % 2 == 0;
+    ASSERT_TRUE(receiver.SendString(bend ? "rest" : kBentKnee));
+    ASSERT_TRUE(WaitForPoints(receiver, device, bend ? rest : bent, tolerance, 10, nullptr));
+    const Clock::time_point sent = Clock::now();
+    ASSERT_TRUE(receiver.SendString(bend ? kBentKnee : "rest"));
+    ASSERT_TRUE(WaitForPoints(receiver, device, bend ? bent : rest, tolerance, 10, nullptr))
+        << "pose " << k << " never showed";
+    latency_ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - sent).count());
+  }
+  std::sort(latency_ms.begin(), latency_ms.end());
+  const auto at = [&](double q) {
+    const std::size_t rank = static_cast<std::size_t>(std::ceil(q * latency_ms.size()));
+    return latency_ms[std::min(latency_ms.size() - 1, rank > 0 ? rank - 1 : 0)];
+  };
+  std::cout << mesh << " (" << device << "): pose-to-points latency over " << latency_ms.size()
+            << " poses: median " << at(0.5) << " ms, p99 " << at(0.99) << " ms, max "
+            << latency_ms.back() << " ms" << std::endl;
 }
 
 class IgtlBridgeTest : public ::testing::TestWithParam<LegCase> {};
@@ -277,31 +307,7 @@ TEST_P(IgtlBridgeTest, ServesTopologyFramesBonesAndTakesJointAngles) {
   EXPECT_TRUE(still.error.empty()) << still.error;
   EXPECT_GE(still.frames, kMinimumRateHz) << "the first receiver was disturbed";
 
-  // Pose-to-points latency: from a STRING sent to the first points-only frame showing its pose.
-  const std::vector<float>& bent_points = bent.last_points;
-  const float tolerance = 0.05f * MaxDifference(bent_points, rest.last_points);
-  std::vector<double> latency_ms;
-  const int poses = LatencyPoses();
-  for (int k = 0; k < poses; ++k) {
-    const bool bend = k % 2 == 0;
-    ASSERT_TRUE(receiver.SendString(bend ? "rest" : kBentKnee));
-    ASSERT_TRUE(
-        WaitForPoints(receiver, bend ? rest.last_points : bent_points, tolerance, 10, nullptr));
-    const Clock::time_point sent = Clock::now();
-    ASSERT_TRUE(receiver.SendString(bend ? kBentKnee : "rest"));
-    ASSERT_TRUE(
-        WaitForPoints(receiver, bend ? bent_points : rest.last_points, tolerance, 10, nullptr))
-        << "pose " << k << " never showed";
-    latency_ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - sent).count());
-  }
-  std::sort(latency_ms.begin(), latency_ms.end());
-  const auto at = [&](double q) {
-    const std::size_t rank = static_cast<std::size_t>(std::ceil(q * latency_ms.size()));
-    return latency_ms[std::min(latency_ms.size() - 1, rank > 0 ? rank - 1 : 0)];
-  };
-  std::cout << leg.mesh << ": pose-to-points latency over " << latency_ms.size()
-            << " poses: median " << at(0.5) << " ms, p99 " << at(0.99) << " ms, max "
-            << latency_ms.back() << " ms" << std::endl;
+  PrintPoseToPointsLatency(receiver, "SkinPoints", leg.mesh, rest.last_points, bent.last_points);
 
   receiver.Close();
   EXPECT_EQ(bridge.Stop(), 0) << bridge.Log();
@@ -309,16 +315,21 @@ TEST_P(IgtlBridgeTest, ServesTopologyFramesBonesAndTakesJointAngles) {
 }
 
 // --full-frames: every frame is the full POLYDATA "Skin", triangles included, and the angles
-// still bend it.
-TEST(IgtlBridgeFullFramesTest, SendsEveryFrameAsTheFullPolyData) {
-  DEFORM_REQUIRE_SHARED_FILE(mesh, "leg/leg_1633.obj");
+// still bend it. Prints the pose-to-points latency of full frames, to set against the
+// points-only frames' (the test above).
+class IgtlBridgeFullFramesTest : public ::testing::TestWithParam<LegCase> {};
+
+TEST_P(IgtlBridgeFullFramesTest, SendsEveryFrameAsTheFullPolyData) {
+  const LegCase leg = GetParam();
+  DEFORM_REQUIRE_SHARED_FILE(mesh, leg.mesh);
   DEFORM_REQUIRE_SHARED_FILE(skeleton, "leg/leg.tgf");
   DeformdProcess deformd({"--listen", "127.0.0.1:0"});
   ASSERT_TRUE(deformd.WaitForListening()) << deformd.Log();
-  DeformdProcess bridge({"--target", deformd.target(), "--mesh", mesh, "--skeleton", skeleton,
-                         "--igtl-listen", "127.0.0.1:0", "--full-frames", "--mm-per-unit", "100"},
-                        "", DEFORM_IGTL_BRIDGE_PATH);
-  const int port = bridge.WaitForListeningPort(std::chrono::seconds(120));
+  DeformdProcess bridge(
+      {"--target", deformd.target(), "--mesh", mesh, "--skeleton", skeleton, "--igtl-listen",
+       "127.0.0.1:0", "--full-frames", "--rate", "60", "--mm-per-unit", "100", "--ras-axes=-x,z,y"},
+      "", DEFORM_IGTL_BRIDGE_PATH);
+  const int port = bridge.WaitForListeningPort(std::chrono::seconds(600));
   ASSERT_GT(port, 0) << bridge.Log();
   IgtlReceiver receiver;
   ASSERT_TRUE(receiver.Connect(port));
@@ -329,22 +340,35 @@ TEST(IgtlBridgeFullFramesTest, SendsEveryFrameAsTheFullPolyData) {
   ASSERT_TRUE(receiver.SendString(kBentKnee));
   int frames = 0;
   float moved = 0;
-  const Clock::time_point end = Clock::now() + std::chrono::seconds(10);
+  std::vector<float> bent;
+  const Clock::time_point end = Clock::now() + std::chrono::seconds(20);
   while ((frames < 10 || moved < 10) && Clock::now() < end) {
     ReceivedMessage message;
     ASSERT_TRUE(receiver.Read(&message, &error)) << error;
     if (message.type != "POLYDATA") continue;
     ASSERT_EQ(message.device, "Skin");
-    EXPECT_EQ(message.polygons, 3240u);
+    EXPECT_EQ(message.polygons, leg.triangles);
     ASSERT_EQ(message.points.size(), topology.points.size());
     moved = std::max(moved, MaxDifference(message.points, topology.points));
+    bent = std::move(message.points);
     ++frames;
   }
   EXPECT_GE(frames, 10);
-  EXPECT_GT(moved, 10.0f) << "the knee did not bend";
+  ASSERT_GT(moved, 10.0f) << "the knee did not bend";
+  // The bent pose as it stands once the frames have caught up.
+  ASSERT_TRUE(WaitForPoints(receiver, "Skin", bent, 0.1f, 10, nullptr));
+  PrintPoseToPointsLatency(receiver, "Skin", leg.mesh, topology.points, bent);
+  receiver.Close();
+  EXPECT_EQ(bridge.Stop(), 0) << bridge.Log();
 }
 
 INSTANTIATE_TEST_SUITE_P(SharedLegs, IgtlBridgeTest,
+                         ::testing::Values(LegCase{"leg/leg_1633.obj", 1633, 3240},
+                                           LegCase{"leg/leg_25969.obj", 25969, 51840}),
+                         [](const ::testing::TestParamInfo<LegCase>& info) {
+                           return std::to_string(info.param.vertices);
+                         });
+INSTANTIATE_TEST_SUITE_P(SharedLegs, IgtlBridgeFullFramesTest,
                          ::testing::Values(LegCase{"leg/leg_1633.obj", 1633, 3240},
                                            LegCase{"leg/leg_25969.obj", 25969, 51840}),
                          [](const ::testing::TestParamInfo<LegCase>& info) {
