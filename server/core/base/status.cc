@@ -33,7 +33,24 @@ std::string Status::ToString() const {
 
 Status Status::WithContext(const std::string& context) const {
   if (ok()) return *this;
-  return Status(code_, context + ": " + message_);
+  Status status = *this;
+  status.message_ = context + ": " + message_;
+  return status;
+}
+
+Status Status::WithSubject(std::string subject) const {
+  if (ok()) return *this;
+  Status status = *this;
+  status.subject_ = std::move(subject);
+  return status;
+}
+
+Status Status::WithLimit(std::string scope, std::string option) const {
+  if (ok()) return *this;
+  Status status = *this;
+  status.subject_ = std::move(scope);
+  status.limit_ = std::move(option);
+  return status;
 }
 
 }  // namespace deform

@@ -68,13 +68,29 @@ class [[nodiscard]] Status {
   // "INVALID_ARGUMENT: message", or "OK".
   std::string ToString() const;
 
-  // Returns a copy with `context + ": "` prepended to the message (the code is kept).
+  // Returns a copy with `context + ": "` prepended to the message (the code, the subject and the
+  // limit are kept).
   Status WithContext(const std::string& context) const;
+
+  // What the error is about, for the machine-readable details the service attaches
+  // (service/transport/status_mapping.h); empty where the check does not know it. For
+  // INVALID_ARGUMENT the path of the request field at fault ("upload.bone_surfaces[0].mesh");
+  // for RESOURCE_EXHAUSTED whose limit it is ("server", or "tenant:NAME").
+  const std::string& subject() const { return subject_; }
+  // For RESOURCE_EXHAUSTED the option that sets the limit ("--max-meshes"); empty otherwise.
+  const std::string& limit() const { return limit_; }
+
+  // Returns a copy with the subject set (an OK status is returned unchanged: it has none).
+  Status WithSubject(std::string subject) const;
+  // Returns a copy naming the limit that refused: its scope (the subject) and its option.
+  Status WithLimit(std::string scope, std::string option) const;
 
  private:
   Status(StatusCode code, std::string msg) : code_(code), message_(std::move(msg)) {}
   StatusCode code_ = StatusCode::kOk;
   std::string message_;
+  std::string subject_;
+  std::string limit_;
 };
 
 // Either a value or a non-OK Status.
