@@ -9,6 +9,9 @@ std::string MebiBytes(std::size_t bytes) {
   return std::to_string((bytes + (std::size_t{1} << 20) - 1) >> 20) + " MiB";
 }
 
+// The scope a per-tenant refusal names (QuotaFailure's subject, status_mapping.h).
+std::string TenantScope(const std::string& tenant) { return "tenant:" + tenant; }
+
 }  // namespace
 
 Admission::MeshSlot::MeshSlot(MeshSlot&& other) noexcept
@@ -80,14 +83,16 @@ StatusOr<Admission::MeshSlot> Admission::ReserveMesh(const std::string& tenant) 
     return Status::ResourceExhausted("mesh limit reached: " + std::to_string(loaded_) +
                                      " loaded and " + std::to_string(reserved_) +
                                      " loading, of at most " + std::to_string(limits_.max_meshes) +
-                                     " (unload a mesh first)");
+                                     " (unload a mesh first)")
+        .WithLimit("server", "--max-meshes");
   }
   Usage& usage = tenants_[tenant];
   if (limits_.tenant_max_meshes > 0 && usage.loaded + usage.reserved >= limits_.tenant_max_meshes) {
     return Status::ResourceExhausted(
-        "tenant mesh limit reached (--tenant-max-meshes): " + std::to_string(usage.loaded) +
-        " loaded and " + std::to_string(usage.reserved) + " loading, of at most " +
-        std::to_string(limits_.tenant_max_meshes) + " per tenant (unload a mesh first)");
+               "tenant mesh limit reached (--tenant-max-meshes): " + std::to_string(usage.loaded) +
+               " loaded and " + std::to_string(usage.reserved) + " loading, of at most " +
+               std::to_string(limits_.tenant_max_meshes) + " per tenant (unload a mesh first)")
+        .WithLimit(TenantScope(tenant), "--tenant-max-meshes");
   }
   ++reserved_;
   ++usage.reserved;
@@ -112,12 +117,13 @@ Status Admission::CheckMemoryLocked(std::size_t bytes, std::size_t held, const s
   const std::size_t in_use = memory_used_ + memory_reserved_ + memory_streams_ - held;
   if (bytes > limits_.max_memory_bytes || in_use > limits_.max_memory_bytes - bytes) {
     return Status::ResourceExhausted(
-        "memory budget exceeded (--max-memory-mb): " + what + " needs about " + MebiBytes(bytes) +
-        ", " + MebiBytes(in_use) + " of the " + MebiBytes(limits_.max_memory_bytes) +
-        " budget are in use (" + MebiBytes(memory_used_ - memory_retained_) +
-        " by loaded meshes, " + MebiBytes(memory_retained_) +
-        " by unloaded meshes that streams still use, " + MebiBytes(memory_streams_) +
-        " by streams' buffers and factorizations)");
+               "memory budget exceeded (--max-memory-mb): " + what + " needs about " +
+               MebiBytes(bytes) + ", " + MebiBytes(in_use) + " of the " +
+               MebiBytes(limits_.max_memory_bytes) + " budget are in use (" +
+               MebiBytes(memory_used_ - memory_retained_) + " by loaded meshes, " +
+               MebiBytes(memory_retained_) + " by unloaded meshes that streams still use, " +
+               MebiBytes(memory_streams_) + " by streams' buffers and factorizations)")
+        .WithLimit("server", "--max-memory-mb");
   }
   if (limits_.tenant_max_memory_bytes > 0) {
     const auto it = tenants_.find(tenant);
@@ -127,9 +133,10 @@ Status Admission::CheckMemoryLocked(std::size_t bytes, std::size_t held, const s
                                        it->second.stream_memory_bytes - held;
     if (bytes > limits_.tenant_max_memory_bytes || used > limits_.tenant_max_memory_bytes - bytes) {
       return Status::ResourceExhausted(
-          "tenant memory budget exceeded (--tenant-max-memory-mb): " + what + " needs about " +
-          MebiBytes(bytes) + ", " + MebiBytes(used) + " of the tenant's " +
-          MebiBytes(limits_.tenant_max_memory_bytes) + " are in use");
+                 "tenant memory budget exceeded (--tenant-max-memory-mb): " + what +
+                 " needs about " + MebiBytes(bytes) + ", " + MebiBytes(used) + " of the tenant's " +
+                 MebiBytes(limits_.tenant_max_memory_bytes) + " are in use")
+          .WithLimit(TenantScope(tenant), "--tenant-max-memory-mb");
     }
   }
   return Status::Ok();
@@ -184,14 +191,16 @@ Status Admission::AcquireStream(const std::string& tenant) {
   MutexLock lock(&mutex_);
   if (limits_.max_streams > 0 && streams_ >= limits_.max_streams) {
     return Status::ResourceExhausted(
-        "server stream limit reached (--max-streams): " + std::to_string(streams_) +
-        " streams open, of at most " + std::to_string(limits_.max_streams));
+               "server stream limit reached (--max-streams): " + std::to_string(streams_) +
+               " streams open, of at most " + std::to_string(limits_.max_streams))
+        .WithLimit("server", "--max-streams");
   }
   Usage& usage = tenants_[tenant];
   if (limits_.tenant_max_streams > 0 && usage.streams >= limits_.tenant_max_streams) {
-    return Status::ResourceExhausted(
-        "tenant stream limit reached (--tenant-max-streams): " + std::to_string(usage.streams) +
-        " streams open, of at most " + std::to_string(limits_.tenant_max_streams) + " per tenant");
+    return Status::ResourceExhausted("tenant stream limit reached (--tenant-max-streams): " +
+                                     std::to_string(usage.streams) + " streams open, of at most " +
+                                     std::to_string(limits_.tenant_max_streams) + " per tenant")
+        .WithLimit(TenantScope(tenant), "--tenant-max-streams");
   }
   ++usage.streams;
   ++streams_;

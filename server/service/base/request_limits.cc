@@ -24,7 +24,13 @@ Status CheckLength(std::string_view value, std::size_t limit, std::string_view f
   if (value.size() <= limit) return Status::Ok();
   return Status::InvalidArgument(std::string(field) + " is " + std::to_string(value.size()) +
                                  " bytes long, over the limit of " + std::to_string(limit) +
-                                 " bytes");
+                                 " bytes")
+      .WithSubject(std::string(field));
+}
+
+Status InField(const Status& status, const std::string& field) {
+  if (status.code() != StatusCode::kInvalidArgument) return status;
+  return status.WithSubject(status.subject().empty() ? field : field + "." + status.subject());
 }
 
 std::string EchoForClient(std::string_view text) {
@@ -70,7 +76,7 @@ Status CheckStiffnessStrings(const v1::StiffnessUpdate& stiffness) {
 Status CheckMethodOptionStrings(const v1::MethodOptions& options) {
   for (int k = 0; k < options.region_radii_size(); ++k) {
     DEFORM_RETURN_IF_ERROR(CheckLength(options.region_radii(k).joint(), kMaxJointNameBytes,
-                                       Indexed("options.region_radii", k, "joint")));
+                                       Indexed("region_radii", k, "joint")));
   }
   return Status::Ok();
 }
@@ -85,7 +91,8 @@ Status CheckLoadHeaderStrings(const v1::LoadMeshHeader& header) {
     DEFORM_RETURN_IF_ERROR(
         CheckLength(bones[i].blend_bone(), kMaxJointNameBytes, field + ".blend_bone"));
   }
-  return CheckMethodOptionStrings(header.options());
+  const Status options = CheckMethodOptionStrings(header.options());
+  return InField(options.WithContext("options"), "options");
 }
 
 Status CheckUploadSize(std::uint64_t mesh_bytes, std::uint64_t skeleton_bytes,
@@ -96,10 +103,11 @@ Status CheckUploadSize(std::uint64_t mesh_bytes, std::uint64_t skeleton_bytes,
   const bool saturated = total == std::numeric_limits<std::uint64_t>::max() &&
                          (skeleton_bytes != 0 || weights_bytes != 0);
   return Status::ResourceExhausted(
-      "upload of " + (saturated ? std::string("more than ") : std::string()) +
-      std::to_string(total) + " bytes (mesh " + std::to_string(mesh_bytes) + ", skeleton " +
-      std::to_string(skeleton_bytes) + ", weights " + std::to_string(weights_bytes) +
-      ") exceeds the limit of " + std::to_string(limit) + " bytes");
+             "upload of " + (saturated ? std::string("more than ") : std::string()) +
+             std::to_string(total) + " bytes (mesh " + std::to_string(mesh_bytes) + ", skeleton " +
+             std::to_string(skeleton_bytes) + ", weights " + std::to_string(weights_bytes) +
+             ") exceeds the limit of " + std::to_string(limit) + " bytes")
+      .WithLimit("server", "--max-upload-mb");
 }
 
 }  // namespace deform::service

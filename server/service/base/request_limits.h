@@ -37,6 +37,13 @@ inline constexpr double kQuaternionNormTolerance = 0.1;
 // OK, or INVALID_ARGUMENT "<field> is N bytes long, over the limit of L bytes".
 Status CheckLength(std::string_view value, std::size_t limit, std::string_view field);
 
+// `status`, from checking the request field at path `field`, naming that field as its subject
+// (Status::subject, which status_mapping.h turns into a BadRequest): an INVALID_ARGUMENT without
+// a subject gets `field`, one whose subject is a path inside the field gets it prefixed
+// ("options" and "region_radii[0].joint" give "options.region_radii[0].joint"). Other statuses,
+// whose subject is no field path, are returned as they are. The message is not changed.
+Status InField(const Status& status, const std::string& field);
+
 // `text` escaped (EscapeForLog) and cut after kMaxEchoBytes input bytes, with its length when cut:
 // what an error message may repeat of a client string.
 std::string EchoForClient(std::string_view text);

@@ -93,6 +93,9 @@ class DeformStreamReactor final : public StreamHandler,
   void HandleStiffness() DEFORM_EXCLUDES(mutex_);
   void Fail(grpc::StatusCode code, const std::string& message) DEFORM_EXCLUDES(mutex_);
   void FailLocked(grpc::StatusCode code, const std::string& message) DEFORM_REQUIRES(mutex_);
+  // As above with a core status, which keeps its error details (status_mapping.h).
+  void Fail(const Status& status) DEFORM_EXCLUDES(mutex_);
+  void FailLocked(const Status& status) DEFORM_REQUIRES(mutex_);
   // Reads the next request, or stops reading while the notice backlog is full (a client that
   // sends without reading); WriteCompleted resumes once it has drained.
   void ReadNextLocked() DEFORM_REQUIRES(mutex_);
@@ -240,6 +243,18 @@ void DeformStreamReactor::FailLocked(grpc::StatusCode code, const std::string& m
   pump_.Pump();
 }
 
+void DeformStreamReactor::Fail(const Status& status) {
+  MutexLock lock(&mutex_);
+  FailLocked(status);
+}
+
+void DeformStreamReactor::FailLocked(const Status& status) {
+  const grpc::Status mapped = ToGrpcStatus(status);
+  spdlog::warn("{} ending: {}", log_context_, EscapeControlBytes(mapped.error_message()));
+  pump_.RequestFinish(mapped);
+  pump_.Pump();
+}
+
 void DeformStreamReactor::HandleStart() {
   if (model_ != nullptr) {
     Fail(grpc::StatusCode::INVALID_ARGUMENT, "`start` sent twice on one stream");
@@ -248,26 +263,26 @@ void DeformStreamReactor::HandleStart() {
   const std::string& mesh_id = request_.start().mesh_id();
   const Status id_length = CheckLength(mesh_id, kMaxMeshIdBytes, "start.mesh_id");
   if (!id_length.ok()) {
-    Fail(grpc::StatusCode::INVALID_ARGUMENT, id_length.message());
+    Fail(id_length);
     return;
   }
   auto entry = context_->registry().Find(mesh_id, caller_);
   if (!entry.ok()) {
     Audit(caller_.tenant, "deform", mesh_id, entry.status().ToString());
-    Fail(ToGrpcCode(entry.status().code()), entry.status().message());
+    Fail(entry.status());
     return;
   }
   const Status attached = context_->registry().AttachStream(**entry);  // unloaded since: NOT_FOUND
   if (!attached.ok()) {
     Audit(caller_.tenant, "deform", mesh_id, attached.ToString());
-    Fail(ToGrpcCode(attached.code()), attached.message());
+    Fail(attached);
     return;
   }
   entry_ = std::move(*entry);  // attached: DetachStream in OnDone
   const Status quota = context_->admission().AcquireStream(caller_.tenant);
   Audit(caller_.tenant, "deform", mesh_id, quota.ok() ? "OK" : quota.ToString());
   if (!quota.ok()) {
-    Fail(ToGrpcCode(quota.code()), quota.message());
+    Fail(quota);
     return;
   }
   counted_ = true;
@@ -287,7 +302,7 @@ void DeformStreamReactor::HandleStart() {
   log_context_ += " mesh=" + entry_->id;
   auto encoder = MakeFrameEncoder(request_.start(), *entry_);
   if (!encoder.ok()) {
-    Fail(ToGrpcCode(encoder.status().code()), encoder.status().message());
+    Fail(encoder.status());
     return;
   }
   const std::size_t encoded_bytes = *encoder ? (*encoder)->max_encoded_bytes() : 0;
@@ -317,7 +332,7 @@ void DeformStreamReactor::HandleStart() {
     held_bytes = buffer_bytes_;
     const Status held = memory_.Resize(buffer_bytes_, "a Deform stream's buffers");
     if (!held.ok()) {
-      FailLocked(ToGrpcCode(held.code()), held.message());
+      FailLocked(held);
       return;
     }
   }

@@ -153,7 +153,9 @@ void LoadMeshReactor::OnReadDone(bool ok) {
 }
 
 Status LoadMeshReactor::HandleHeader() {
-  if (has_header_) return Status::InvalidArgument("the header was sent twice");
+  if (has_header_) {
+    return Status::InvalidArgument("the header was sent twice").WithSubject("header");
+  }
   start_ = Clock::now();
   header_.Swap(request_.mutable_header());
   has_header_ = true;
@@ -180,13 +182,19 @@ Status LoadMeshReactor::HandleHeader() {
 }
 
 Status LoadMeshReactor::HandleChunk() {
-  if (!has_header_) return Status::InvalidArgument("the first LoadMeshRequest must be the header");
-  if (header_.has_phantom()) return Status::InvalidArgument("a phantom load takes no chunks");
+  if (!has_header_) {
+    return Status::InvalidArgument("the first LoadMeshRequest must be the header")
+        .WithSubject("header");
+  }
+  if (header_.has_phantom()) {
+    return Status::InvalidArgument("a phantom load takes no chunks").WithSubject("chunk");
+  }
   const std::string& chunk = request_.chunk();
   if (mesh_bytes_.size() + chunk.size() > expected_bytes_) {
     return Status::InvalidArgument("the upload sent more than the " +
                                    std::to_string(expected_bytes_) +
-                                   " mesh bytes announced in the header");
+                                   " mesh bytes announced in the header")
+        .WithSubject("chunk");
   }
   mesh_bytes_.append(chunk);
   context_->uploads().Touch(upload_watch_);
@@ -199,11 +207,14 @@ Status LoadMeshReactor::HandleEndOfInput() {
     MutexLock lock(&mutex_);
     if (pump_.finish_requested()) return Status::Ok();  // cancelled or already failed
   }
-  if (!has_header_) return Status::InvalidArgument("the stream ended without a header");
+  if (!has_header_) {
+    return Status::InvalidArgument("the stream ended without a header").WithSubject("header");
+  }
   if (header_.has_upload() && mesh_bytes_.size() != expected_bytes_) {
     return Status::InvalidArgument(
-        "truncated upload: received " + std::to_string(mesh_bytes_.size()) + " of the " +
-        std::to_string(expected_bytes_) + " mesh bytes announced in the header");
+               "truncated upload: received " + std::to_string(mesh_bytes_.size()) + " of the " +
+               std::to_string(expected_bytes_) + " mesh bytes announced in the header")
+        .WithSubject("chunk");
   }
   MutexLock lock(&mutex_);
   AddProgressLocked(v1::LoadMeshResponse::STAGE_RECEIVED, MillisecondsSince(start_));

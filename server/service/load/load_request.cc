@@ -29,7 +29,8 @@ StatusOr<Skeleton> ParseSkeleton(v1::SkeletonFormat format, const std::string& b
       return ParseSkeletonJson(bytes);
     default:
       return Status::InvalidArgument("upload.skeleton_format is unspecified or unknown (" +
-                                     std::to_string(static_cast<int>(format)) + ")");
+                                     std::to_string(static_cast<int>(format)) + ")")
+          .WithSubject("upload.skeleton_format");
   }
 }
 
@@ -40,7 +41,7 @@ Status ParseUpload(const v1::UploadSource& upload, std::string* mesh_bytes,
   if (upload.format() == v1::MESH_FORMAT_GLTF) {
     auto rig = ReadGltf(*mesh_bytes, limits);
     std::string().swap(*mesh_bytes);
-    if (!rig.ok()) return rig.status().WithContext("glTF");
+    if (!rig.ok()) return InField(rig.status().WithContext("glTF"), "chunk");
     job->mesh = std::move(rig->mesh);
     job->skeleton = std::move(rig->skeleton);
     job->weights = std::move(rig->weights);
@@ -63,32 +64,34 @@ Status ParseUpload(const v1::UploadSource& upload, std::string* mesh_bytes,
   }
   DEFORM_ASSIGN_OR_RETURN(const MeshFormat format, CoreMeshFormat(upload.format()));
   auto mesh = ReadMesh(*mesh_bytes, format, limits);
-  if (!mesh.ok()) return mesh.status().WithContext("mesh");
+  if (!mesh.ok()) return InField(mesh.status().WithContext("mesh"), "chunk");
   job->mesh = std::move(*mesh);
   std::string().swap(*mesh_bytes);  // the bytes are no longer needed
   auto skeleton = ParseSkeleton(upload.skeleton_format(), upload.skeleton());
-  if (!skeleton.ok()) return skeleton.status().WithContext("skeleton");
+  if (!skeleton.ok()) return InField(skeleton.status().WithContext("skeleton"), "upload.skeleton");
   job->skeleton = std::move(*skeleton);
   if (!upload.weights().empty()) {
     DEFORM_ASSIGN_OR_RETURN(const SkinWeightsFormat format,
                             CoreWeightsFormat(upload.weights_format()));
     auto weights = ReadSkinWeights(upload.weights(), format, limits);
-    if (!weights.ok()) return weights.status().WithContext("weights");
+    if (!weights.ok()) return InField(weights.status().WithContext("weights"), "upload.weights");
     WidenSkinWeights(format, job->mesh.num_vertices(), job->skeleton.num_bones(), &*weights);
     job->weights = std::move(*weights);
   }
   return Status::Ok();
 }
 
-// The bone `name` means (BoneFromName), its error prefixed by `field`; a name that is not
-// printable ASCII is repeated only escaped and cut.
-StatusOr<int> BoneOf(const Skeleton& skeleton, const std::string& name, const std::string& field) {
+// The bone `name` means (BoneFromName), its error prefixed by `field` and naming the request
+// field `path`; a name that is not printable ASCII is repeated only escaped and cut.
+StatusOr<int> BoneOf(const Skeleton& skeleton, const std::string& name, const std::string& field,
+                     const std::string& path) {
   StatusOr<int> bone = BoneFromName(skeleton, name);
   if (bone.ok()) return bone;
   if (EscapeForLog(name) != name) {
-    return Status::InvalidArgument(field + ": no bone named " + EchoForClient(name));
+    return Status::InvalidArgument(field + ": no bone named " + EchoForClient(name))
+        .WithSubject(path);
   }
-  return Status::InvalidArgument(field + ": " + bone.status().message());
+  return Status::InvalidArgument(field + ": " + bone.status().message()).WithSubject(path);
 }
 
 // An upload's bone surfaces: each mesh parsed (its reader validates it), its bones resolved, all
@@ -104,17 +107,21 @@ StatusOr<std::vector<BoneSurface>> ParseBoneSurfaces(const v1::UploadSource& upl
     surface.name = proto.name().empty() ? "bone_surfaces[" + std::to_string(i) + "]"
                                         : EscapeForLog(proto.name(), kMaxMeshNameBytes);
     const std::string field = "bone surface '" + surface.name + "'";
-    DEFORM_ASSIGN_OR_RETURN(surface.bone, BoneOf(skeleton, proto.bone(), field + " bone"));
+    const std::string path = "upload.bone_surfaces[" + std::to_string(i) + "]";
+    DEFORM_ASSIGN_OR_RETURN(surface.bone,
+                            BoneOf(skeleton, proto.bone(), field + " bone", path + ".bone"));
     if (!proto.blend_bone().empty()) {
-      DEFORM_ASSIGN_OR_RETURN(surface.blend_bone,
-                              BoneOf(skeleton, proto.blend_bone(), field + " blend_bone"));
+      DEFORM_ASSIGN_OR_RETURN(
+          surface.blend_bone,
+          BoneOf(skeleton, proto.blend_bone(), field + " blend_bone", path + ".blend_bone"));
       surface.blend = proto.blend();
     } else if (proto.blend() != 0) {
-      return Status::InvalidArgument(field + ": blend is given without a blend_bone");
+      return Status::InvalidArgument(field + ": blend is given without a blend_bone")
+          .WithSubject(path + ".blend");
     }
     DEFORM_ASSIGN_OR_RETURN(const MeshFormat format, CoreMeshFormat(proto.format()));
     auto mesh = ReadMesh(proto.mesh(), format, limits);
-    if (!mesh.ok()) return mesh.status().WithContext(field + " mesh");
+    if (!mesh.ok()) return InField(mesh.status().WithContext(field + " mesh"), path + ".mesh");
     surface.mesh = std::move(*mesh);
     surfaces.push_back(std::move(surface));
   }
@@ -148,10 +155,12 @@ StatusOr<LoadJob> LoadJobFromRequest(const v1::LoadMeshHeader& header, std::stri
     DEFORM_RETURN_IF_ERROR(ValidateBoneSurfaces(job.bone_surfaces, job.skeleton, mesh_limits));
   }
   auto options = ModelOptionsFromProto(header.options(), job.skeleton);
-  if (!options.ok()) return options.status().WithContext("options");
+  if (!options.ok()) return InField(options.status().WithContext("options"), "options");
   job.options = std::move(*options);
   auto constraints = ConstraintOptionsFromProto(header.options().constraints());
-  if (!constraints.ok()) return constraints.status().WithContext("options.constraints");
+  if (!constraints.ok()) {
+    return InField(constraints.status().WithContext("options.constraints"), "options.constraints");
+  }
   job.constraints = *constraints;
   return job;
 }
@@ -171,7 +180,8 @@ StatusOr<std::size_t> DeclaredLoadBytes(const v1::LoadMeshHeader& header,
     return Status::ResourceExhausted("the " + std::string(MeshFormatName(*format)) +
                                      " data declares " + std::to_string(declared->vertices) +
                                      " vertices, more than the limit of " +
-                                     std::to_string(limits.max_vertices) + " (--max-vertices)");
+                                     std::to_string(limits.max_vertices) + " (--max-vertices)")
+        .WithLimit("server", "--max-vertices");
   }
   const auto clamp = [](std::size_t count) {
     return static_cast<int>(std::min<std::size_t>(count, INT_MAX));

@@ -6,6 +6,7 @@
 
 #include "core/constraints/bone_reach.h"
 #include "service/base/log_text.h"
+#include "service/base/request_limits.h"
 
 namespace deform::service {
 namespace {
@@ -57,11 +58,15 @@ StatusOr<MeshConstraints> MakeConstraints(const DeformationModel& model,
   if (!surfaces.empty()) {
     auto contacts = BoneContacts::Create(std::move(surfaces), model.skeleton(), model.mesh(),
                                          model.rigid_bones(), limits);
-    if (!contacts.ok()) return contacts.status().WithContext("bone surfaces");
+    if (!contacts.ok()) {
+      return InField(contacts.status().WithContext("bone surfaces"), "upload.bone_surfaces");
+    }
     bones = std::move(*contacts);
   }
   auto constraints = SkinConstraints::Create(model, std::move(bones), options);
-  if (!constraints.ok()) return constraints.status().WithContext("options.constraints");
+  if (!constraints.ok()) {
+    return InField(constraints.status().WithContext("options.constraints"), "options.constraints");
+  }
   made.constraints = std::move(*constraints);
   // An open skin without bones, taking no tools.
   if (!made.constraints->active() && !made.constraints->takes_tools()) made.constraints = nullptr;

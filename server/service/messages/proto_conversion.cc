@@ -80,23 +80,30 @@ StatusOr<ModelOptions> ModelOptionsFromProto(const v1::MethodOptions& proto,
   if (proto.region_radius_factor() != 0) {
     if (!std::isfinite(proto.region_radius_factor()) || proto.region_radius_factor() < 0) {
       return Status::InvalidArgument("region_radius_factor must be positive and finite, got " +
-                                     std::to_string(proto.region_radius_factor()));
+                                     std::to_string(proto.region_radius_factor()))
+          .WithSubject("region_radius_factor");
     }
     options.regions.radius_factor = proto.region_radius_factor();
   }
-  for (const v1::JointRadius& radius : proto.region_radii()) {
-    DEFORM_ASSIGN_OR_RETURN(const int joint, JointOf(skeleton, radius.joint(), "region_radii"));
+  for (int k = 0; k < proto.region_radii_size(); ++k) {
+    const v1::JointRadius& radius = proto.region_radii(k);
+    const std::string path = "region_radii[" + std::to_string(k) + "]";
+    const StatusOr<int> found = JointOf(skeleton, radius.joint(), "region_radii");
+    if (!found.ok()) return InField(found.status(), path + ".joint");
+    const int joint = *found;
     if (!std::isfinite(radius.radius()) || radius.radius() <= 0) {
       return Status::InvalidArgument("region radius of joint '" + radius.joint() +
                                      "' must be positive and finite, got " +
-                                     std::to_string(radius.radius()));
+                                     std::to_string(radius.radius()))
+          .WithSubject(path + ".radius");
     }
     options.regions.explicit_radius.emplace_back(joint, radius.radius());
   }
   if (proto.has_default_material()) {
-    DEFORM_ASSIGN_OR_RETURN(
-        options.default_material,
-        MaterialFromProto(proto.default_material(), JointMaterial{}, "default material"));
+    const StatusOr<JointMaterial> material =
+        MaterialFromProto(proto.default_material(), JointMaterial{}, "default material");
+    if (!material.ok()) return InField(material.status(), "default_material");
+    options.default_material = *material;
   }
   switch (proto.rotation_blend()) {
     case v1::ROTATION_BLEND_UNSPECIFIED:
@@ -108,7 +115,8 @@ StatusOr<ModelOptions> ModelOptionsFromProto(const v1::MethodOptions& proto,
       break;
     default:
       return Status::InvalidArgument("unknown rotation_blend " +
-                                     std::to_string(proto.rotation_blend()));
+                                     std::to_string(proto.rotation_blend()))
+          .WithSubject("rotation_blend");
   }
   // DeformationModel::Build checks the range (INVALID_ARGUMENT naming the field).
   if (proto.has_rigid_weight_tolerance()) {
@@ -130,7 +138,8 @@ StatusOr<ConstraintOptions> ConstraintOptionsFromProto(const v1::Constraints& pr
     const double margin = proto.contact_margin();
     if (!std::isfinite(margin) || margin < 0 || margin > 0.1) {
       return Status::InvalidArgument("contact_margin must be in [0, 0.1] of the diagonal, got " +
-                                     std::to_string(margin));
+                                     std::to_string(margin))
+          .WithSubject("contact_margin");
     }
     options.contact_margin = margin;
   }
@@ -148,25 +157,32 @@ StatusOr<Stiffness> StiffnessFromProto(const v1::StiffnessUpdate& proto,
                                        const std::vector<int>& client_order) {
   DEFORM_RETURN_IF_ERROR(CheckStiffnessStrings(proto));
   Stiffness stiffness;
-  for (const v1::JointMaterialUpdate& update : proto.joint_materials()) {
-    DEFORM_ASSIGN_OR_RETURN(const int joint,
-                            RegionJointOf(model, update.joint(), "joint_materials"));
-    DEFORM_ASSIGN_OR_RETURN(const JointMaterial material,
-                            MaterialFromProto(update.material(), model.options().default_material,
-                                              "material of joint '" + update.joint() + "'"));
-    stiffness.joint_materials.emplace_back(joint, material);
+  for (int k = 0; k < proto.joint_materials_size(); ++k) {
+    const v1::JointMaterialUpdate& update = proto.joint_materials(k);
+    const std::string path = "joint_materials[" + std::to_string(k) + "]";
+    const StatusOr<int> joint = RegionJointOf(model, update.joint(), "joint_materials");
+    if (!joint.ok()) return InField(joint.status(), path + ".joint");
+    const StatusOr<JointMaterial> material =
+        MaterialFromProto(update.material(), model.options().default_material,
+                          "material of joint '" + update.joint() + "'");
+    if (!material.ok()) return InField(material.status(), path + ".material");
+    stiffness.joint_materials.emplace_back(*joint, *material);
   }
-  for (const v1::RegionWeight& weight : proto.region_weights()) {
-    DEFORM_ASSIGN_OR_RETURN(const int joint,
-                            RegionJointOf(model, weight.joint(), "region_weights"));
-    DEFORM_RETURN_IF_ERROR(
-        CheckMaterialWeight(weight.weight(), "region weight of joint '" + weight.joint() + "'"));
-    stiffness.region_weights.emplace_back(joint, weight.weight());
+  for (int k = 0; k < proto.region_weights_size(); ++k) {
+    const v1::RegionWeight& weight = proto.region_weights(k);
+    const std::string path = "region_weights[" + std::to_string(k) + "]";
+    const StatusOr<int> joint = RegionJointOf(model, weight.joint(), "region_weights");
+    if (!joint.ok()) return InField(joint.status(), path + ".joint");
+    DEFORM_RETURN_IF_ERROR(InField(
+        CheckMaterialWeight(weight.weight(), "region weight of joint '" + weight.joint() + "'"),
+        path + ".weight"));
+    stiffness.region_weights.emplace_back(*joint, weight.weight());
   }
   if (proto.vertex_indices_size() != proto.vertex_weights_size()) {
     return Status::InvalidArgument(
-        "vertex_indices has " + std::to_string(proto.vertex_indices_size()) +
-        " entries but vertex_weights has " + std::to_string(proto.vertex_weights_size()));
+               "vertex_indices has " + std::to_string(proto.vertex_indices_size()) +
+               " entries but vertex_weights has " + std::to_string(proto.vertex_weights_size()))
+        .WithSubject("vertex_weights");
   }
   const std::uint32_t vertices = static_cast<std::uint32_t>(
       client_order.empty() ? model.mesh().num_vertices() : client_order.size());
@@ -176,10 +192,12 @@ StatusOr<Stiffness> StiffnessFromProto(const v1::StiffnessUpdate& proto,
     if (vertex >= vertices) {
       return Status::InvalidArgument("vertex_indices[" + std::to_string(k) +
                                      "] = " + std::to_string(vertex) + " but the mesh has " +
-                                     std::to_string(vertices) + " vertices");
+                                     std::to_string(vertices) + " vertices")
+          .WithSubject("vertex_indices[" + std::to_string(k) + "]");
     }
-    DEFORM_RETURN_IF_ERROR(
-        CheckMaterialWeight(proto.vertex_weights(k), "weight of vertex " + std::to_string(vertex)));
+    DEFORM_RETURN_IF_ERROR(InField(
+        CheckMaterialWeight(proto.vertex_weights(k), "weight of vertex " + std::to_string(vertex)),
+        "vertex_weights[" + std::to_string(k) + "]"));
     const int solved = client_order.empty() ? static_cast<int>(vertex) : client_order[vertex];
     stiffness.vertex_weights.emplace_back(solved, proto.vertex_weights(k));
   }

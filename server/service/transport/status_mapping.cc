@@ -1,5 +1,7 @@
 #include "service/transport/status_mapping.h"
 
+#include "google/rpc/error_details.pb.h"
+#include "google/rpc/status.pb.h"
 #include "service/base/request_limits.h"
 
 namespace deform::service {
@@ -28,10 +30,34 @@ grpc::StatusCode ToGrpcCode(StatusCode code) {
   return grpc::StatusCode::UNKNOWN;
 }
 
+std::string ErrorDetailsOf(const Status& status) {
+  google::rpc::Status details;
+  if (status.code() == StatusCode::kInvalidArgument && !status.subject().empty()) {
+    google::rpc::BadRequest bad_request;
+    google::rpc::BadRequest::FieldViolation* violation = bad_request.add_field_violations();
+    violation->set_field(BoundStatusMessage(status.subject()));
+    violation->set_description(BoundStatusMessage(status.message()));
+    details.add_details()->PackFrom(bad_request);
+  } else if (status.code() == StatusCode::kResourceExhausted && !status.limit().empty()) {
+    google::rpc::QuotaFailure quota_failure;
+    google::rpc::QuotaFailure::Violation* violation = quota_failure.add_violations();
+    violation->set_subject(status.subject().empty() ? "server" : status.subject());
+    violation->set_description(BoundStatusMessage(status.limit() + ": " + status.message()));
+    details.add_details()->PackFrom(quota_failure);
+  } else {
+    return {};
+  }
+  details.set_code(static_cast<int>(ToGrpcCode(status.code())));
+  details.set_message(BoundStatusMessage(status.message()));
+  return details.SerializeAsString();
+}
+
 grpc::Status ToGrpcStatus(const Status& status) {
   if (status.ok()) return grpc::Status::OK;
-  // Cut: a message repeating client strings must never overflow gRPC's metadata limit.
-  return grpc::Status(ToGrpcCode(status.code()), BoundStatusMessage(status.message()));
+  // Cut: a message repeating client strings must never overflow gRPC's metadata limit (the
+  // details repeat the message once more, each part cut alike).
+  return grpc::Status(ToGrpcCode(status.code()), BoundStatusMessage(status.message()),
+                      ErrorDetailsOf(status));
 }
 
 }  // namespace deform::service

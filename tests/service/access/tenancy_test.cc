@@ -15,6 +15,8 @@
 #include <thread>
 #include <vector>
 
+#include "google/rpc/error_details.pb.h"
+#include "google/rpc/status.pb.h"
 #include "service/access/audit_log.h"
 #include "service/access/identity.h"
 #include "service/registry/mesh_id.h"
@@ -156,6 +158,15 @@ TEST_F(TenancyTest, PerTenantMeshAndStreamLimits) {
   const grpc::Status second = ward_a_->LoadPhantom(300, {}, &summary);
   EXPECT_EQ(second.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
   EXPECT_THAT(second.error_message(), HasSubstr("--tenant-max-meshes"));
+  // The machine-readable form: a QuotaFailure naming the tenant and the option.
+  google::rpc::Status details;
+  ASSERT_TRUE(details.ParseFromString(second.error_details()));
+  google::rpc::QuotaFailure quota_failure;
+  ASSERT_EQ(details.details_size(), 1);
+  ASSERT_TRUE(details.details(0).UnpackTo(&quota_failure));
+  ASSERT_EQ(quota_failure.violations_size(), 1);
+  EXPECT_EQ(quota_failure.violations(0).subject(), "tenant:ward-a");
+  EXPECT_THAT(quota_failure.violations(0).description(), HasSubstr("--tenant-max-meshes"));
   const std::string b_mesh = LoadPhantom(*ward_b_);  // another tenant is not affected
 
   StreamRecorder first;
