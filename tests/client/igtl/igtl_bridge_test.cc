@@ -357,7 +357,11 @@ TEST_P(IgtlBridgeFullFramesTest, SendsEveryFrameAsTheFullPolyData) {
   ASSERT_GT(moved, 10.0f) << "the knee did not bend";
   // The bent pose as it stands once the frames have caught up.
   ASSERT_TRUE(WaitForPoints(receiver, "Skin", bent, 0.1f, 10, nullptr));
+#ifndef DEFORM_IGTL_TEST_SANITIZED
+  // A measurement, in the Release build only: under ASan+UBSan a full frame of the 26k leg packs
+  // and unpacks so slowly that a pose can take longer than the wait to show.
   PrintPoseToPointsLatency(receiver, "Skin", leg.mesh, topology.points, bent);
+#endif
   receiver.Close();
   EXPECT_EQ(bridge.Stop(), 0) << bridge.Log();
 }
