@@ -4,9 +4,11 @@
 #include <chrono>
 #include <fstream>
 #include <sstream>
+#include <thread>
 #include <utility>
 
 #include "deform_stream_impl.h"
+#include "reconnecting_stream.h"
 
 namespace deform::client {
 namespace {
@@ -106,6 +108,11 @@ std::shared_ptr<grpc::Channel> MakeDeformChannel(const std::string& target,
   grpc::ChannelArguments arguments;
   arguments.SetMaxReceiveMessageSize(options.max_receive_message_bytes);
   arguments.SetMaxSendMessageSize(-1);
+  // A lost server is tried again within 100 ms to 1 s (gRPC's defaults: 1 s growing to 120 s),
+  // so that a reconnecting stream (ReconnectPolicy) finds the next server soon.
+  arguments.SetInt(GRPC_ARG_MIN_RECONNECT_BACKOFF_MS, 100);
+  arguments.SetInt(GRPC_ARG_INITIAL_RECONNECT_BACKOFF_MS, 100);
+  arguments.SetInt(GRPC_ARG_MAX_RECONNECT_BACKOFF_MS, 1000);
   if (!options.tls.enabled) {
     return grpc::CreateCustomChannel(target, grpc::InsecureChannelCredentials(), arguments);
   }
@@ -121,6 +128,15 @@ std::shared_ptr<grpc::Channel> MakeDeformChannel(const std::string& target,
 
 void AddCallCredentials(const ClientOptions& options, grpc::ClientContext* context) {
   if (!options.token.empty()) context->AddMetadata("authorization", "Bearer " + options.token);
+}
+
+void AddMeshKey(const std::string& mesh_id, grpc::ClientContext* context) {
+  constexpr std::size_t kMaxKeyBytes = 128;
+  if (mesh_id.empty() || mesh_id.size() > kMaxKeyBytes) return;
+  for (const char c : mesh_id) {
+    if (c < 0x21 || c > 0x7e) return;  // gRPC refuses other metadata values
+  }
+  context->AddMetadata(kMeshKeyHeader, mesh_id);
 }
 
 DeformClient::DeformClient(const std::string& target, ClientOptions options)
@@ -248,10 +264,23 @@ grpc::Status DeformClient::GetMeshInfo(const std::string& mesh_id, bool include_
 
 grpc::Status DeformClient::GetMeshInfo(const deform::v1::GetMeshInfoRequest& request,
                                        deform::v1::GetMeshInfoResponse* info) {
-  grpc::ClientContext context;
-  SetUnaryDeadline(options_, &context);
-  AddCallCredentials(options_, &context);
-  return stub_->GetMeshInfo(&context, request, info);
+  // A server still building the mesh (a cluster's replica, from the shared store) says when to
+  // ask again (google.rpc.RetryInfo): asked again then, within the call's deadline.
+  const auto deadline =
+      std::chrono::steady_clock::now() + std::chrono::milliseconds(options_.unary_deadline_ms);
+  for (;;) {
+    grpc::ClientContext context;
+    SetUnaryDeadline(options_, &context);
+    AddCallCredentials(options_, &context);
+    AddMeshKey(request.mesh_id(), &context);
+    const grpc::Status status = stub_->GetMeshInfo(&context, request, info);
+    const int retry_ms = internal::RetryDelayMs(status);
+    if (status.error_code() != grpc::StatusCode::UNAVAILABLE || retry_ms <= 0 ||
+        std::chrono::steady_clock::now() + std::chrono::milliseconds(retry_ms) >= deadline) {
+      return status;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(retry_ms));
+  }
 }
 
 grpc::Status DeformClient::ListMeshes(std::vector<deform::v1::MeshSummary>* meshes) {
@@ -271,6 +300,7 @@ grpc::Status DeformClient::UnloadMesh(const std::string& mesh_id) {
   grpc::ClientContext context;
   SetUnaryDeadline(options_, &context);
   AddCallCredentials(options_, &context);
+  AddMeshKey(mesh_id, &context);
   deform::v1::UnloadMeshRequest request;
   request.set_mesh_id(mesh_id);
   deform::v1::UnloadMeshResponse response;
@@ -281,6 +311,7 @@ grpc::Status DeformClient::OpenContactQuery(const deform::v1::ContactQueryStart&
                                             std::unique_ptr<ContactQuery>* query) {
   auto context = std::make_unique<grpc::ClientContext>();
   AddCallCredentials(options_, context.get());
+  AddMeshKey(start.mesh_id(), context.get());
   return ContactQuery::Open(stub_.get(), std::move(context), start, query);
 }
 
@@ -292,6 +323,21 @@ std::unique_ptr<DeformStream> DeformClient::OpenStream(const std::string& mesh_i
 std::unique_ptr<DeformStream> DeformClient::OpenStream(const std::string& mesh_id,
                                                        StreamCallbacks callbacks,
                                                        const StreamOptions& stream_options) {
+  if (!stream_options.reconnect.enabled) {
+    return OpenPlainStream(mesh_id, std::move(callbacks), stream_options, /*must_decode=*/false);
+  }
+  return internal::StartReconnectingStream(
+      [this, mesh_id, stream_options](StreamCallbacks plain_callbacks) {
+        return OpenPlainStream(mesh_id, std::move(plain_callbacks), stream_options,
+                               /*must_decode=*/true);
+      },
+      std::move(callbacks), stream_options.reconnect);
+}
+
+std::unique_ptr<DeformStream> DeformClient::OpenPlainStream(const std::string& mesh_id,
+                                                            StreamCallbacks callbacks,
+                                                            const StreamOptions& stream_options,
+                                                            bool must_decode) {
   deform::v1::DeformStart start;
   start.set_mesh_id(mesh_id);
   start.set_encoding(stream_options.encoding);
@@ -304,8 +350,14 @@ std::unique_ptr<DeformStream> DeformClient::OpenStream(const std::string& mesh_i
     request.set_include_geometry(predicted);
     request.set_include_prediction_weights(predicted);
     deform::v1::GetMeshInfoResponse info;
-    // An unknown mesh is answered by the stream itself (NOT_FOUND through on_done).
-    if (GetMeshInfo(request, &info).ok()) decoder = internal::MakeFrameDecoder(info);
+    // An unknown mesh is answered by the stream itself (NOT_FOUND through on_done); a server that
+    // cannot answer now is tried again by a reconnecting stream.
+    const grpc::Status status = GetMeshInfo(request, &info);
+    if (status.ok()) {
+      decoder = internal::MakeFrameDecoder(info);
+    } else if (must_decode && status.error_code() == grpc::StatusCode::UNAVAILABLE) {
+      return nullptr;
+    }
   }
   return internal::StartDeformStream(stub_.get(), options_, start, std::move(callbacks),
                                      std::move(decoder));

@@ -58,12 +58,38 @@ struct ClientOptions {
   std::string token;
 };
 
-// The channel DeformClient(target, options) uses: TLS or plaintext, message limits. For other
+// The channel DeformClient(target, options) uses: TLS or plaintext, message limits, a lost
+// connection tried again after 100 ms growing to at most 1 s. For other
 // stubs on the same server (e.g. the health service).
 std::shared_ptr<grpc::Channel> MakeDeformChannel(const std::string& target,
                                                  const ClientOptions& options);
 // Adds options.token (if any) to `context` as "authorization: Bearer <token>".
 void AddCallCredentials(const ClientOptions& options, grpc::ClientContext* context);
+
+// The metadata every call that names a mesh carries, with the mesh's id (its content key), so that
+// a balancer in front of several servers routes all of a mesh's calls to the one that holds it
+// (docs/cluster.md). The library sets it on GetMeshInfo, UnloadMesh, Deform and QueryContact.
+inline constexpr char kMeshKeyHeader[] = "deform-mesh-key";
+// Adds `mesh_id` to `context` as kMeshKeyHeader (nothing for an id that is not printable ASCII of
+// at most 128 bytes: such an id is no server's, and the call is answered NOT_FOUND unrouted).
+void AddMeshKey(const std::string& mesh_id, grpc::ClientContext* context);
+
+// How a Deform stream survives the loss of its server (a replica that died or drained, a mesh
+// still being built on the replica the balancer chose): when the stream ends UNAVAILABLE (or
+// CANCELLED without the application cancelling it: a balancer resets the streams of a server that
+// died), the
+// library opens it again on the same mesh after a backoff and re-sends the latest pose and the
+// latest stiffness update; the application sees on_reconnect, then frames again, and on_done only
+// when the stream really ends. Delays: the server's google.rpc.RetryInfo when it gives one, else
+// initial_backoff_ms doubling up to max_backoff_ms (each with up to 20% jitter); it gives up, and
+// on_done receives the UNAVAILABLE, once give_up_after_ms have passed since the stream last had a
+// frame. Defaults: off.
+struct ReconnectPolicy {
+  bool enabled = false;
+  int initial_backoff_ms = 50;
+  int max_backoff_ms = 1000;
+  int give_up_after_ms = 10'000;
+};
 
 using ProgressCallback = std::function<void(const deform::v1::LoadMeshResponse&)>;
 
@@ -116,6 +142,9 @@ class DeformClient {
     std::function<void(const deform::v1::DeformFrame&)> on_frame;
     std::function<void(const deform::v1::Notice&)> on_notice;
     std::function<void(const grpc::Status&)> on_done;  // once, when the stream ends
+    // With a ReconnectPolicy: the stream was lost with `lost` and has been opened again (its
+    // `attempt`-th try since the last frame); frames follow from the new server.
+    std::function<void(const grpc::Status& lost, int attempt)> on_reconnect;
   };
   // Opens a Deform stream on `mesh_id` (sends `start`). Errors such as NOT_FOUND arrive through
   // on_done / DeformStream::Wait().
@@ -126,11 +155,14 @@ class DeformClient {
   // own vertex order) before on_frame; `encoded` stays as received (its size is what travelled).
   struct StreamOptions {
     deform::v1::FrameEncoding encoding = deform::v1::FRAME_ENCODING_FLOAT32;
-    double max_error = 0;  // PREDICTED: fraction of the bounding-box diagonal; 0 = the default
+    double max_error = 0;       // PREDICTED: fraction of the bounding-box diagonal; 0 = the default
+    ReconnectPolicy reconnect;  // default: off (the first UNAVAILABLE ends the stream)
   };
   // As above with an encoding. For QUANTIZED and PREDICTED it first asks GetMeshInfo for what the
   // decoder needs (the vertex count; PREDICTED: the rest positions and prediction weights, once).
-  // A frame that does not decode ends the stream with INTERNAL naming the problem.
+  // A frame that does not decode ends the stream with INTERNAL naming the problem. With
+  // stream_options.reconnect the stream survives its server's loss (ReconnectPolicy); the
+  // client must then outlive it.
   std::unique_ptr<DeformStream> OpenStream(const std::string& mesh_id, StreamCallbacks callbacks,
                                            const StreamOptions& stream_options);
 
@@ -145,6 +177,12 @@ class DeformClient {
   deform::v1::DeformService::Stub* stub() { return stub_.get(); }
 
  private:
+  // One Deform call; with `must_decode`, null when the decoder's GetMeshInfo was UNAVAILABLE.
+  std::unique_ptr<DeformStream> OpenPlainStream(const std::string& mesh_id,
+                                                StreamCallbacks callbacks,
+                                                const StreamOptions& stream_options,
+                                                bool must_decode);
+
   std::shared_ptr<grpc::Channel> channel_;
   std::unique_ptr<deform::v1::DeformService::Stub> stub_;
   ClientOptions options_;

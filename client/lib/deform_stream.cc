@@ -23,6 +23,7 @@ class DeformStreamImpl final
                    std::unique_ptr<codec::FrameDecoder> decoder)
       : callbacks_(std::move(callbacks)), decoder_(std::move(decoder)) {
     AddCallCredentials(options, &context_);
+    AddMeshKey(start.mesh_id(), &context_);
     stub->async()->Deform(&context_, this);
     *in_flight_.mutable_start() = start;
     write_in_flight_ = true;

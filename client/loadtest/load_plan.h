@@ -34,6 +34,8 @@ struct LoadPlan {
   // After the last send: how long to wait for every stream's last frame, then for the streams to
   // finish after the half-close (streams still open are cancelled).
   double drain_s = 2.0;
+  // Streams open themselves again when their server is lost (ReconnectPolicy, defaults).
+  bool reconnect = false;
 };
 
 // A StiffnessUpdate giving `joint` the material {rigid 2, soft `soft`, seam 4} (the defaults, but

@@ -91,6 +91,7 @@ LoadReport BuildReport(const RunDescription& run, const LoadPlan& plan, RunOutco
     report.stiffness_sent += stream.stiffness_sent;
     report.stiffness_applied += stats.stiffness_applied;
     report.max_gap_ms = std::max(report.max_gap_ms, stream.max_gap_ms);
+    report.reconnects += stats.reconnects;
     report.latency_ms.insert(report.latency_ms.end(), stats.latency_ms.begin(),
                              stats.latency_ms.end());
     timings.insert(timings.end(), stats.timings.begin(), stats.timings.end());
@@ -137,6 +138,8 @@ nlohmann::ordered_json ReportJson(const LoadReport& report) {
   nlohmann::ordered_json out;
   out["target"] = report.run.target;
   out["mesh"] = report.run.mesh;
+  out["mesh_id"] = report.run.mesh_id;
+  out["acquire_ms"] = Round(report.run.acquire_ms, 3);
   out["vertices"] = report.run.vertices;
   out["triangles"] = report.run.triangles;
   out["rotation_blend"] = report.run.rotation_blend;
@@ -165,6 +168,7 @@ nlohmann::ordered_json ReportJson(const LoadReport& report) {
                        {"p99", Ms(report.latency.p99)}, {"p999", Ms(report.latency.p999)},
                        {"max", Ms(report.latency.max)}, {"mean", Ms(report.latency.mean)}};
   out["max_gap_ms"] = Ms(report.max_gap_ms);
+  out["reconnects"] = report.reconnects;
   out["stiffness_every_s"] = plan.stiffness_every_s;
   out["stiffness_joint"] = report.run.stiffness_joint;
   out["stiffness_updates_sent"] = report.stiffness_sent;
@@ -223,6 +227,10 @@ std::string ReportText(const LoadReport& report) {
   add("latency ms: p50 %.3f  p90 %.3f  p99 %.3f  p99.9 %.3f  max %.3f  (mean %.3f)\n", l.p50, l.p90,
       l.p99, l.p999, l.max, l.mean);
   add("largest gap between frames of one stream: %.3f ms\n", report.max_gap_ms);
+  if (report.reconnects > 0) {
+    add("streams opened again after losing their server: %llu\n",
+        static_cast<unsigned long long>(report.reconnects));
+  }
   add("server ms (median): queue %.3f  rhs %.3f  solve %.3f  constraints %.3f  encode %.3f\n",
       report.server_p50.queue_ms, report.server_p50.rhs_ms, report.server_p50.solve_ms,
       report.server_p50.constraint_ms, report.server_p50.encode_ms);

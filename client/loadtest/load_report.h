@@ -23,6 +23,8 @@ struct RunDescription {
   std::string rotation_blend;   // as the server reports the mesh loaded
   std::string encoding;         // the frames' (--encoding)
   std::string stiffness_joint;  // empty without stiffness updates
+  // From before connecting to the mesh being ready (connect, then load or look up), client side.
+  double acquire_ms = 0;
 };
 
 struct LoadReport {
@@ -43,6 +45,7 @@ struct LoadReport {
   std::vector<double> latency_ms;   // every measured frame's, ascending
   LatencySummary latency;
   double max_gap_ms = 0;
+  std::uint64_t reconnects = 0;  // streams opened again after their server was lost
   std::uint64_t stiffness_sent = 0;
   std::uint64_t stiffness_applied = 0;
   double stiffness_factor_ms_p50 = 0;

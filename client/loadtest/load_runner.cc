@@ -71,8 +71,10 @@ std::vector<StreamSlot> OpenStreams(client::DeformClient& client, const LoadPlan
     callbacks.on_frame = [recorder](const deform::v1::DeformFrame& f) { recorder->OnFrame(f); };
     callbacks.on_notice = [recorder](const deform::v1::Notice& n) { recorder->OnNotice(n); };
     callbacks.on_done = [recorder](const grpc::Status& s) { recorder->OnDone(s); };
+    callbacks.on_reconnect = [recorder](const grpc::Status&, int) { recorder->OnReconnect(); };
     client::DeformClient::StreamOptions options;
     options.encoding = plan.encoding;
+    options.reconnect.enabled = plan.reconnect;
     slot.stream = client.OpenStream(plan.mesh_id, std::move(callbacks), options);
     slot.open = slot.stream != nullptr;
   }

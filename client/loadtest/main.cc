@@ -1,6 +1,7 @@
 // deform-loadtest: many concurrent Deform streams at headset rate against one server.
 //
-//   deform-loadtest [--target ADDR] [--mesh FILE --skeleton FILE] [--streams N] [--rate HZ]
+//   deform-loadtest [--target ADDR] [--mesh FILE --skeleton FILE | --mesh-id ID] [--streams N]
+//                   [--rate HZ] [--reconnect]
 //                   [--duration S] [--warmup S] [--stiffness-every S] [--joint J --axis A]
 //                   [--json] [--fail-on-errors]
 //
@@ -8,6 +9,7 @@
 // when the run completed (errors are counted in the report), 1 when it could not run (connect or
 // load failure) or, with --fail-on-errors, when errors were counted, 2 for usage errors.
 #include <CLI/CLI.hpp>
+#include <chrono>
 #include <iostream>
 #if defined(__GLIBC__)
 #include <malloc.h>
@@ -46,6 +48,7 @@ struct LoadtestArgs {
   double drain_s = 2.0;
   deform::v1::FrameEncoding encoding = deform::v1::FRAME_ENCODING_FLOAT32;
   bool keep_mesh = false;
+  bool reconnect = false;
   bool json = false;
   bool fail_on_errors = false;
 };
@@ -70,7 +73,7 @@ int Fail(const grpc::Status& status) { return deform::cli::ReportFailure(kProgra
 
 // Runs the plan on a loaded mesh and prints the report; returns the exit code.
 int RunOnMesh(deform::client::DeformClient& client, const LoadtestArgs& args,
-              const deform::v1::MeshSummary& summary) {
+              const deform::v1::MeshSummary& summary, double acquire_ms) {
   deform::loadtest::LoadPlan plan;
   plan.mesh_id = summary.mesh_id();
   plan.vertex_count = summary.vertex_count();
@@ -83,11 +86,13 @@ int RunOnMesh(deform::client::DeformClient& client, const LoadtestArgs& args,
   plan.cycle_s = args.cycle_s;
   plan.drain_s = args.drain_s;
   plan.encoding = args.encoding;
+  plan.reconnect = args.reconnect;
 
   deform::loadtest::RunDescription run;
   run.target = args.connection.target;
   run.mesh = args.source.Description();
   run.mesh_id = summary.mesh_id();
+  run.acquire_ms = acquire_ms;
   run.vertices = summary.vertex_count();
   run.triangles = summary.triangle_count();
   run.rotation_blend = deform::cli::RotationBlendName(summary.rotation_blend());
@@ -117,17 +122,26 @@ int RunOnMesh(deform::client::DeformClient& client, const LoadtestArgs& args,
 }
 
 int Run(const LoadtestArgs& args) {
+  const auto start = std::chrono::steady_clock::now();
   return deform::cli::RunOnAcquiredMesh(
       kProgram, args.connection, args.source,
       [&](deform::client::DeformClient& client, const deform::v1::MeshSummary& summary) {
-        return RunOnMesh(client, args, summary);
+        const double acquire_ms =
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                .count();
+        return RunOnMesh(client, args, summary, acquire_ms);
       },
       [&](bool loaded) { return loaded && !args.keep_mesh; });
 }
 
 void AddFlags(CLI::App& app, LoadtestArgs& args) {
   deform::cli::AddConnectionFlags(app, &args.connection);
-  deform::cli::AddMeshSourceFlags(app, &args.source);
+  const deform::cli::MeshSourceOptions source = deform::cli::AddMeshSourceFlags(app, &args.source);
+  app.add_option("--mesh-id", args.source.mesh_id,
+                 "Run on a mesh the server already holds (it is left loaded)")
+      ->excludes(source.mesh)
+      ->excludes(source.skeleton)
+      ->excludes(source.phantom_vertices);
 
   deform::cli::AddFrameEncodingFlag(app, &args.encoding);
   app.add_option("--streams", args.streams, "Concurrent Deform streams on the mesh")
@@ -166,6 +180,9 @@ void AddFlags(CLI::App& app, LoadtestArgs& args) {
       ->capture_default_str()
       ->check(CLI::Range(0.0, 3600.0));
   app.add_flag("--keep-mesh", args.keep_mesh, "Leave the loaded mesh on the server");
+  app.add_flag("--reconnect", args.reconnect,
+               "Streams that lose their server (UNAVAILABLE) open again on the same mesh "
+               "(the client library's ReconnectPolicy, its defaults); counted as reconnects");
   app.add_flag("--json", args.json,
                "Print one JSON object instead of the summary and latency histogram");
   app.add_flag("--fail-on-errors", args.fail_on_errors,

@@ -111,4 +111,9 @@ StreamStats StreamRecorder::Snapshot() {
   return stats_;
 }
 
+void StreamRecorder::OnReconnect() {
+  std::lock_guard<std::mutex> lock(mu_);
+  ++stats_.reconnects;
+}
+
 }  // namespace deform::loadtest

@@ -61,6 +61,7 @@ struct StreamStats {
   std::vector<double> stiffness_factor_ms;  // Notice.factor_ms of each KIND_STIFFNESS_APPLIED
   grpc::Status final_status;
   bool done = false;
+  std::uint64_t reconnects = 0;  // times the stream was opened again (ReconnectPolicy)
 };
 
 class StreamRecorder {
@@ -78,6 +79,7 @@ class StreamRecorder {
   void OnFrame(const deform::v1::DeformFrame& frame);
   void OnNotice(const deform::v1::Notice& notice);
   void OnDone(const grpc::Status& status);
+  void OnReconnect();
 
   // Waits until pose `sequence` (or a later one) is answered or rejected, or the stream ends.
   // False on timeout.

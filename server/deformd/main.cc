@@ -8,7 +8,8 @@
 //           [--max-connections N] [--max-connections-per-address N]
 //           [--tls-cert PEM --tls-key PEM [--tls-client-ca PEM]] [--plaintext]
 //           [--token-file FILE] [--tenant-max-meshes N] [--tenant-max-streams N]
-//           [--tenant-max-memory-mb N] [--preload-tenant NAME] [--store DIR [--store-key FILE]]
+//           [--tenant-max-memory-mb N] [--preload-tenant NAME]
+//           [--store DIR [--store-key FILE] [--store-shared]] [--drain-delay-ms N]
 //           [--metrics ADDR]
 //           [--http ADDR [--http-root DIR] [--http-max-connections N]
 //            [--http-max-connections-per-address N]
@@ -26,6 +27,8 @@
 //
 // --store DIR keeps loaded meshes on disk and builds them again, under their ids and owners, when
 // the server starts (service/mesh_store.h); preloads are not kept (their flags bring them back).
+// With --store-shared the directory is a cluster's, shared by its replicas, and meshes are built
+// when a call first names them (docs/cluster.md).
 //
 // Transport: TLS with --tls-cert/--tls-key (mutual TLS with --tls-client-ca); without a
 // certificate, plaintext on a loopback address only, unless --plaintext
@@ -89,6 +92,7 @@ struct Args {
   double keepalive_timeout_s = 10;
   double idle_timeout_s = 300;
   std::string store_key;
+  bool store_shared = false;
   std::string http_address;
   std::string http_root;
   int http_max_connections = 64;
@@ -300,6 +304,16 @@ int main(int argc, char** argv) {
                  "The --store entries' HMAC key (32 bytes, created 0600 if missing; outside the "
                  "store): an entry whose owner was edited is refused at restore")
       ->envname("DEFORMD_STORE_KEY");
+  app.add_flag("--store-shared", args.store_shared,
+               "The --store directory is shared by the replicas of a cluster (needs --store-key, "
+               "the same on every replica): meshes are built on demand, not restored at start")
+      ->envname("DEFORMD_STORE_SHARED");
+  app.add_option("--drain-delay-ms", args.server.drain_delay_ms,
+                 "On SIGTERM, milliseconds of NOT_SERVING health before the streams end (for a "
+                 "balancer to stop routing here; within --shutdown-grace-s)")
+      ->check(CLI::Range(0, 600'000))
+      ->capture_default_str()
+      ->envname("DEFORMD_DRAIN_DELAY_MS");
   app.add_option("--preload-tenant", args.preload_tenant,
                  "Tenant that owns the --preload and --preload-phantom meshes")
       ->capture_default_str()
@@ -397,7 +411,8 @@ int main(int argc, char** argv) {
     }
   }
   if (!args.store_dir.empty()) {
-    const deform::Status store = server.UseStore(args.store_dir, nullptr, args.store_key);
+    const deform::Status store =
+        server.UseStore(args.store_dir, nullptr, args.store_key, args.store_shared);
     if (!store.ok()) {
       spdlog::error("--store: {}", store.ToString());
       return 1;

@@ -53,4 +53,11 @@ Status Status::WithLimit(std::string scope, std::string option) const {
   return status;
 }
 
+Status Status::WithRetryDelay(int milliseconds) const {
+  if (ok()) return *this;
+  Status status = *this;
+  status.retry_delay_ms_ = milliseconds;
+  return status;
+}
+
 }  // namespace deform

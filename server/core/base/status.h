@@ -13,7 +13,7 @@
 namespace deform {
 
 // Each value is its canonical gRPC code's number (gRPC's doc/statuscodes.md), so a code converts
-// to a gRPC code by its number; the core uses only these eight.
+// to a gRPC code by its number; the core uses only these nine.
 enum class StatusCode {
   kOk = 0,
   kInvalidArgument = 3,     // the input (mesh, skeleton, pose, request) is malformed
@@ -23,6 +23,7 @@ enum class StatusCode {
   kFailedPrecondition = 9,  // the operation does not apply in the current state
   kOutOfRange = 11,         // a value lies outside its allowed range
   kInternal = 13,           // a numerical or programming failure (e.g. factorization broke down)
+  kUnavailable = 14,        // not answerable now, but soon: retry (retry_delay_ms() says when)
   kUnauthenticated = 16,    // the caller presented no valid credentials (the service's token check)
 };
 
@@ -54,6 +55,7 @@ class [[nodiscard]] Status {
   static Status ResourceExhausted(std::string msg) {
     return {StatusCode::kResourceExhausted, std::move(msg)};
   }
+  static Status Unavailable(std::string msg) { return {StatusCode::kUnavailable, std::move(msg)}; }
   static Status FailedPrecondition(std::string msg) {
     return {StatusCode::kFailedPrecondition, std::move(msg)};
   }
@@ -79,11 +81,15 @@ class [[nodiscard]] Status {
   const std::string& subject() const { return subject_; }
   // For RESOURCE_EXHAUSTED the option that sets the limit ("--max-meshes"); empty otherwise.
   const std::string& limit() const { return limit_; }
+  // For UNAVAILABLE how long the caller should wait before retrying; 0: no hint.
+  int retry_delay_ms() const { return retry_delay_ms_; }
 
   // Returns a copy with the subject set (an OK status is returned unchanged: it has none).
   Status WithSubject(std::string subject) const;
   // Returns a copy naming the limit that refused: its scope (the subject) and its option.
   Status WithLimit(std::string scope, std::string option) const;
+  // Returns a copy advising a retry after `milliseconds` (> 0).
+  Status WithRetryDelay(int milliseconds) const;
 
  private:
   Status(StatusCode code, std::string msg) : code_(code), message_(std::move(msg)) {}
@@ -91,6 +97,7 @@ class [[nodiscard]] Status {
   std::string message_;
   std::string subject_;
   std::string limit_;
+  int retry_delay_ms_ = 0;
 };
 
 // Either a value or a non-OK Status.

@@ -100,6 +100,11 @@ struct ServerOptions {
   // Where GET /metrics is served (metrics_endpoint.h), "host:port"; empty: not served. Default:
   // empty.
   std::string metrics_address;
+  // On shutdown, how long the server reports NOT_SERVING through gRPC health while still serving
+  // everything, before it stops accepting and ends the open streams (UNAVAILABLE): the time a
+  // balancer's health check needs to send new streams elsewhere (docs/cluster.md). Counted in the
+  // shutdown's grace period. Default: 0 (a single server has no balancer to wait for).
+  int drain_delay_ms = 0;
   ConnectionOptions connections;
   ServiceLimits limits;
   TransportSecurity security;

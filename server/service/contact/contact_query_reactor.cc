@@ -182,7 +182,7 @@ Status ContactQueryReactor::StartChecked() {
   DEFORM_RETURN_IF_ERROR(CheckLength(mesh_id, kMaxMeshIdBytes, "start.mesh_id"));
   if (start.stiffness() != 0) force_model_.stiffness = start.stiffness();
   DEFORM_RETURN_IF_ERROR(ValidateContactForceModel(force_model_));
-  auto entry = context_->registry().Find(mesh_id, caller_);
+  auto entry = context_->FindMesh(mesh_id, caller_);
   if (!entry.ok()) {
     Audit(caller_.tenant, "contact", mesh_id, entry.status().ToString());
     return entry.status();

@@ -1,5 +1,7 @@
 #include "service/context/service_context.h"
 
+#include <spdlog/spdlog.h>
+
 #include "service/base/log_text.h"
 
 namespace deform::service {
@@ -47,6 +49,38 @@ ServiceContext::ServiceContext(const ServerOptions& options)
       uploads_(std::chrono::milliseconds(options.limits.upload_idle_timeout_ms),
                std::chrono::milliseconds(options.limits.upload_time_limit_ms)) {
   InstallEscapingDefaultLogger();  // every line safe, in-process servers included (log_text.h)
+}
+
+StatusOr<std::shared_ptr<const MeshEntry>> ServiceContext::FindMesh(const std::string& mesh_id,
+                                                                    const Identity& caller) {
+  StatusOr<std::shared_ptr<const MeshEntry>> entry = registry_.Find(mesh_id, caller);
+  if (store_ == nullptr || !store_->shared()) return entry;
+  if (entry.ok()) {
+    bool stored;
+    {
+      MutexLock lock(&stored_mutex_);
+      stored = stored_ids_.count(mesh_id) != 0;
+    }
+    if (!stored || store_->Contains(mesh_id)) return entry;
+    // Unloaded by another replica: its open streams here run on (they hold the model).
+    spdlog::info("mesh={} unloaded on another replica (its store entry is gone): unloading it",
+                 mesh_id);
+    (void)registry_.Unload(mesh_id);
+    {
+      MutexLock lock(&stored_mutex_);
+      stored_ids_.erase(mesh_id);
+    }
+    return registry_.Find(mesh_id, caller);  // NOT_FOUND, as any unknown id
+  }
+  if (entry.status().code() != StatusCode::kNotFound || restorer_ == nullptr) return entry;
+  const Status restoring = restorer_->Restore(mesh_id, caller);
+  if (restoring.code() == StatusCode::kNotFound) return entry;  // the registry's own message
+  return restoring;
+}
+
+void ServiceContext::MarkStored(const std::string& id) {
+  MutexLock lock(&stored_mutex_);
+  stored_ids_.insert(id);
 }
 
 bool ServiceContext::CountRefusal(ServiceMetrics::Refusal reason, std::uint64_t* held_back) {

@@ -27,6 +27,7 @@
 #include "service/base/thread_annotations.h"
 #include "service/context/latest_frames.h"
 #include "service/metrics/service_metrics.h"
+#include "service/registry/mesh_key.h"
 #include "service/registry/mesh_registry.h"
 #include "service/registry/mesh_store.h"
 #include "service/workers/worker_pool.h"
@@ -70,8 +71,19 @@ class ActiveStreams {
   bool draining_ DEFORM_GUARDED_BY(mutex_) = false;
 };
 
+// Builds a mesh this server has not loaded from a shared store's entry, in the background
+// (load/store_restore.h implements it; the context only knows it is there).
+class MeshRestorer {
+ public:
+  virtual ~MeshRestorer() = default;
+  // `mesh_id` is not loaded here: UNAVAILABLE with a retry delay while its build (started now, or
+  // earlier) runs; NOT_FOUND when the store holds no entry of it for `caller` or its build
+  // failed. Must not block (it runs on the RPC's thread).
+  virtual Status Restore(const std::string& mesh_id, const Identity& caller) = 0;
+};
+
 // Thread safety: the accessors may be called from any thread; each object they return states its
-// own (set_store only before serving).
+// own (the set_ methods only before serving).
 class ServiceContext {
  public:
   explicit ServiceContext(const ServerOptions& options);
@@ -96,6 +108,21 @@ class ServiceContext {
   MeshStore* store() const { return store_.get(); }
   // Before serving only.
   void set_store(std::unique_ptr<MeshStore> store) { store_ = std::move(store); }
+  // What names a load's mesh (mesh_key.h): under the store key, or a random secret.
+  const MeshKeys& mesh_keys() const { return mesh_keys_; }
+  void set_mesh_keys(MeshKeys keys) { mesh_keys_ = std::move(keys); }
+  // With a shared store (MeshStore::shared): how meshes not loaded here are built.
+  void set_restorer(std::unique_ptr<MeshRestorer> restorer) { restorer_ = std::move(restorer); }
+
+  // The mesh `caller` may use, as MeshRegistry::Find; with a shared store, also what the other
+  // replicas did: a mesh another replica unloaded (its entry gone) is unloaded here and
+  // NOT_FOUND, and one another replica loaded is built here (MeshRestorer::Restore: UNAVAILABLE
+  // with a retry delay meanwhile). Every RPC that names a mesh looks it up here.
+  StatusOr<std::shared_ptr<const MeshEntry>> FindMesh(const std::string& mesh_id,
+                                                      const Identity& caller)
+      DEFORM_EXCLUDES(stored_mutex_);
+  // The mesh `id` has an entry in the store (kept at its load, or built from it).
+  void MarkStored(const std::string& id) DEFORM_EXCLUDES(stored_mutex_);
   // Cancelled when the server shuts down: the parent of every build's token (cancel_token.h).
   CancelToken& shutting_down() { return shutting_down_; }
   // Ids for log lines: each stream's and each load's, counting from 1.
@@ -122,6 +149,10 @@ class ServiceContext {
   ActiveStreams streams_;
   LatestFrames latest_frames_;
   std::unique_ptr<MeshStore> store_;
+  MeshKeys mesh_keys_;
+  std::unique_ptr<MeshRestorer> restorer_;
+  mutable Mutex stored_mutex_;
+  std::unordered_set<std::string> stored_ids_ DEFORM_GUARDED_BY(stored_mutex_);
   CancelToken shutting_down_;
   std::atomic<std::uint64_t> next_stream_id_{1};
   std::atomic<std::uint64_t> next_load_id_{1};

@@ -266,7 +266,7 @@ void DeformStreamReactor::HandleStart() {
     Fail(id_length);
     return;
   }
-  auto entry = context_->registry().Find(mesh_id, caller_);
+  auto entry = context_->FindMesh(mesh_id, caller_);
   if (!entry.ok()) {
     Audit(caller_.tenant, "deform", mesh_id, entry.status().ToString());
     Fail(entry.status());

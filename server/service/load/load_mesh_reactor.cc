@@ -20,7 +20,6 @@
 #include "service/load/load_request.h"
 #include "service/load/mesh_loader.h"
 #include "service/messages/proto_conversion.h"
-#include "service/registry/mesh_id.h"
 #include "service/registry/mesh_store.h"
 #include "service/transport/status_mapping.h"
 #include "service/transport/stream_write_pump.h"
@@ -117,6 +116,8 @@ class LoadMeshReactor final : public StreamHandler,
   std::uint64_t expected_bytes_ = 0;
   Admission::MeshSlot reservation_;
   std::uint64_t upload_watch_ = 0;  // context_->uploads()' id while an upload arrives; 0: none
+  // The load named a mesh loaded already (the same content): a cancel must not unload it.
+  bool reused_ = false;
 
   Mutex mutex_;
   std::deque<v1::LoadMeshResponse> outbox_ DEFORM_GUARDED_BY(mutex_);
@@ -237,7 +238,7 @@ void LoadMeshReactor::Build() {
   if (!entry.ok()) reservation_.Release();
   MutexLock lock(&mutex_);
   if (entry.ok()) {
-    if (cancelled_) {
+    if (cancelled_ && !reused_) {
       // Nobody is waiting for it: the mesh would be unreachable.
       (void)context_->registry().Unload((*entry)->id);
       // An entry that cannot be deleted is logged; the mesh comes back at the next start.
@@ -274,21 +275,35 @@ StatusOr<std::shared_ptr<const MeshEntry>> LoadMeshReactor::ParseAndBuild() {
     DEFORM_RETURN_IF_ERROR(
         context_->admission().ReserveMemory(&reservation_, declared, declared_subject));
   }
-  std::string pending_id;
-  if (context_->store() != nullptr) {
-    // Kept on disk as uploaded (before parsing frees the bytes); committed once registered.
-    pending_id = NewMeshId();
-    DEFORM_RETURN_IF_ERROR(
-        context_->store()->WritePending({pending_id, caller_.tenant, header_, mesh_bytes_}));
+  // The mesh's content key (mesh_key.h): the same content loaded again by this tenant is the
+  // mesh loaded already, answered without a rebuild.
+  const std::string key = context_->mesh_keys().KeyOf(caller_.tenant, header_, mesh_bytes_);
+  {
+    auto loaded = context_->registry().Find(key, caller_);
+    if (loaded.ok()) {
+      reused_ = true;
+      reservation_.Release();
+      spdlog::info("{} mesh={} is loaded already: the same content", log_context_, key);
+      return loaded;
+    }
+  }
+  MeshStore* const store = context_->store();
+  std::string pending;
+  // Kept on disk as uploaded (before parsing frees the bytes); committed once registered. A shared
+  // store may hold it already (another replica's load): entries are immutable by key.
+  const bool write_entry = store != nullptr && !store->Contains(key);
+  if (write_entry) {
+    DEFORM_ASSIGN_OR_RETURN(pending,
+                            store->WritePending({key, caller_.tenant, header_, mesh_bytes_}));
   }
   StatusOr<LoadJob> parsed = LoadJobFromRequest(header_, &mesh_bytes_, context_->limits());
   if (!parsed.ok()) {
-    if (!pending_id.empty()) context_->store()->Discard(pending_id);
+    if (write_entry) store->Discard(pending);
     return parsed.status();
   }
   LoadJob job = std::move(*parsed);
   job.start = start_;
-  job.id = pending_id;
+  job.id = key;
   job.cancel = &cancel_;
   job.metrics = &context_->metrics();
 
@@ -308,13 +323,18 @@ StatusOr<std::shared_ptr<const MeshEntry>> LoadMeshReactor::ParseAndBuild() {
     pump_.Pump();
   };
   auto entry = BuildAndRegister(context_, std::move(reservation_), std::move(job), progress);
-  if (!pending_id.empty()) {
-    if (entry.ok()) {
-      context_->store()->Commit(pending_id);
-    } else {
-      context_->store()->Discard(pending_id);
+  if (!entry.ok()) {
+    if (write_entry) store->Discard(pending);
+    // The same content loaded at the same time by another call of this tenant: that mesh.
+    auto loaded = context_->registry().Find(key, caller_);
+    if (loaded.ok()) {
+      reused_ = true;
+      return loaded;
     }
+    return entry;
   }
+  if (write_entry) store->Commit(pending, key);
+  if (store != nullptr) context_->MarkStored(key);
   return entry;
 }
 

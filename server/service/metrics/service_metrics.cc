@@ -299,6 +299,8 @@ void ServiceMetrics::SetGauges(const Gauges& gauges) {
   memory_streams_->Set(static_cast<double>(gauges.memory_streams_bytes));
   memory_budget_->Set(static_cast<double>(gauges.memory_budget_bytes));
   notice_backlog_->Set(static_cast<double>(gauges.notice_backlog_bytes));
+  MutexLock lock(&mesh_streams_mutex_);
+  mesh_streams_ = gauges.mesh_streams;
 }
 
 std::string ServiceMetrics::Serialize() const {
@@ -306,6 +308,19 @@ std::string ServiceMetrics::Serialize() const {
   for (const AtomicHistogram* histogram : {&frame_server_seconds_, &frame_queue_seconds_,
                                            &frame_compute_seconds_, &frame_constraint_seconds_}) {
     families.push_back(histogram->Collect());
+  }
+  {
+    prometheus::MetricFamily mesh_streams{"deformd_mesh_streams_open",
+                                          "Open Deform streams of each loaded mesh",
+                                          prometheus::MetricType::Gauge,
+                                          {}};
+    MutexLock lock(&mesh_streams_mutex_);
+    for (const auto& [mesh, streams] : mesh_streams_) {
+      prometheus::ClientMetric& metric = mesh_streams.metric.emplace_back();
+      metric.label.push_back({"mesh", mesh});
+      metric.gauge.value = streams;
+    }
+    families.push_back(std::move(mesh_streams));
   }
   std::vector<prometheus::MetricFamily> process = process_->Collect();
   families.insert(families.end(), std::make_move_iterator(process.begin()),

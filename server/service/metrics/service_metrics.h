@@ -24,7 +24,8 @@
 //    deformd_loads_in_progress, deformd_memory_budget_used_bytes,
 //    deformd_memory_budget_reserved_bytes, deformd_memory_budget_streams_bytes,
 //    deformd_memory_budget_bytes,
-//    deformd_notice_backlog_bytes.
+//    deformd_notice_backlog_bytes; deformd_mesh_streams_open{mesh} for each loaded mesh (its
+//    id), so that a cluster's operator sees which replica serves which mesh's streams.
 //  - deformd_refused_total{reason}: what any peer can cause at will, counted whether or not it
 //    was logged (ServiceContext::CountRefusal bounds the lines): unauthenticated calls,
 //    HTTP connections over --http-max-connections, HTTP requests for another Host or Origin,
@@ -58,8 +59,12 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <utility>
+#include <vector>
 
 #include "core/base/status.h"
+#include "service/base/annotated_mutex.h"
+#include "service/base/thread_annotations.h"
 #include "service/metrics/atomic_histogram.h"
 #include "service/metrics/grpc_methods.h"
 
@@ -134,6 +139,7 @@ class ServiceMetrics {
     std::size_t memory_streams_bytes = 0;
     std::size_t memory_budget_bytes = 0;
     std::int64_t notice_backlog_bytes = 0;
+    std::vector<std::pair<std::string, int>> mesh_streams;  // mesh id, its open streams
   };
   void SetGauges(const Gauges& gauges);
   // The served TLS certificate's end of validity (Unix seconds); called once, when TLS starts.
@@ -176,6 +182,8 @@ class ServiceMetrics {
   prometheus::Gauge* memory_budget_ = nullptr;
   prometheus::Gauge* notice_backlog_ = nullptr;
   prometheus::Gauge* certificate_expiry_ = nullptr;  // added by SetCertificateExpiry
+  mutable Mutex mesh_streams_mutex_;
+  std::vector<std::pair<std::string, int>> mesh_streams_ DEFORM_GUARDED_BY(mesh_streams_mutex_);
 };
 
 }  // namespace deform::service

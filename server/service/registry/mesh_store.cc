@@ -29,6 +29,10 @@ constexpr std::string_view kMagic = "deformd-store v1\n";       // SHA-256 of th
 constexpr std::string_view kKeyedMagic = "deformd-store v2\n";  // HMAC-SHA256 of the body
 constexpr std::size_t kKeyBytes = 32;
 constexpr std::size_t kDigestBytes = 32;
+// A shared store's pending file this old has no writer left (a load's build takes minutes at most).
+constexpr long kSharedPendingAgeSeconds = 3600;
+// Enough of an entry's beginning for its id and tenant (PeekTenant).
+constexpr std::size_t kPeekBytes = 4096;
 
 std::string ErrnoText() { return std::strerror(errno); }
 
@@ -224,9 +228,12 @@ StatusOr<std::string> MeshStore::ReadOrCreateKey(const std::string& path, const 
   }
   int fd = ::open(path.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
   if (fd < 0 && errno == ENOENT) {
+    // Written beside it, then linked into place: replicas starting together all read one whole
+    // key (link() refuses to replace the one another replica published first).
     unsigned char fresh[kKeyBytes];
     if (RAND_bytes(fresh, sizeof fresh) != 1) return Status::Internal("no random bytes for a key");
-    const int out = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+    const std::string draft = path + "." + NewMeshId().substr(5) + ".new";
+    const int out = ::open(draft.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
     if (out < 0) {
       return Status::FailedPrecondition("cannot create the store key '" + path +
                                         "': " + ErrnoText());
@@ -234,11 +241,13 @@ StatusOr<std::string> MeshStore::ReadOrCreateKey(const std::string& path, const 
     const bool written = ::write(out, fresh, sizeof fresh) == static_cast<ssize_t>(sizeof fresh) &&
                          ::fsync(out) == 0;
     ::close(out);
-    if (!written) {
-      ::unlink(path.c_str());
+    const bool published = written && ::link(draft.c_str(), path.c_str()) == 0;
+    const int link_error = errno;
+    ::unlink(draft.c_str());
+    if (!written || (!published && link_error != EEXIST)) {
       return Status::FailedPrecondition("cannot write the store key '" + path + "'");
     }
-    spdlog::info("store: created the key '{}'", EscapeForLog(path));
+    if (published) spdlog::info("store: created the key '{}'", EscapeForLog(path));
     fd = ::open(path.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
   }
   if (fd < 0) {
@@ -262,7 +271,7 @@ StatusOr<std::string> MeshStore::ReadOrCreateKey(const std::string& path, const 
 }
 
 StatusOr<std::unique_ptr<MeshStore>> MeshStore::Open(const std::string& dir,
-                                                     const std::string& key_file) {
+                                                     const std::string& key_file, bool shared) {
   if (dir.empty()) return Status::FailedPrecondition("the store directory is empty");
   if (::mkdir(dir.c_str(), 0700) != 0 && errno != EEXIST) {
     return Status::FailedPrecondition("cannot create the store directory '" + dir +
@@ -279,16 +288,18 @@ StatusOr<std::unique_ptr<MeshStore>> MeshStore::Open(const std::string& dir,
     return Status::FailedPrecondition("cannot make the store directory '" + dir +
                                       "' private (0700): " + ErrnoText());
   }
-  // One server per store: a second one would delete the first's unfinished entries and unload
-  // its meshes' files.
+  // One server per exclusive store: a second one would delete the first's unfinished entries and
+  // unload its meshes' files. Replicas share theirs.
   const std::string lock_path = dir + "/" + std::string(kLockFileName);
   const int lock_fd = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0600);
   if (lock_fd < 0) {
     return Status::FailedPrecondition("cannot open the store's lock file '" + lock_path +
                                       "': " + ErrnoText());
   }
-  if (::flock(lock_fd, LOCK_EX | LOCK_NB) != 0) {
-    const std::string why = errno == EWOULDBLOCK ? "another deformd uses this store" : ErrnoText();
+  if (::flock(lock_fd, (shared ? LOCK_SH : LOCK_EX) | LOCK_NB) != 0) {
+    const std::string why = errno != EWOULDBLOCK ? ErrnoText()
+                            : shared ? "a deformd without --store-shared uses this store"
+                                     : "another deformd uses this store";
     ::close(lock_fd);
     return Status::FailedPrecondition("the store '" + dir + "' is locked (" + lock_path +
                                       "): " + why);
@@ -302,9 +313,9 @@ StatusOr<std::unique_ptr<MeshStore>> MeshStore::Open(const std::string& dir,
     }
     key = std::move(*read);
   }
-  std::unique_ptr<MeshStore> store(new MeshStore(dir, lock_fd, std::move(key)));
+  std::unique_ptr<MeshStore> store(new MeshStore(dir, lock_fd, std::move(key), shared));
   // Writable now, not at the first load: a read-only store would fail every load.
-  const std::string probe = dir + "/.write-check.pending";
+  const std::string probe = dir + "/.write-check." + NewMeshId() + ".pending";
   const int probe_fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
   if (probe_fd < 0 || ::fsync(probe_fd) != 0 || ::unlink(probe.c_str()) != 0) {
     const std::string why = ErrnoText();
@@ -316,6 +327,12 @@ StatusOr<std::unique_ptr<MeshStore>> MeshStore::Open(const std::string& dir,
   for (const auto& file : std::filesystem::directory_iterator(dir, error)) {
     const std::string name = file.path().filename().string();
     if (name.size() > 9 && name[0] == '.' && name.substr(name.size() - 8) == ".pending") {
+      // Shared: only those no replica can still be writing.
+      struct stat pending {};
+      if (shared && (::stat(file.path().c_str(), &pending) != 0 ||
+                     ::time(nullptr) - pending.st_mtime < kSharedPendingAgeSeconds)) {
+        continue;
+      }
       spdlog::warn("store: deleting the unfinished entry '{}'", EscapeForLog(name));
       std::filesystem::remove(file.path(), error);
     }
@@ -323,8 +340,9 @@ StatusOr<std::unique_ptr<MeshStore>> MeshStore::Open(const std::string& dir,
   return store;
 }
 
-Status MeshStore::WritePending(const StoredMesh& mesh) const {
-  const std::string path = PendingPath(mesh.id);
+StatusOr<std::string> MeshStore::WritePending(const StoredMesh& mesh) const {
+  // Unique: several loads (or replicas) may write the same id at once.
+  const std::string path = dir_ + "/." + mesh.id + "." + NewMeshId().substr(5) + ".pending";
   const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
   if (fd < 0) {
     spdlog::error("store: cannot create '{}': {}", EscapeForLog(path), ErrnoText());
@@ -349,20 +367,59 @@ Status MeshStore::WritePending(const StoredMesh& mesh) const {
     spdlog::error("store: cannot write '{}': {}", EscapeForLog(path), error);
     return Status::Internal("the server cannot keep the mesh in its store (see its log)");
   }
-  return Status::Ok();
+  return path;
 }
 
-void MeshStore::Commit(const std::string& id) const {
-  if (::rename(PendingPath(id).c_str(), EntryPath(id).c_str()) != 0) {
+void MeshStore::Commit(const std::string& pending, const std::string& id) const {
+  if (::rename(pending.c_str(), EntryPath(id).c_str()) != 0) {
     spdlog::error("store: mesh={} cannot be kept ({}): it will not come back after a restart", id,
                   ErrnoText());
-    ::unlink(PendingPath(id).c_str());
+    ::unlink(pending.c_str());
     return;
   }
   SyncDirectory(dir_);  // the rename is durable once the directory is synced
 }
 
-void MeshStore::Discard(const std::string& id) const { ::unlink(PendingPath(id).c_str()); }
+void MeshStore::Discard(const std::string& pending) const { ::unlink(pending.c_str()); }
+
+bool MeshStore::Contains(const std::string& id) const {
+  struct stat info {};
+  return LooksLikeMeshId(id) && ::lstat(EntryPath(id).c_str(), &info) == 0 && S_ISREG(info.st_mode);
+}
+
+StatusOr<StoredMesh> MeshStore::Read(const std::string& id) const {
+  if (!LooksLikeMeshId(id)) return Status::NotFound("no entry");
+  const std::string path = EntryPath(id);
+  const StatusOr<std::string> data = ReadRegularFile(path);
+  if (!data.ok()) return Status::NotFound("no readable entry: " + data.status().message());
+  StatusOr<StoredMesh> stored = ParseEntry(*data, key_);
+  if (stored.ok() && stored->id != id) {
+    stored = Status::InvalidArgument("its id '" + stored->id + "' does not match its file name");
+  }
+  if (!stored.ok()) {
+    spdlog::error("store: the entry '{}' is corrupt: {}", EscapeForLog(path),
+                  stored.status().message());
+  }
+  return stored;
+}
+
+StatusOr<std::string> MeshStore::PeekTenant(const std::string& id) const {
+  if (!Contains(id)) return Status::NotFound("no entry");
+  const int fd = ::open(EntryPath(id).c_str(), O_RDONLY | O_NONBLOCK | O_NOFOLLOW | O_CLOEXEC);
+  if (fd < 0) return Status::NotFound("no readable entry");
+  std::string data(kPeekBytes, '\0');
+  const ssize_t n = ::pread(fd, data.data(), data.size(), 0);
+  ::close(fd);
+  if (n < 0) return Status::NotFound("no readable entry");
+  data.resize(static_cast<std::size_t>(n));
+  std::size_t offset = kMagic.size();
+  std::string_view stored_id, tenant;
+  if (data.size() < offset || !ReadField<std::uint32_t>(data, &offset, &stored_id) ||
+      !ReadField<std::uint32_t>(data, &offset, &tenant) || stored_id != id) {
+    return Status::InvalidArgument("malformed entry");
+  }
+  return std::string(tenant);
+}
 
 MeshStore::~MeshStore() {
   if (lock_fd_ >= 0) ::close(lock_fd_);  // releases the lock

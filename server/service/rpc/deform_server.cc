@@ -7,6 +7,7 @@
 
 #include <cstdlib>
 #include <ctime>
+#include <thread>
 #include <vector>
 
 #include "health.pb.h"
@@ -17,6 +18,7 @@
 #include "service/context/service_context.h"
 #include "service/load/load_request.h"
 #include "service/load/mesh_loader.h"
+#include "service/load/store_restore.h"
 #include "service/metrics/rpc_metrics_interceptor.h"
 #include "service/registry/mesh_store.h"
 #include "service/rpc/deform_service.h"
@@ -54,22 +56,12 @@ std::string RenderMetrics(ServiceContext* context) {
   gauges.memory_streams_bytes = context->admission().memory_bytes_streams();
   gauges.memory_budget_bytes = context->limits().max_memory_bytes;
   gauges.notice_backlog_bytes = context->notice_backlog_bytes().load(std::memory_order_relaxed);
+  for (const auto& entry : context->registry().List()) {
+    gauges.mesh_streams.emplace_back(entry->id,
+                                     entry->open_streams.load(std::memory_order_relaxed));
+  }
   context->metrics().SetGauges(gauges);
   return context->metrics().Serialize();
-}
-
-// Builds `stored` again under its id and owner and registers it (`start` is when its restore
-// began).
-StatusOr<std::shared_ptr<const MeshEntry>> Restore(ServiceContext* context, StoredMesh* stored,
-                                                   std::chrono::steady_clock::time_point start) {
-  DEFORM_ASSIGN_OR_RETURN(
-      LoadJob job, LoadJobFromRequest(stored->header, &stored->mesh_bytes, context->limits()));
-  job.id = stored->id;
-  job.start = start;
-  job.metrics = &context->metrics();
-  DEFORM_ASSIGN_OR_RETURN(Admission::MeshSlot reservation,
-                          context->admission().ReserveMesh(stored->tenant));
-  return BuildAndRegister(context, std::move(reservation), std::move(job));
 }
 
 }  // namespace
@@ -246,8 +238,14 @@ void DeformServer::StartAccepting() {
       });
 }
 
-Status DeformServer::UseStore(const std::string& dir, int* restored, const std::string& key_file) {
-  DEFORM_ASSIGN_OR_RETURN(std::unique_ptr<MeshStore> store, MeshStore::Open(dir, key_file));
+Status DeformServer::UseStore(const std::string& dir, int* restored, const std::string& key_file,
+                              bool shared) {
+  if (shared && key_file.empty()) {
+    return Status::FailedPrecondition(
+        "--store-shared needs --store-key: the replicas must share the key that names meshes "
+        "and seals their entries");
+  }
+  DEFORM_ASSIGN_OR_RETURN(std::unique_ptr<MeshStore> store, MeshStore::Open(dir, key_file, shared));
   if (key_file.empty()) {
     spdlog::warn(
         "store: no --store-key: entries are checksummed, not authenticated (whoever "
@@ -255,23 +253,31 @@ Status DeformServer::UseStore(const std::string& dir, int* restored, const std::
         EscapeForLog(dir));
   }
   ServiceContext& context = impl_->context;
+  if (!store->key().empty()) context.set_mesh_keys(MeshKeys(store->key()));
   int count = 0;
-  for (StoredMesh& stored : store->LoadAll()) {
-    const auto start = std::chrono::steady_clock::now();
-    const StatusOr<std::shared_ptr<const MeshEntry>> entry = Restore(&context, &stored, start);
-    if (!entry.ok()) {
-      spdlog::error("store: mesh={} tenant={} not restored: {}", stored.id,
-                    EscapeForLog(stored.tenant), entry.status().ToString());
-      continue;
+  if (shared) {
+    spdlog::info("store: '{}' shared with other replicas: meshes are built when first named",
+                 EscapeForLog(dir));
+  } else {
+    for (StoredMesh& stored : store->LoadAll()) {
+      const auto start = std::chrono::steady_clock::now();
+      const StatusOr<std::shared_ptr<const MeshEntry>> entry =
+          RestoreStoredMesh(&context, &stored, start);
+      if (!entry.ok()) {
+        spdlog::error("store: mesh={} tenant={} not restored: {}", stored.id,
+                      EscapeForLog(stored.tenant), entry.status().ToString());
+        continue;
+      }
+      ++count;
+      spdlog::info(
+          "store: mesh={} tenant={} restored in {:.0f} ms", stored.id, EscapeForLog(stored.tenant),
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+              .count());
     }
-    ++count;
-    spdlog::info("store: mesh={} tenant={} restored in {:.0f} ms", stored.id,
-                 EscapeForLog(stored.tenant),
-                 std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-                     .count());
+    spdlog::info("store: {} meshes restored from '{}'", count, EscapeForLog(dir));
   }
-  spdlog::info("store: {} meshes restored from '{}'", count, EscapeForLog(dir));
   context.set_store(std::move(store));
+  if (shared) context.set_restorer(std::make_unique<StoreRestorer>(&context));
   if (restored != nullptr) *restored = count;
   return Status::Ok();
 }
@@ -331,6 +337,11 @@ void DeformServer::Shutdown(std::chrono::milliseconds grace) {
     spdlog::info("draining: {} open streams", impl_->context.streams().count());
     if (grpc::HealthCheckServiceInterface* health = impl_->server->GetHealthCheckService()) {
       health->SetServingStatus(false);
+    }
+    if (impl_->options.drain_delay_ms > 0) {
+      spdlog::info("draining: NOT_SERVING for {} ms before the streams end (--drain-delay-ms)",
+                   impl_->options.drain_delay_ms);
+      std::this_thread::sleep_for(std::chrono::milliseconds(impl_->options.drain_delay_ms));
     }
     impl_->acceptor->Stop();  // no new connections
     impl_->context.streams().DrainAll();

@@ -55,9 +55,12 @@ class DeformServer {
   // mesh stored there under its id and owner, on the calling thread; before Start(). A corrupt or
   // failing entry is logged and skipped. FAILED_PRECONDITION when the directory cannot be used.
   // `restored` (optional) receives the number of meshes restored. `key_file`: the store's HMAC
-  // key (--store-key; mesh_store.h), empty for none.
-  Status UseStore(const std::string& dir, int* restored = nullptr,
-                  const std::string& key_file = "");
+  // key (--store-key; mesh_store.h), empty for none; it is also the secret of the mesh keys
+  // (mesh_key.h). `shared` (--store-shared): a store the replicas of a cluster share
+  // (docs/cluster.md): it needs a key (the replicas must agree on mesh keys), restores nothing at
+  // start, and builds a mesh another replica loaded when a call first names it (StoreRestorer).
+  Status UseStore(const std::string& dir, int* restored = nullptr, const std::string& key_file = "",
+                  bool shared = false);
 
   // Authenticates calls with the token file at `path` from now on (identity.h); before Start().
   // NOT_FOUND or INVALID_ARGUMENT (naming the line) for a bad file. Without it, every caller is

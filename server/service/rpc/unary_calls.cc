@@ -47,7 +47,7 @@ Status GetMeshInfoCall(ServiceContext& context, std::string_view authorization,
   DEFORM_ASSIGN_OR_RETURN(Identity caller, AuthenticateCall(context, authorization, action,
                                                             BoundedForAudit(request.mesh_id())));
   DEFORM_RETURN_IF_ERROR(CheckLength(request.mesh_id(), kMaxMeshIdBytes, "mesh_id"));
-  auto entry = context.registry().Find(request.mesh_id(), caller);
+  auto entry = context.FindMesh(request.mesh_id(), caller);
   Audit(caller.tenant, action, request.mesh_id(), ResultText(entry.status()));
   if (!entry.ok()) return entry.status();
   FillMeshSummary(**entry, response->mutable_summary());
@@ -74,10 +74,17 @@ Status UnloadMeshCall(ServiceContext& context, std::string_view authorization,
   DEFORM_RETURN_IF_ERROR(CheckLength(request.mesh_id(), kMaxMeshIdBytes, "mesh_id"));
   // The stored entry first: a mesh whose entry cannot be deleted stays loaded (else it would
   // come back at the next start), and the caller is told.
+  MeshStore* const store = context.store();
   Status status = context.registry().Find(request.mesh_id(), caller).status();
-  if (status.ok() && context.store() != nullptr)
-    status = context.store()->Remove(request.mesh_id());
-  if (status.ok()) status = context.registry().Unload(request.mesh_id(), caller);
+  if (status.ok() && store != nullptr) status = store->Remove(request.mesh_id());
+  if (status.ok()) {
+    status = context.registry().Unload(request.mesh_id(), caller);
+  } else if (status.code() == StatusCode::kNotFound && store != nullptr && store->shared()) {
+    // Loaded by another replica only: its entry goes, and that replica unloads it when a call
+    // next names it (ServiceContext::FindMesh).
+    const StatusOr<std::string> owner = store->PeekTenant(request.mesh_id());
+    if (owner.ok() && caller.CanAccess(*owner)) status = store->Remove(request.mesh_id());
+  }
   Audit(caller.tenant, "unload", request.mesh_id(), ResultText(status));
   return status;
 }

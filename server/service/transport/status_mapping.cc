@@ -22,6 +22,8 @@ grpc::StatusCode ToGrpcCode(StatusCode code) {
       return grpc::StatusCode::FAILED_PRECONDITION;
     case StatusCode::kInternal:
       return grpc::StatusCode::INTERNAL;
+    case StatusCode::kUnavailable:
+      return grpc::StatusCode::UNAVAILABLE;
     case StatusCode::kUnauthenticated:
       return grpc::StatusCode::UNAUTHENTICATED;
     case StatusCode::kPermissionDenied:
@@ -44,6 +46,11 @@ std::string ErrorDetailsOf(const Status& status) {
     violation->set_subject(status.subject().empty() ? "server" : status.subject());
     violation->set_description(BoundStatusMessage(status.limit() + ": " + status.message()));
     details.add_details()->PackFrom(quota_failure);
+  } else if (status.code() == StatusCode::kUnavailable && status.retry_delay_ms() > 0) {
+    google::rpc::RetryInfo retry;
+    retry.mutable_retry_delay()->set_seconds(status.retry_delay_ms() / 1000);
+    retry.mutable_retry_delay()->set_nanos((status.retry_delay_ms() % 1000) * 1'000'000);
+    details.add_details()->PackFrom(retry);
   } else {
     return {};
   }

@@ -8,7 +8,9 @@
 //     (Status::subject()) and the message;
 //   - for RESOURCE_EXHAUSTED naming its limit, a google.rpc.QuotaFailure with one violation: the
 //     limit's scope ("server", "tenant:NAME") and a description that begins with the option
-//     that sets it ("--max-meshes: ...").
+//     that sets it ("--max-meshes: ...");
+//   - for UNAVAILABLE with a retry delay (a mesh being built from a shared store), a
+//     google.rpc.RetryInfo whose retry_delay is Status::retry_delay_ms().
 // Any other status, or one without a subject, has no details (never an empty BadRequest).
 // Thread-safe (pure functions).
 #pragma once

@@ -310,14 +310,14 @@ TEST_F(LoadMeshTest, TooManyMeshesIsResourceExhausted) {
   service::ServerOptions options = TestServerOptions();
   options.limits.max_meshes = 2;
   StartServer(options);
-  const std::string second = LoadPhantom(300);  // the background mesh is the first
+  const std::string second = LoadPhantom(301);  // the background mesh is the first
   v1::MeshSummary summary;
-  const grpc::Status third = client_->LoadPhantom(300, {}, &summary);
+  const grpc::Status third = client_->LoadPhantom(302, {}, &summary);
   EXPECT_EQ(third.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
   EXPECT_THAT(third.error_message(), HasSubstr("mesh limit"));
   ExpectBackgroundStreamAlive();
   ASSERT_TRUE(client_->UnloadMesh(second).ok());
-  EXPECT_TRUE(client_->LoadPhantom(300, {}, &summary).ok());
+  EXPECT_TRUE(client_->LoadPhantom(302, {}, &summary).ok());
 }
 
 TEST_F(LoadMeshTest, MemoryBudgetIsResourceExhausted) {
