@@ -4,7 +4,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh scripts/packages/build.txt scripts/packages/browser.txt \
-  scripts/packages/csharp.txt
+  scripts/packages/csharp.txt scripts/packages/deploy.txt
 scripts/install-node-tools.sh
 scripts/build.sh
 scripts/run-ctest.sh "${DEFORM_BUILD_DIR:-build}" --output-on-failure --parallel "$(nproc)" \
