@@ -19,13 +19,15 @@
 #   --shutdown-grace-s, within terminationGracePeriodSeconds, and take no DEFORMD_* variables from
 #   Services (enableServiceLinks false); the balancer's DEFORM_REPLICA_N are
 #   the StatefulSet's pods under its Service, one per replica, and its ConfigMap's haproxy.cfg
-#   passes `haproxy -c` with the balancer's environment.
+#   passes `haproxy -c` with the balancer's environment and is DIR/haproxy.cfg line for line but
+#   for the Kubernetes additions (resolvers, monitor, the servers' resolver options).
 #
 #   Compose: three deformd replicas (the services with DEFORMD_STORE_SHARED) with one named
 #   volume at their store's path, one key file, hardened as docker/compose.yaml (read_only,
 #   cap_drop ALL, no-new-privileges, mem_limit, cpus), a health check and a stop_grace_period
 #   above --shutdown-grace-s; a balancer whose DEFORM_REPLICA_1..3 are those services, that
-#   waits for them to be healthy and publishes the gRPC port; the key file ignored by git and
+#   waits for them to be healthy and publishes the gRPC port, and with whose environment
+#   haproxy.cfg passes `haproxy -c`; the key file ignored by git and
 #   by the image's build context.
 #
 # Schemas first: the Kubernetes documents against the API's (scripts/k8s-schema: kubernetes-models
@@ -181,6 +183,46 @@ def probe_port(probe):
 
 def env_of(container):
     return {e["name"]: e.get("value") for e in container.get("env") or [] if "name" in e}
+
+
+SECTIONS = ("global", "defaults", "frontend", "backend", "listen", "resolvers", "peers")
+KUBERNETES_OPTIONS = re.compile(r" (resolvers|init-addr|resolve-prefer) \S+")
+
+
+def haproxy_lines(text, kubernetes):
+    """The configuration's lines without comments and blanks; with `kubernetes`, also without
+    what Kubernetes adds to docker/cluster/haproxy.cfg: the resolvers section, the monitor
+    lines, and the servers' resolvers, init-addr and resolve-prefer options."""
+    lines, skipping = [], False
+    for raw in text.splitlines():
+        line = " ".join(raw.split("#", 1)[0].split())
+        if not line:
+            continue
+        if line.split()[0] in SECTIONS:
+            skipping = kubernetes and line.startswith("resolvers ")
+        if skipping or (kubernetes and line.startswith("monitor")):
+            continue
+        if kubernetes and line.startswith("default-server "):
+            line = KUBERNETES_OPTIONS.sub("", line)
+        lines.append(line)
+    return lines
+
+
+def haproxy_drift(text):
+    shipped_path = os.path.join(directory, "haproxy.cfg")
+    try:
+        with open(shipped_path) as f:
+            shipped = haproxy_lines(f.read(), False)
+    except OSError:
+        return f"{shipped_path} is missing"
+    ours = haproxy_lines(text, True)
+    for i, (a, b) in enumerate(zip(shipped, ours)):
+        if a != b:
+            return f"'{b}' where haproxy.cfg has '{a}'"
+    if len(shipped) != len(ours):
+        extra = (shipped[len(ours):] or ours[len(shipped):])[0]
+        return f"'{extra}' is only in {'haproxy.cfg' if len(shipped) > len(ours) else 'the ConfigMap'}"
+    return None
 
 
 for kind, name, path, d in workloads:
@@ -383,6 +425,10 @@ for kind, name, path, d, c in replicas:
                 if check.returncode != 0:
                     problem(cp, f"ConfigMap {config} {key}: haproxy -c fails: "
                                 + (check.stderr or check.stdout).strip().replace("\n", " | "))
+                drift = haproxy_drift(text)
+                if drift:
+                    problem(cp, f"ConfigMap {config} {key}: differs from haproxy.cfg beyond the "
+                                f"Kubernetes additions: {drift}")
                 for i in range(count or 0):
                     if f"${{DEFORM_REPLICA_{i + 1}}}" not in text:
                         problem(cp, f"ConfigMap {config} {key}: no server at DEFORM_REPLICA_{i + 1}")
@@ -497,6 +543,17 @@ for name, s in balancers.items():
     if named != set(deformd):
         problem(compose_path, f"service {name}: DEFORM_REPLICA_1..3 name {sorted(named)}, not the "
                               f"deformd services {sorted(deformd)}")
+    # The image's configuration (Dockerfile.haproxy copies haproxy.cfg) with this environment,
+    # the replicas' names as loopback addresses (haproxy -c resolves them, and they exist only
+    # on the compose network).
+    environment = dict(os.environ, **env)
+    for i in (1, 2, 3):
+        environment[f"DEFORM_REPLICA_{i}"] = "127.0.0.1:" + env.get(f"DEFORM_REPLICA_{i}", ":").rsplit(":", 1)[1]
+    check = subprocess.run(["haproxy", "-c", "-f", os.path.join(directory, "haproxy.cfg")],
+                           env=environment, capture_output=True, text=True)
+    if check.returncode != 0:
+        problem(compose_path, f"service {name}: haproxy -c fails on haproxy.cfg: "
+                              + (check.stderr or check.stdout).strip().replace("\n", " | "))
     depends = s.get("depends_on") or {}
     for replica in deformd:
         condition = depends.get(replica, {}).get("condition") if isinstance(depends, dict) else None

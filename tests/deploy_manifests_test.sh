@@ -83,6 +83,17 @@ edit("k8s/balancer.yaml", f)'
 break_case haproxy-config "haproxy -c fails" '
 def f(d): d["data"]["haproxy.cfg"] = d["data"]["haproxy.cfg"].replace("hash-type consistent", "hash-type ring")
 edit("k8s/balancer-config.yaml", f)'
+break_case haproxy-drift "differs from haproxy.cfg beyond the Kubernetes additions: 'default-server check proto h2 inter 2s" '
+def f(d): d["data"]["haproxy.cfg"] = d["data"]["haproxy.cfg"].replace("inter 500ms", "inter 2s")
+edit("k8s/balancer-config.yaml", f)'
+break_case haproxy-shipped-changed "'tune.h2.max-concurrent-streams 100' where haproxy.cfg has" '
+with open("haproxy.cfg") as f: text = f.read()
+with open("haproxy.cfg", "w") as f: f.write(text.replace("max-concurrent-streams 1000", "max-concurrent-streams 2000"))
+def g(d): d["data"]["haproxy.cfg"] = d["data"]["haproxy.cfg"].replace("max-concurrent-streams 1000", "max-concurrent-streams 100")
+edit("k8s/balancer-config.yaml", g)'
+break_case compose-haproxy "service balancer: haproxy -c fails on haproxy.cfg" '
+def f(d): d["services"]["balancer"]["environment"]["DEFORM_LB_STATS"] = "0.0.0.0"
+edit("compose.yaml", f)'
 break_case drain-within-grace "is not within --shutdown-grace-s" '
 def f(d):
     for e in d["spec"]["template"]["spec"]["containers"][0]["env"]:
