@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Generates the deform.v1 stubs that the package ships (deform_client/_proto/), or checks them.
 
-    python3 client/python/generate_stubs.py          # rewrites deform_client/_proto/deform_pb2*
+    python3 client/python/generate_stubs.py          # rewrites deform_client/_proto/*_pb2*
     python3 client/python/generate_stubs.py --check  # exit 1 naming every file that differs
 
 The stubs are committed so that `pip install client/python` needs neither protoc nor the C++
@@ -12,6 +12,15 @@ they live inside the package instead of as a top-level `deform` package: deform_
 imports deform_pb2 relatively, and the messages' module is deform_client._proto.deform_pb2.
 The descriptor keeps its file name deform/v1/deform.proto. ctest's python_client_stubs_current
 runs --check, so a proto change without regenerated stubs fails the tests.
+
+Beside them, google.rpc.Status and its error details (rpc_status_pb2*, rpc_error_details_pb2*:
+what the server's RetryInfo is read from) are made from Debian's golang-github-gogo-googleapis-dev
+protos (the ones the C++ build uses; GOOGLE_RPC_PROTO_DIR names another copy of their
+google/rpc/), with their proto package renamed deform_client.rpc and their files placed as
+deform_client/_proto/rpc_*.proto: the same wire format under names of this package's own, so
+that they never collide in protobuf's descriptor pool with the real google.rpc modules
+(googleapis-common-protos) an application may import too. Any's type URLs still name
+google.rpc.RetryInfo, which is what the client compares.
 
 PROTOC and GRPC_PYTHON_PLUGIN name other programs; exit 2 when one is missing.
 """
@@ -31,6 +40,10 @@ PROTO = "deform/v1/deform.proto"
 PACKAGE_DIR = HERE / "deform_client" / "_proto"
 MODULE = "deform_client._proto.deform_pb2"
 GENERATED = ("deform_pb2.py", "deform_pb2.pyi", "deform_pb2_grpc.py")
+GOOGLE_RPC_DIR = pathlib.Path(os.environ.get(
+    "GOOGLE_RPC_PROTO_DIR", "/usr/share/gocode/src/github.com/gogo/googleapis/google/rpc"))
+GOOGLE_RPC = ("status", "error_details")
+RPC_PACKAGE = ("package google.rpc;", "package deform_client.rpc;")
 # (file, text protoc writes, text the package ships): each must occur exactly once.
 REWRITES = (
     ("deform_pb2.py", "'deform.v1.deform_pb2'", f"'{MODULE}'"),
@@ -57,6 +70,7 @@ def generate(directory):
                         str(PROTO_ROOT / PROTO)], check=True)
         texts = {name: (pathlib.Path(out) / "deform" / "v1" / name).read_text()
                  for name in GENERATED}
+    texts.update(generate_google_rpc(protoc))
     for name, before, after in REWRITES:
         if texts[name].count(before) != 1:
             sys.exit(f"generate_stubs: {name} holds {before!r} "
@@ -64,6 +78,33 @@ def generate(directory):
         texts[name] = texts[name].replace(before, after)
     for name, text in texts.items():
         (pathlib.Path(directory) / name).write_text(text)
+    return texts
+
+
+def generate_google_rpc(protoc):
+    """{file name: text} of rpc_status_pb2.py(i) and rpc_error_details_pb2.py(i)."""
+    texts = {}
+    with tempfile.TemporaryDirectory() as work:
+        tree = pathlib.Path(work) / "in" / "deform_client" / "_proto"
+        tree.mkdir(parents=True)
+        out = pathlib.Path(work) / "out"
+        out.mkdir()
+        for name in GOOGLE_RPC:
+            source = GOOGLE_RPC_DIR / f"{name}.proto"
+            if not source.is_file():
+                sys.exit(f"generate_stubs: {source} not found (Debian's "
+                         f"golang-github-gogo-googleapis-dev; or set GOOGLE_RPC_PROTO_DIR)")
+            text = source.read_text()
+            if text.count(RPC_PACKAGE[0]) != 1:
+                sys.exit(f"generate_stubs: {source} does not declare {RPC_PACKAGE[0]!r} once")
+            (tree / f"rpc_{name}.proto").write_text(text.replace(*RPC_PACKAGE))
+        subprocess.run([protoc, f"-I{pathlib.Path(work) / 'in'}", f"--python_out={out}",
+                        f"--pyi_out={out}"]
+                       + [str(tree / f"rpc_{name}.proto") for name in GOOGLE_RPC], check=True)
+        for name in GOOGLE_RPC:
+            for suffix in (".py", ".pyi"):
+                file_name = f"rpc_{name}_pb2{suffix}"
+                texts[file_name] = (out / "deform_client" / "_proto" / file_name).read_text()
     return texts
 
 
@@ -80,10 +121,10 @@ def check():
                 shipped.splitlines(True), text.splitlines(True), f"shipped/{name}",
                 f"generated/{name}", n=1))[:40])
     if stale:
-        print(f"generate_stubs: {', '.join(stale)} differ from what {PROTO} generates; run "
+        print(f"generate_stubs: {', '.join(stale)} differ from what {PROTO} and google/rpc generate; run "
               f"python3 client/python/generate_stubs.py", file=sys.stderr)
         return 1
-    print(f"generate_stubs: {len(texts)} stubs match {PROTO}")
+    print(f"generate_stubs: {len(texts)} stubs match {PROTO} and google/rpc")
     return 0
 
 
@@ -94,8 +135,7 @@ def main():
     if parser.parse_args().check:
         return check()
     PACKAGE_DIR.mkdir(exist_ok=True)
-    generate(PACKAGE_DIR)
-    print(f"generate_stubs: wrote {', '.join(GENERATED)} into {PACKAGE_DIR}")
+    print(f"generate_stubs: wrote {', '.join(sorted(generate(PACKAGE_DIR)))} into {PACKAGE_DIR}")
     return 0
 
 
