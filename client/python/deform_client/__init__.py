@@ -10,15 +10,17 @@ Modules: client (DeformClient), async_client (AsyncDeformClient, AsyncDeformStre
 asyncio), summary (MeshSummary, MeshInfo, Joint, Bone, BoneSurface...), stream (DeformStream,
 Frame), contact (ContactQuery: a tool's contact at haptic rate), calls (what both clients send; timeouts: DEFAULT), channel (TLS), codec (the frame
 decoders), meshopt (meshoptimizer's decoder through ctypes), poses (pose forms), tools (tool
-forms), errors (DeformError), stubs (the generated deform.v1 code shipped in _proto/, `pb`),
+forms), errors (DeformError), reconnect (ReconnectPolicy: streams that survive their server's
+loss), stubs (the generated deform.v1 code shipped in _proto/, `pb`),
 version (`__version__`, deformd's).
 """
 
 from .async_client import AsyncDeformClient, AsyncDeformStream, async_client_from_environment
-from .calls import DEFAULT, DEFAULT_LOAD_TIMEOUT, DEFAULT_UNARY_TIMEOUT
+from .calls import DEFAULT, DEFAULT_LOAD_TIMEOUT, DEFAULT_UNARY_TIMEOUT, MESH_KEY_HEADER
 from .client import DeformClient, client_from_environment
 from .contact import ContactQuery
 from .errors import DeformError
+from .reconnect import ReconnectPolicy
 from .stream import DeformStream, Frame
 from .stubs import pb
 from .summary import (Bone, BoneSurface, BoneSurfaceInfo, DegreeOfFreedom, Joint, MeshInfo,
@@ -29,5 +31,5 @@ from .version import __version__
 __all__ = ["__version__", "AsyncDeformClient", "AsyncDeformStream", "Bone", "BoneSurface",
            "BoneSurfaceInfo", "ContactQuery", "DEFAULT", "DEFAULT_LOAD_TIMEOUT", "DEFAULT_UNARY_TIMEOUT",
            "DegreeOfFreedom", "DeformClient", "DeformError", "DeformStream", "Frame", "Joint",
-           "MeshInfo", "MeshSummary", "async_client_from_environment", "client_from_environment",
-           "pb", "tool_state"]
+           "MESH_KEY_HEADER", "MeshInfo", "MeshSummary", "ReconnectPolicy",
+           "async_client_from_environment", "client_from_environment", "pb", "tool_state"]

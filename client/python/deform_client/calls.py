@@ -5,11 +5,17 @@ Timeouts: every call takes `timeout=` in seconds. DEFAULT (the default) means th
 `unary_timeout` (30 s) for info, list and unload, `load_timeout` (600 s, a load's time grows
 with the mesh) for loads; None means no deadline (what a stream has unless given one). A call
 past its deadline fails with DeformError DEADLINE_EXCEEDED.
+
+Routing: every call that names a mesh (info, unload, stream, contact) carries the metadata
+MESH_KEY_HEADER with the mesh's id (its content key), as the C++ library's calls do
+(client/lib/deform_client.h, kMeshKeyHeader), so that a balancer in front of several servers
+sends all of a mesh's calls to the one that holds it (docs/cluster.md).
 """
 
 from __future__ import annotations
 
 import pathlib
+import time
 from typing import (Callable, Iterable, Iterator, List, Optional, Sequence, Tuple, Union,
                     cast)
 
@@ -172,3 +178,26 @@ def stream_start(mesh_id: str, encoding: int, max_error: float,
 
 def metadata(token: Optional[str]) -> Sequence[Tuple[str, str]]:
     return (("authorization", f"Bearer {token}"),) if token else ()
+
+
+MESH_KEY_HEADER = "deform-mesh-key"
+_MAX_MESH_KEY_BYTES = 128
+
+
+def with_mesh_key(base: Sequence[Tuple[str, str]],
+                  mesh_id: str) -> Sequence[Tuple[str, str]]:
+    """`base` and MESH_KEY_HEADER: mesh_id; `base` alone for an id that is not printable ASCII
+    (no space) of at most 128 bytes: such an id is no server's (gRPC would refuse it as a value),
+    and the call is answered NOT_FOUND unrouted."""
+    if not 0 < len(mesh_id) <= _MAX_MESH_KEY_BYTES or \
+            any(not 0x21 <= ord(c) <= 0x7e for c in mesh_id):
+        return base
+    return (*base, (MESH_KEY_HEADER, mesh_id))
+
+
+def retries_after(error: DeformError, deadline: Optional[float]) -> bool:
+    """Whether a unary call that failed with `error` is asked again after error.retry_delay: an
+    UNAVAILABLE with a RetryInfo whose delay ends before `deadline` (time.monotonic(); None: no
+    deadline)."""
+    return (error.code == grpc.StatusCode.UNAVAILABLE and error.retry_delay > 0 and
+            (deadline is None or time.monotonic() + error.retry_delay < deadline))

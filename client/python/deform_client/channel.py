@@ -32,9 +32,15 @@ def channel_settings(tls: bool, ca: Pem, cert: Pem, key: Pem, server_name: Optio
     """(credentials, options): credentials None for a plaintext channel."""
     if (cert is None) != (key is None):
         raise ValueError("a client certificate needs its key and a key its certificate")
+    # A lost server is tried again within 100 ms to 1 s (gRPC's defaults: 1 s growing to 120 s),
+    # so that a reconnecting stream (reconnect.py) finds the next server soon; the C++ library's
+    # channel does the same (client/lib/deform_client.cc, MakeDeformChannel).
     options: List[Tuple[str, object]] = [
         ("grpc.max_receive_message_length", max_receive_message_bytes),
-        ("grpc.max_send_message_length", -1)]
+        ("grpc.max_send_message_length", -1),
+        ("grpc.min_reconnect_backoff_ms", 100),
+        ("grpc.initial_reconnect_backoff_ms", 100),
+        ("grpc.max_reconnect_backoff_ms", 1000)]
     if not (tls or ca is not None or cert is not None):
         return None, options
     credentials = grpc.ssl_channel_credentials(root_certificates=_pem(ca),

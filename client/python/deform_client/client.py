@@ -5,6 +5,10 @@ The Python counterpart of the C++ client library (client/lib/deform_client.h):
 - Connection: `target` "host:port". Plaintext by default (deformd serves it on loopback only);
   TLS with `tls=True` or any of `ca`, `cert`, `key`, `server_name` (channel.py).
 - Identity: `token` is sent with every call as the metadata "authorization: Bearer <token>".
+- Clusters (docs/cluster.md): the calls that name a mesh also send its id as the metadata
+  "deform-mesh-key" (calls.MESH_KEY_HEADER), which a balancer routes on; info() asks again when a
+  replica answers UNAVAILABLE with a RetryInfo (it is building the mesh), within its deadline;
+  stream(reconnect=True) survives the loss of its server (reconnect.py).
 - Deadlines: every call takes `timeout=` (calls.py): by default `unary_timeout` seconds (30) for
   info, list_meshes and unload, `load_timeout` (600) for loads, none for a stream; None: none.
   A call past its deadline raises DeformError DEADLINE_EXCEEDED.
@@ -22,7 +26,8 @@ async_client.py is the same client on asyncio.
 from __future__ import annotations
 
 import os
-from typing import Any, Iterable, List, Literal, Optional, Union
+import time
+from typing import Any, Iterable, List, Literal, Optional, Sequence, Tuple, Union
 
 import grpc
 
@@ -31,6 +36,7 @@ from .calls import DEFAULT, BoneSurfaceSpec, PathLike, Progress, Timeout
 from .channel import DEFAULT_MAX_RECEIVE_MESSAGE_BYTES, Pem, channel_settings
 from .contact import ContactQuery
 from .errors import DeformError
+from .reconnect import OnReconnect, Reconnect, policy_of
 from .stream import DeformStream
 from .stubs import grpc_stubs, pb
 from .summary import BoneSurface, MeshInfo, MeshSummary
@@ -128,9 +134,10 @@ class DeformClient:
 
     # Inspecting.
 
-    def _unary(self, method: Any, request: Any, timeout: Timeout) -> Any:
+    def _unary(self, method: Any, request: Any, timeout: Timeout,
+               metadata: Optional[Sequence[Tuple[str, str]]] = None) -> Any:
         try:
-            return method(request, metadata=self._metadata,
+            return method(request, metadata=self._metadata if metadata is None else metadata,
                           timeout=calls.deadline(timeout, self._unary_timeout))
         except grpc.RpcError as error:
             raise DeformError.from_rpc_error(error) from None
@@ -143,31 +150,50 @@ class DeformClient:
     def info(self, mesh_id: str, geometry: bool = False, prediction_weights: bool = False, *,
              timeout: Timeout = DEFAULT) -> MeshInfo:
         """A mesh's MeshInfo; with `geometry` its rest positions and triangles, with
-        `prediction_weights` what predicted frames are decoded with."""
+        `prediction_weights` what predicted frames are decoded with. A server that answers
+        UNAVAILABLE with a RetryInfo (a replica building the mesh from a shared store) is asked
+        again after the delay it gives, while that ends within `timeout` (None: always)."""
         request = calls.info_request(mesh_id, geometry, prediction_weights)
-        return MeshInfo(self._unary(self._stub.GetMeshInfo, request, timeout), geometry,
-                        prediction_weights)
+        metadata = calls.with_mesh_key(self._metadata, mesh_id)
+        seconds = calls.deadline(timeout, self._unary_timeout)
+        deadline = None if seconds is None else time.monotonic() + seconds
+        while True:
+            left = None if deadline is None else max(0.0, deadline - time.monotonic())
+            try:
+                response = self._unary(self._stub.GetMeshInfo, request, left, metadata)
+                return MeshInfo(response, geometry, prediction_weights)
+            except DeformError as error:
+                if not calls.retries_after(error, deadline):
+                    raise
+                time.sleep(error.retry_delay)
 
     def unload(self, mesh_id: str, *, timeout: Timeout = DEFAULT) -> None:
         """Unloads a mesh (streams open on it keep it until they end)."""
-        self._unary(self._stub.UnloadMesh, pb.UnloadMeshRequest(mesh_id=mesh_id), timeout)
+        self._unary(self._stub.UnloadMesh, pb.UnloadMeshRequest(mesh_id=mesh_id), timeout,
+                    calls.with_mesh_key(self._metadata, mesh_id))
 
     # Streaming.
 
     def stream(self, mesh_id: str, encoding: Union[str, int] = "float32",
-               max_error: float = 0.0, *, timeout: Optional[float] = None) -> DeformStream:
+               max_error: float = 0.0, *, timeout: Optional[float] = None,
+               reconnect: Reconnect = False,
+               on_reconnect: Optional[OnReconnect] = None) -> DeformStream:
         """Opens a Deform stream on `mesh_id` whose frames travel in `encoding` (float32,
         quantized or predicted; max_error: predicted frames' largest error as a fraction of the
         bounding-box diagonal, 0 = the server's default 5e-5, kDefaultPredictedMaxError in
         server/core/codec/frame_codec.h). Asks GetMeshInfo first for what the decoder needs
         (which also raises NOT_FOUND for an unknown id; within the unary timeout). `timeout`:
         the stream's deadline in seconds (default None: none; past it the stream fails with
-        DEADLINE_EXCEEDED). Returns a DeformStream (stream.py)."""
+        DEADLINE_EXCEEDED). `reconnect`: True or a ReconnectPolicy (reconnect.py) for a stream
+        that survives the loss of its server, `on_reconnect(loss, attempt)` hearing of each
+        re-opened call (also counted in the stream's `reconnects`); default off. Returns a
+        DeformStream (stream.py)."""
         value, predicted = calls.stream_encoding(encoding)
         info = self.info(mesh_id, geometry=predicted, prediction_weights=predicted)
         start, decoder = calls.stream_start(mesh_id, value, max_error, info)
-        return DeformStream(self._stub, start, self._metadata, decoder,
-                            timeout=calls.deadline(timeout, None))
+        return DeformStream(self._stub, start, calls.with_mesh_key(self._metadata, mesh_id),
+                            decoder, timeout=calls.deadline(timeout, None),
+                            reconnect=policy_of(reconnect), on_reconnect=on_reconnect)
 
     def contact(self, mesh_id: str, deform_stream_id: int = 0,
                 stiffness: float = 0.0) -> ContactQuery:
@@ -177,7 +203,7 @@ class DeformClient:
         DeformError NOT_FOUND for an unknown mesh or stream."""
         start = pb.ContactQueryStart(mesh_id=mesh_id, deform_stream_id=deform_stream_id,
                                      stiffness=stiffness)
-        return ContactQuery(self._stub, start, self._metadata)
+        return ContactQuery(self._stub, start, calls.with_mesh_key(self._metadata, mesh_id))
 
 
 def client_from_environment(target: Optional[str] = None) -> DeformClient:

@@ -14,6 +14,13 @@ event after it; a frame that does not decode cancels the call and raises DeformE
 naming the problem. A cancel() by the caller ends the stream quietly. A stream opened with a
 deadline (DeformClient.stream(timeout=)) fails with DEADLINE_EXCEEDED past it.
 
+Reconnecting (DeformClient.stream(reconnect=...), reconnect.py): the reader thread itself waits
+out the backoff and opens the next call, which starts with the same DeformStart and the latest
+pose and stiffness update; its frames follow in the same queue. Sends while the stream is lost
+only become the latest pose or stiffness. The frames' decoder is kept: the same mesh id is the
+same content on every server (docs/cluster.md). A close() while the stream is lost ends it with
+the loss's DeformError, as without reconnecting; a cancel() ends it quietly.
+
 event_from and PoseNumbering are shared with the asyncio stream (async_client.py).
 """
 
@@ -21,9 +28,10 @@ from __future__ import annotations
 
 import dataclasses
 import queue
+import random
 import threading
 import time
-from typing import Iterator, List, Literal, Optional, Sequence, Tuple, Union
+from typing import Any, Iterator, List, Literal, Optional, Sequence, Tuple, Union
 
 import grpc
 import numpy as np
@@ -31,6 +39,7 @@ import numpy as np
 from . import codec
 from .errors import DeformError
 from .poses import pose_update
+from .reconnect import OnReconnect, ReconnectPolicy, is_loss
 from .stubs import pb
 from .tools import ToolSpec, tool_states
 
@@ -123,25 +132,45 @@ class PoseNumbering:
 
 class DeformStream:
     def __init__(self, stub: object, start: pb.DeformStart, metadata: Sequence[Tuple[str, str]],
-                 decoder: codec.FrameDecoder, timeout: Optional[float] = None):
+                 decoder: codec.FrameDecoder, timeout: Optional[float] = None,
+                 reconnect: Optional[ReconnectPolicy] = None,
+                 on_reconnect: Optional[OnReconnect] = None):
         """stub: a DeformServiceStub; start: the DeformStart message; metadata: call metadata;
         decoder: a codec.FrameDecoder for the mesh; timeout: the call's deadline in seconds
-        (None: none)."""
+        (None: none; with reconnect, for all the calls together); reconnect: a ReconnectPolicy
+        (None: the first loss ends the stream); on_reconnect: reconnect.OnReconnect."""
+        self._stub = stub
+        self._start = pb.DeformRequest(start=start)
+        self._metadata = metadata
         self._decoder = decoder
-        self._requests: queue.Queue = queue.Queue()
+        self._deadline = None if timeout is None else time.monotonic() + timeout
+        self._policy = reconnect
+        self._on_reconnect = on_reconnect
+        self._jitter = random.Random()
         self._events: queue.Queue = queue.Queue()
         self._lock = threading.Lock()
+        self._wake = threading.Event()  # set by close() and cancel(): ends a backoff's wait
         self._closing = False
         self._cancelled = False
         self._ended = False
         self._numbering = PoseNumbering()
+        # Guarded by _lock: what a re-opened call sends again.
+        self._latest_pose: Optional[pb.DeformRequest] = None
+        self._latest_stiffness: Optional[pb.DeformRequest] = None
+        self._attempts = 0        # re-opened calls since the last frame (reader thread only)
+        self._lost_at = 0.0       # when the stream was lost, the first time since its last frame
+        self.reconnects = 0       # calls re-opened after a loss (reconnect.py), in all
         self.notices: List[pb.Notice] = []  # every Notice taken so far (rejections, switches)
-        self._requests.put(pb.DeformRequest(start=start))
-        self._call = stub.Deform(self._request_iterator(), metadata=metadata,  # type: ignore
-                                 timeout=timeout)
+        self._requests: queue.Queue = queue.Queue()
+        self._requests.put(self._start)
+        self._call = self._open(self._requests, timeout)
         self._reader = threading.Thread(target=self._read, name="deform-stream-reader",
                                         daemon=True)
         self._reader.start()
+
+    def _open(self, requests: queue.Queue, timeout: Optional[float]) -> Any:
+        return self._stub.Deform(self._request_iterator(requests),  # type: ignore
+                                 metadata=self._metadata, timeout=timeout)
 
     # Sending.
 
@@ -156,22 +185,25 @@ class DeformStream:
         with self._lock:
             self._check_open_locked()
             request, sequence = self._numbering.request(pose, sequence, tools)
-            self._requests.put(request)
+            self._latest_pose = request
+            self._requests.put(request)  # a lost call's queue is read no more: the next resends
             return sequence
 
     def send_stiffness(self, stiffness: pb.StiffnessUpdate) -> None:
         """Sends a StiffnessUpdate message (replaces the stream's stiffness)."""
         with self._lock:
             self._check_open_locked()
-            self._requests.put(pb.DeformRequest(stiffness=stiffness))
+            self._latest_stiffness = pb.DeformRequest(stiffness=stiffness)
+            self._requests.put(self._latest_stiffness)
 
     def _check_open_locked(self) -> None:
         if self._closing or self._cancelled or self._ended:
             raise RuntimeError("the stream is closed")
 
-    def _request_iterator(self) -> Iterator[pb.DeformRequest]:
+    @staticmethod
+    def _request_iterator(requests: queue.Queue) -> Iterator[pb.DeformRequest]:
         while True:
-            request = self._requests.get()
+            request = requests.get()
             if request is None:
                 return
             yield request
@@ -179,17 +211,63 @@ class DeformStream:
     # Receiving.
 
     def _read(self) -> None:
-        try:
-            for response in self._call:
-                self._events.put(response)
-            self._events.put(_END)
-        except grpc.RpcError as error:
-            if self._cancelled and error.code() == grpc.StatusCode.CANCELLED:
-                self._events.put(_END)
-            else:
-                self._events.put(DeformError.from_rpc_error(error))
-        finally:
-            self._requests.put(None)  # lets gRPC's request thread finish
+        call, requests = self._call, self._requests
+        while True:
+            outcome: object = _END
+            try:
+                for response in call:
+                    if response.HasField("frame"):
+                        self._attempts = 0  # healthy again: the next loss starts a fresh budget
+                    self._events.put(response)
+            except grpc.RpcError as error:
+                if not (self._cancelled and error.code() == grpc.StatusCode.CANCELLED):
+                    outcome = DeformError.from_rpc_error(error)
+            finally:
+                requests.put(None)  # lets gRPC's request thread finish
+            if isinstance(outcome, DeformError) and self._policy is not None and \
+                    is_loss(outcome, self._cancelled):
+                reopened = self._reconnect(self._policy, outcome)
+                if isinstance(reopened, tuple):
+                    call, requests = reopened
+                    continue
+                outcome = reopened
+            self._events.put(outcome)
+            return
+
+    def _reconnect(self, policy: ReconnectPolicy, loss: DeformError) -> object:
+        """Waits out the backoff and opens the next call: (call, its request queue), or what ends
+        the stream instead (a DeformError, or _END once the caller cancelled)."""
+        if self._attempts == 0:
+            self._lost_at = time.monotonic()
+        while True:
+            if self._cancelled:
+                return _END
+            if self._closing:
+                return loss
+            if time.monotonic() - self._lost_at >= policy.give_up_after:
+                return loss
+            self._attempts += 1
+            if self._wake.wait(policy.delay(self._attempts, loss.retry_delay, self._jitter)):
+                continue  # closed or cancelled meanwhile
+            timeout = None
+            if self._deadline is not None:
+                timeout = self._deadline - time.monotonic()
+                if timeout <= 0:
+                    return DeformError(grpc.StatusCode.DEADLINE_EXCEEDED,
+                                       f"the stream's deadline passed while it was lost ({loss})")
+            with self._lock:
+                if self._cancelled or self._closing:
+                    continue
+                requests: queue.Queue = queue.Queue()
+                for request in (self._start, self._latest_pose, self._latest_stiffness):
+                    if request is not None:
+                        requests.put(request)
+                call = self._open(requests, timeout)
+                self._call, self._requests = call, requests
+            self.reconnects += 1
+            if self._on_reconnect is not None:
+                self._on_reconnect(loss, self._attempts)
+            return call, requests
 
     def next_event(self, timeout: Optional[float] = None) -> Optional[Event]:
         """The next Frame or Notice, or None once the stream has ended well. Raises DeformError
@@ -247,6 +325,7 @@ class DeformStream:
             if not self._closing:
                 self._closing = True
                 self._requests.put(None)
+        self._wake.set()
         deadline = time.monotonic() + timeout
         try:
             while self.next_event(timeout=max(0.0, deadline - time.monotonic())) is not None:
@@ -259,8 +338,10 @@ class DeformStream:
         """Cancels the call now; the stream ends quietly."""
         with self._lock:
             self._cancelled = True
-        self._call.cancel()
-        self._requests.put(None)
+            call, requests = self._call, self._requests
+        self._wake.set()
+        call.cancel()
+        requests.put(None)
 
     def __enter__(self) -> "DeformStream":
         return self

@@ -1,11 +1,12 @@
 """The real deformd as a child process for the Python client's tests.
 
-DeformdProcess(*flags): starts $DEFORM_TEST_DEFORMD (set by ctest to the deformd of the same
-build; default <repository>/build/server/deformd/deformd) with --listen 127.0.0.1:0 and `flags`,
+DeformdProcess(*flags, listen=): starts $DEFORM_TEST_DEFORMD (set by ctest to the deformd of the
+same build; default <repository>/build/server/deformd/deformd) with --listen `listen` (default
+127.0.0.1:0: a kernel-chosen port; free_port() gives one to start a second server on) and `flags`,
 its output into a temporary file, and waits (up to 60 s) for its "listening on HOST:PORT" line.
 RuntimeError with the log when the program is missing, exits or never listens: a missing server
 fails the tests, it never skips them. stop() sends SIGTERM (SIGKILL after 10 s); also on leaving
-a `with` block. paused() stops the process (SIGSTOP) for a `with` block and then continues it
+a `with` block; kill() sends SIGKILL (a replica that dies). paused() stops the process (SIGSTOP) for a `with` block and then continues it
 (SIGCONT): a server that answers nothing, for the deadline tests.
 """
 
@@ -14,6 +15,7 @@ import os
 import pathlib
 import re
 import signal
+import socket
 import subprocess
 import tempfile
 import time
@@ -30,11 +32,18 @@ def deformd_program():
     return program
 
 
+def free_port():
+    """A loopback port nothing listens on now (the kernel's pick, released)."""
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
+
+
 class DeformdProcess:
-    def __init__(self, *flags, timeout=60.0):
+    def __init__(self, *flags, listen="127.0.0.1:0", timeout=60.0):
         self._log = tempfile.NamedTemporaryFile(prefix="deformd-pytest-", suffix=".log")
         self._process = subprocess.Popen(
-            [str(deformd_program()), "--listen", "127.0.0.1:0", *map(str, flags)],
+            [str(deformd_program()), "--listen", listen, *map(str, flags)],
             stdout=self._log, stderr=subprocess.STDOUT)
         deadline = time.monotonic() + timeout
         while True:
@@ -60,6 +69,11 @@ class DeformdProcess:
                 self._process.kill()
                 self._process.wait()
         return self._process.returncode
+
+    def kill(self):
+        if self._process.poll() is None:
+            self._process.kill()
+        return self._process.wait()
 
     @contextlib.contextmanager
     def paused(self):
