@@ -4,10 +4,22 @@
 // goes in the Authorization header of POSTs and as the "bearer.<base64url>" subprotocol of
 // WebSockets (browsers cannot set headers on an upgrade). The paths name the RPCs as the proto's
 // DeformService does (/api/ListMeshes, /ws/Deform), the names taken from the generated code.
+// Clusters (docs/cluster.md): the POSTs that name a mesh send its id in the deform-mesh-key header
+// and the Deform WebSocket's URL carries it as ?mesh=<id> (an upgrade cannot carry the header), so
+// that a balancer in front of several servers sends all of a mesh's calls to the one holding it;
+// the server ignores the query string.
 import { DeformService, FrameEncoding } from './deform/v1/deform_pb.js';
 import * as wire from './proto_wire.js';
 
 const rpc = DeformService.method;
+
+// The header the C++ and Python clients send too (client/lib/deform_client.h, kMeshKeyHeader):
+// only for an id of printable ASCII without spaces, at most 128 bytes (no server has another).
+export const MESH_KEY_HEADER = 'deform-mesh-key';
+
+export function isMeshKey(meshId) {
+  return typeof meshId === 'string' && meshId.length > 0 && meshId.length <= 128 && /^[\x21-\x7e]+$/.test(meshId);
+}
 
 function base64url(text) {
   const bytes = new TextEncoder().encode(text);
@@ -19,11 +31,12 @@ function base64url(text) {
 export class DeformApi {
   constructor(token = '') { this.token = token; }
 
-  // POSTs one unary call's request message (bytes) to /api/<method name>; resolves with the
-  // response message's bytes.
-  async call(method, body) {
+  // POSTs one unary call's request message (bytes) to /api/<method name>, with the mesh it names
+  // (if any) as MESH_KEY_HEADER; resolves with the response message's bytes.
+  async call(method, body, meshId = '') {
     const headers = { 'Content-Type': 'application/x-protobuf' };
     if (this.token) headers.Authorization = `Bearer ${this.token}`;
+    if (isMeshKey(meshId)) headers[MESH_KEY_HEADER] = meshId;
     const response = await fetch(`/api/${method}`, { method: 'POST', headers, body });
     const bytes = new Uint8Array(await response.arrayBuffer());
     if (!response.ok) {
@@ -40,14 +53,17 @@ export class DeformApi {
   // FRAME_ENCODING_PREDICTED frames are decoded with.
   async meshInfo(meshId, includePredictionWeights = true) {
     return wire.decodeGetMeshInfoResponse(
-      await this.call(rpc.getMeshInfo.name, wire.encodeGetMeshInfoRequest(meshId, true, includePredictionWeights)));
+      await this.call(rpc.getMeshInfo.name, wire.encodeGetMeshInfoRequest(meshId, true, includePredictionWeights),
+                      meshId));
   }
 
-  // A WebSocket to /ws/<method> with the protocol's subprotocols.
-  openSocket(method) {
+  // A WebSocket to /ws/<method> with the protocol's subprotocols; ?mesh=<id> for a call that
+  // names a mesh.
+  openSocket(method, meshId = '') {
     const protocols = ['deform.v1'];
     if (this.token) protocols.push(`bearer.${base64url(this.token)}`);
-    const socket = new WebSocket(`${location.origin.replace(/^http/, 'ws')}/ws/${method}`, protocols);
+    const query = isMeshKey(meshId) ? `?mesh=${encodeURIComponent(meshId)}` : '';
+    const socket = new WebSocket(`${location.origin.replace(/^http/, 'ws')}/ws/${method}${query}`, protocols);
     socket.binaryType = 'arraybuffer';
     return socket;
   }
@@ -83,7 +99,7 @@ export class DeformApi {
 // onEnd(code, message).
 export class DeformStream {
   constructor(api, meshId, { onFrame, onNotice, onEnd, onOpen, encoding = FrameEncoding.FLOAT32, maxError = 0 }) {
-    this.socket = api.openSocket(rpc.deform.name);
+    this.socket = api.openSocket(rpc.deform.name, meshId);
     this.sequence = 0;
     this.open = false;
     this.socket.onopen = () => {

@@ -168,7 +168,7 @@ test('the page calls the proto\'s RPCs at the HTTP port\'s paths', async () => {
   const posts = [], sockets = [];
   globalThis.location = { origin: 'http://127.0.0.1:8080' };
   globalThis.fetch = async (url, init) => {
-    posts.push({ url, body: init.body });
+    posts.push({ url, body: init.body, headers: init.headers });
     const body = url === '/api/ListMeshes' ? binary(pb.ListMeshesResponseSchema, { meshes: [summaryJson] })
       : binary(pb.GetMeshInfoResponseSchema, { summary: summaryJson });
     return { ok: true, arrayBuffer: async () => body.slice().buffer };
@@ -178,20 +178,37 @@ test('the page calls the proto\'s RPCs at the HTTP port\'s paths', async () => {
     send(message) { this.sent.push(message); }
     close() {}
   };
-  const { DeformApi, DeformStream } = await load('deform_api.js');
+  const { DeformApi, DeformStream, MESH_KEY_HEADER, isMeshKey } = await load('deform_api.js');
   const api = new DeformApi();
   assertSummary((await api.listMeshes())[0]);
   assertSummary((await api.meshInfo('m1')).summary);
   assert.deepEqual(posts.map((p) => p.url), ['/api/ListMeshes', '/api/GetMeshInfo']);
+  // The mesh's key for a balancer (docs/cluster.md): on the POST naming it, not on the listing.
+  assert.equal(MESH_KEY_HEADER, 'deform-mesh-key');
+  assert.equal(posts[0].headers[MESH_KEY_HEADER], undefined);
+  assert.equal(posts[1].headers[MESH_KEY_HEADER], 'm1');
   assertEncodes(pb.GetMeshInfoRequestSchema, posts[1].body,
                 { meshId: 'm1', includeGeometry: true, includePredictionWeights: true });
 
   api.loadPhantom(2000, () => {}).catch(() => {});
   const stream = new DeformStream(api, 'm1', { encoding: codec.PREDICTED, onFrame() {}, onNotice() {}, onEnd() {} });
-  assert.deepEqual(sockets.map((s) => s.url), ['ws://127.0.0.1:8080/ws/LoadMesh', 'ws://127.0.0.1:8080/ws/Deform']);
+  assert.deepEqual(sockets.map((s) => s.url), ['ws://127.0.0.1:8080/ws/LoadMesh', 'ws://127.0.0.1:8080/ws/Deform?mesh=m1']);
   sockets[0].onopen();
   assertEncodes(pb.LoadMeshRequestSchema, sockets[0].sent[0], { header: { name: 'phantom 2000', phantom: { vertices: 2000 } } });
   sockets[1].onopen();
   assertEncodes(pb.DeformRequestSchema, sockets[1].sent[0], { start: { meshId: 'm1', encoding: 'FRAME_ENCODING_PREDICTED' } });
   stream.close();
+
+  // The id in the URL is encoded as a query value; an id no server has (not printable ASCII, or
+  // over 128 bytes) is sent neither in the URL nor as the header, as the other clients do.
+  new DeformStream(api, 'a&b=c/d#e+f', { onFrame() {}, onNotice() {}, onEnd() {} }).close();
+  assert.equal(sockets[2].url, 'ws://127.0.0.1:8080/ws/Deform?mesh=a%26b%3Dc%2Fd%23e%2Bf');
+  for (const id of ['two words', 'é', 'x'.repeat(129), '']) {
+    assert.equal(isMeshKey(id), false, id);
+    new DeformStream(api, id, { onFrame() {}, onNotice() {}, onEnd() {} }).close();
+    assert.equal(sockets.at(-1).url, 'ws://127.0.0.1:8080/ws/Deform');
+    await api.meshInfo(id);
+    assert.equal(posts.at(-1).headers[MESH_KEY_HEADER], undefined);
+  }
+  assert.equal(isMeshKey('x'.repeat(128)), true);
 });

@@ -128,6 +128,15 @@ async function tokenChecks() {
   const good = await rawRequest(server.port, 'GET', '/ws/Deform', upgradeHeaders(`deform.v1, bearer.${b64url(token)}`));
   check(good.upgraded && good.status === 101 && good.headers['sec-websocket-protocol'] === 'deform.v1',
         'an upgrade with the token as its subprotocol is upgraded, answering "deform.v1" only');
+  // A balancer's routing key (docs/cluster.md): the page's Deform URL carries ?mesh=<id> and its
+  // POSTs naming a mesh the deform-mesh-key header; the server routes on the path alone.
+  const keyed = await rawRequest(server.port, 'GET', '/ws/Deform?mesh=mesh-0a%2Fb',
+                                 upgradeHeaders(`deform.v1, bearer.${b64url(token)}`));
+  check(keyed.upgraded && keyed.status === 101, `an upgrade whose URL carries ?mesh= is upgraded (${keyed.status})`);
+  const keyedPost = await rawRequest(server.port, 'POST', '/api/ListMeshes',
+                                     { 'Content-Type': 'application/x-protobuf', Authorization: `Bearer ${token}`,
+                                       'deform-mesh-key': 'mesh-0a' }, '');
+  check(keyedPost.status === 200, `a POST with the deform-mesh-key header is answered (${keyedPost.status})`);
   const list = await rawRequest(server.port, 'POST', '/api/ListMeshes', { 'Content-Type': 'application/x-protobuf' }, '');
   check(list.status === 401 && list.headers['deform-status'] === '16', 'ListMeshes without a token is 401 (UNAUTHENTICATED)');
   const listed = await rawRequest(server.port, 'POST', '/api/ListMeshes',
@@ -395,12 +404,25 @@ async function browserChecks(server) {
     });
     page.on('pageerror', (error) => consoleErrors.push(`page error: ${error.message}`));
     page.on('requestfailed', (request) => consoleErrors.push(`request failed: ${request.url()}`));
+    // What the page sends a balancer to route on (docs/cluster.md): the WebSockets' URLs and the
+    // GetMeshInfo POSTs' deform-mesh-key header.
+    const socketUrls = [], infoKeys = [];
+    const cdp = await page.createCDPSession();
+    await cdp.send('Network.enable');
+    cdp.on('Network.webSocketCreated', (event) => socketUrls.push(event.url));
+    page.on('request', (request) => {
+      if (request.url().endsWith('/api/GetMeshInfo')) infoKeys.push(request.headers()['deform-mesh-key']);
+    });
     await page.goto(`http://127.0.0.1:${port}/`, { waitUntil: 'load', timeout: 30_000 });
     await waitFor(page, () => window.viewerState && Array.isArray(window.viewerState.meshes), 'the viewer starts');
 
     await page.click('#load-phantom');
     await waitFor(page, () => window.viewerState.streamStatus === 'open', 'the phantom loads and its Deform stream opens', 60_000);
     await waitFor(page, () => window.viewerState.framesReceived >= 1, 'a frame arrives for the rest pose');
+    const meshId = await page.evaluate(() => window.viewerState.meshId);
+    check(socketUrls.some((url) => url.endsWith(`/ws/Deform?mesh=${encodeURIComponent(meshId)}`)),
+          `the Deform WebSocket's URL carries ?mesh=<id> (${socketUrls.join(' ')})`);
+    check(infoKeys.includes(meshId), `GetMeshInfo sends the deform-mesh-key header (${infoKeys.join(' ')})`);
     const listed = await page.evaluate(() => window.viewerState.meshes.map((m) => m.name));
     check(listed.some((name) => name.startsWith('phantom')), `the mesh list shows the phantom (${listed.join(', ')})`);
     const summary = await page.evaluate(() => window.viewerState.summary);
