@@ -121,8 +121,8 @@ def check():
                 shipped.splitlines(True), text.splitlines(True), f"shipped/{name}",
                 f"generated/{name}", n=1))[:40])
     if stale:
-        print(f"generate_stubs: {', '.join(stale)} differ from what {PROTO} and google/rpc generate; run "
-              f"python3 client/python/generate_stubs.py", file=sys.stderr)
+        print(f"generate_stubs: {', '.join(stale)} differ from what {PROTO} and google/rpc "
+              f"generate; run python3 client/python/generate_stubs.py", file=sys.stderr)
         return 1
     print(f"generate_stubs: {len(texts)} stubs match {PROTO} and google/rpc")
     return 0

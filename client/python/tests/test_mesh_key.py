@@ -61,7 +61,8 @@ class RecordingService(grpc_stubs.DeformServiceServicer):
             self.unavailable -= 1
         if refuse:
             if self.retry_ms:
-                context.set_trailing_metadata(((STATUS_DETAILS_KEY, status_details(self.retry_ms)),))
+                details = status_details(self.retry_ms)
+                context.set_trailing_metadata(((STATUS_DETAILS_KEY, details),))
             context.abort(grpc.StatusCode.UNAVAILABLE, "the mesh is being built here")
         return pb.GetMeshInfoResponse(summary=pb.MeshSummary(mesh_id=request.mesh_id,
                                                              vertex_count=3))
